@@ -1,0 +1,95 @@
+//! The BSDF plugin interface (pbrt-v4 `BxDF`), in the local shading frame.
+
+use glam::{Vec2, Vec3};
+
+use crate::spectrum::Rgb;
+
+/// Which quantity is transported; refraction scales radiance by 1/eta^2 but
+/// not importance (Veach 1997, section 5.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TransportMode {
+    #[default]
+    Radiance,
+    Importance,
+}
+
+/// Per-hit information a BSDF may read, so evaluation needs no allocation.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BsdfContext {
+    pub uv: Vec2,
+    pub mode: TransportMode,
+}
+
+/// Lobe classification: what a BSDF (or one sample of it) is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BsdfFlags(u8);
+
+impl BsdfFlags {
+    pub const NONE: Self = Self(0);
+    pub const REFLECTION: Self = Self(1);
+    pub const TRANSMISSION: Self = Self(1 << 1);
+    pub const DIFFUSE: Self = Self(1 << 2);
+    pub const GLOSSY: Self = Self(1 << 3);
+    /// A Dirac delta lobe: `f` and `pdf` are zero for every direction, only
+    /// `sample_f` can produce it and MIS must not weight it.
+    pub const SPECULAR: Self = Self(1 << 4);
+    pub const DIFFUSE_REFLECTION: Self = Self(Self::DIFFUSE.0 | Self::REFLECTION.0);
+
+    #[inline]
+    pub const fn union(self, o: Self) -> Self {
+        Self(self.0 | o.0)
+    }
+
+    #[inline]
+    pub const fn contains(self, o: Self) -> bool {
+        self.0 & o.0 == o.0
+    }
+
+    #[inline]
+    pub const fn is_specular(self) -> bool {
+        self.0 & Self::SPECULAR.0 != 0
+    }
+
+    /// Whether any lobe has a finite density, i.e. can be evaluated with `f`.
+    #[inline]
+    pub const fn is_non_specular(self) -> bool {
+        self.0 & (Self::DIFFUSE.0 | Self::GLOSSY.0) != 0
+    }
+}
+
+impl std::ops::BitOr for BsdfFlags {
+    type Output = Self;
+    fn bitor(self, o: Self) -> Self {
+        self.union(o)
+    }
+}
+
+/// A sampled direction with the BSDF value and density for it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSample {
+    /// `f(wo, wi)`, without the cosine.
+    pub f: Rgb,
+    /// Sampled incident direction, local frame, unit length.
+    pub wi: Vec3,
+    /// Density w.r.t. solid angle (for specular samples: the discrete probability).
+    pub pdf: f32,
+    pub flags: BsdfFlags,
+    /// Relative index of refraction along `wi` (1 for reflection).
+    pub eta: f32,
+}
+
+/// A BSDF in its local shading frame (`z` = shading normal).
+///
+/// Directions point away from the surface. `f` excludes the cosine factor;
+/// `pdf` is a density w.r.t. solid angle and must describe exactly the
+/// distribution `sample_f` draws from (the chi-square tests check this).
+pub trait Bsdf: Send + Sync {
+    fn flags(&self) -> BsdfFlags;
+
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb;
+
+    /// Samples `wi` given `wo`. `u1` picks a lobe, `u2` the direction.
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample>;
+
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32;
+}

@@ -1,0 +1,63 @@
+//! Errors that point at the scene file, line and key that caused them.
+
+use std::fmt;
+use std::sync::Arc;
+
+/// Where a value came from: a line of a scene file, or a command-line override.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Location {
+    File { path: Arc<str>, line: u32, column: u32 },
+    Override(Arc<str>),
+    /// Built into lumis (a parameter default, a programmatic table).
+    Builtin,
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::File { path, line, column } => write!(f, "{path}:{line}:{column}"),
+            Location::Override(text) => write!(f, "--set {text}"),
+            Location::Builtin => write!(f, "<built-in>"),
+        }
+    }
+}
+
+/// A lumis error: a message, and where in the input it was found if known.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub struct Error {
+    pub location: Option<Location>,
+    pub message: String,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.location {
+            Some(location) => write!(f, "{location}: {}", self.message),
+            None => f.write_str(&self.message),
+        }
+    }
+}
+
+impl Error {
+    pub fn msg(message: impl Into<String>) -> Self {
+        Self {
+            location: None,
+            message: message.into(),
+        }
+    }
+
+    pub fn at(location: &Location, message: impl Into<String>) -> Self {
+        Self {
+            location: Some(location.clone()),
+            message: message.into(),
+        }
+    }
+
+    /// Prefixes the message with context, keeping the location.
+    pub fn context(mut self, context: impl fmt::Display) -> Self {
+        self.message = format!("{context}: {}", self.message);
+        self
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

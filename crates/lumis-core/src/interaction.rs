@@ -1,0 +1,82 @@
+//! What an integrator knows about a surface hit.
+
+use glam::{Vec2, Vec3};
+
+use crate::bsdf::Bsdf;
+use crate::light::Light;
+use crate::math::Frame;
+use crate::ray::{Ray, SurfacePoint};
+
+/// An area light attached to the surface that was hit.
+#[derive(Clone, Copy)]
+pub struct HitLight<'a> {
+    /// Index into [`crate::Scene::lights`], for the light sampler's pmf.
+    pub index: u32,
+    pub light: &'a dyn Light,
+}
+
+/// A ray-surface intersection, ready for shading.
+#[derive(Clone, Copy)]
+pub struct SurfaceInteraction<'a> {
+    /// The hit point, its error bound and the unit geometric normal (on the
+    /// front side of the surface as the shape defines it).
+    pub point: SurfacePoint,
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Shading frame; `z` is the shading normal, on the same side as `point.n`.
+    pub shading: Frame,
+    pub uv: Vec2,
+    /// Unit direction back along the incoming ray, in world space.
+    pub wo: Vec3,
+    pub bsdf: &'a dyn Bsdf,
+    pub light: Option<HitLight<'a>>,
+}
+
+impl SurfaceInteraction<'_> {
+    #[inline]
+    pub fn p(&self) -> Vec3 {
+        self.point.p
+    }
+
+    #[inline]
+    pub fn n(&self) -> Vec3 {
+        self.point.n
+    }
+
+    #[inline]
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        self.point.spawn_ray(d)
+    }
+
+    /// Where light sampling starts from this hit.
+    #[inline]
+    pub fn light_context(&self) -> LightSampleContext {
+        LightSampleContext {
+            point: self.point,
+            ns: self.shading.z,
+        }
+    }
+}
+
+/// The reference point for light sampling: a surface point (or, with a zero
+/// normal, a point in space) and its shading normal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSampleContext {
+    pub point: SurfacePoint,
+    pub ns: Vec3,
+}
+
+impl LightSampleContext {
+    /// A context at a point in free space (no surface), as the tests use.
+    pub fn at(p: Vec3) -> Self {
+        Self {
+            point: SurfacePoint::isolated(p),
+            ns: Vec3::ZERO,
+        }
+    }
+
+    #[inline]
+    pub fn p(&self) -> Vec3 {
+        self.point.p
+    }
+}

@@ -1,0 +1,42 @@
+//! lumis core: the types every other crate speaks.
+//!
+//! Math (a glam re-export plus frames and floating-point helpers), RGB
+//! radiance, rays and surface interactions with pbrt-v4 style error bounds,
+//! the plugin traits ([`Sampler`], [`Bsdf`], [`Light`], [`LightSampler`],
+//! [`Integrator`]) with the [`Scene`] they query, and the plugin machinery:
+//! the scene document model, [`Params`] and the [`Registry`].
+
+pub mod bsdf;
+pub mod doc;
+pub mod error;
+pub mod integrator;
+pub mod interaction;
+pub mod light;
+pub mod light_sampler;
+pub mod math;
+pub mod params;
+pub mod ray;
+pub mod registry;
+pub mod sampler;
+pub mod scene;
+pub mod spectrum;
+pub mod stats;
+
+pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
+pub use error::{Error, Location, Result};
+pub use integrator::Integrator;
+pub use interaction::{LightSampleContext, SurfaceInteraction};
+pub use light::{Light, LightKind, LightSample, LightShape};
+pub use light_sampler::{LightSampler, SampledLight};
+pub use math::Frame;
+pub use params::{ParamSpec, ParamType, Params};
+pub use ray::Ray;
+pub use registry::{PluginKind, PluginSpec, Registry};
+pub use sampler::Sampler;
+pub use scene::Scene;
+pub use spectrum::Rgb;
+pub use stats::RenderStats;
+
+/// glam, re-exported so plugins use the exact same math types.
+pub use glam;
+pub use glam::{UVec2, Vec2, Vec3};

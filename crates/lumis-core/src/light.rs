@@ -1,0 +1,67 @@
+//! The light plugin interface.
+
+use glam::{Vec2, Vec3};
+
+use crate::interaction::LightSampleContext;
+use crate::ray::SurfacePoint;
+use crate::spectrum::Rgb;
+
+/// How a light must be treated by integrators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LightKind {
+    /// A single point: sampled only, never hit; MIS weight 1.
+    DeltaPosition,
+    /// Emission from a surface that BSDF rays can hit.
+    Area,
+    /// Radiance arriving from infinitely far away, seen by escaping rays.
+    Infinite,
+}
+
+/// A light sample toward the reference point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSample {
+    /// Radiance arriving at the reference point along `-wi` (unoccluded).
+    pub l: Rgb,
+    /// Unit direction from the reference point toward the light.
+    pub wi: Vec3,
+    /// Density w.r.t. solid angle at the reference point (1 for delta lights).
+    pub pdf: f32,
+    /// The sampled point on the light, for the shadow ray.
+    pub p: SurfacePoint,
+}
+
+/// The geometry an area light is attached to, handed to its factory.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LightShape {
+    /// Not attached to geometry (`[[light]]` tables: point lights, environments).
+    None,
+    /// A parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`;
+    /// its front side faces `normalize(edge_u x edge_v)`.
+    Quad { corner: Vec3, edge_u: Vec3, edge_v: Vec3 },
+    /// A triangle; the front side faces `normalize((p1 - p0) x (p2 - p0))`.
+    Triangle { p: [Vec3; 3] },
+    /// A sphere; the front side faces outward unless `inward`.
+    Sphere { center: Vec3, radius: f32, inward: bool },
+}
+
+/// A light source. Each shape brings its own sampling and density.
+pub trait Light: Send + Sync {
+    fn kind(&self) -> LightKind;
+
+    /// Samples a direction toward the light from `ctx`.
+    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample>;
+
+    /// Density w.r.t. solid angle with which `sample_li` from `ctx` returns
+    /// the direction `wi`; zero for delta lights.
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32;
+
+    /// Emitted radiance leaving the light's surface at `p` (normal `n`) in
+    /// direction `w`; for infinite lights, radiance arriving along `-w`.
+    fn l(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb;
+
+    /// Total emitted power (flux), for power-proportional light selection.
+    fn power(&self) -> Rgb;
+
+    /// Lets infinite lights learn the scene's bounding sphere after loading.
+    fn preprocess(&mut self, _scene_center: Vec3, _scene_radius: f32) {}
+}

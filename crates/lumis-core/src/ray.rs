@@ -1,0 +1,138 @@
+//! Rays and robust spawning of secondary rays (pbrt-v4, section 6.8.6).
+
+use glam::Vec3;
+
+use crate::math::{next_float_down, next_float_up};
+
+/// A ray segment `o + t d` for `t` in `[0, t_max]`. `d` need not be unit
+/// length: shadow rays use `d = to - from` and `t_max` just below 1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    pub o: Vec3,
+    pub d: Vec3,
+    pub t_max: f32,
+}
+
+/// How far short of its end point a shadow ray stops, as a fraction of its
+/// length (pbrt-v4 `ShadowEpsilon`): the end point's own offset keeps it off
+/// the light's surface, this keeps rounding in `t` from reaching it.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
+impl Ray {
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        Self {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
+    }
+
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.o + self.d * t
+    }
+}
+
+/// Moves `p` off its surface along the normal `n`, just far enough that the
+/// true point (within `p_error` of `p`) lies behind it as seen along `w`, and
+/// rounds away from the surface so the move survives the addition
+/// (pbrt-v4 `OffsetRayOrigin`, eq. 6.30-6.31). No scene-scale epsilon.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    let d = n.abs().dot(p_error);
+    let mut offset = n * d;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for i in 0..3 {
+        if offset[i] > 0.0 {
+            po[i] = next_float_up(po[i]);
+        } else if offset[i] < 0.0 {
+            po[i] = next_float_down(po[i]);
+        }
+    }
+    po
+}
+
+/// A point on a surface with its rounding-error bound and geometric normal,
+/// the two things needed to spawn rays from it without self-intersection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    pub p: Vec3,
+    pub p_error: Vec3,
+    /// Unit geometric normal, or zero for points not on a surface (point lights).
+    pub n: Vec3,
+}
+
+impl SurfacePoint {
+    /// A point with no surface and no error, e.g. a point light's position.
+    pub fn isolated(p: Vec3) -> Self {
+        Self {
+            p,
+            p_error: Vec3::ZERO,
+            n: Vec3::ZERO,
+        }
+    }
+
+    /// A ray leaving the surface in direction `d`.
+    #[inline]
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        Ray::new(offset_ray_origin(self.p, self.p_error, self.n, d), d)
+    }
+
+    /// A shadow-ray segment from this point to `to`, both ends offset off
+    /// their surfaces (pbrt-v4 `SpawnRayTo` between two interactions).
+    #[inline]
+    pub fn spawn_ray_to(&self, to: &SurfacePoint) -> Ray {
+        let from = offset_ray_origin(self.p, self.p_error, self.n, to.p - self.p);
+        let end = offset_ray_origin(to.p, to.p_error, to.n, from - to.p);
+        Ray {
+            o: from,
+            d: end - from,
+            t_max: 1.0 - SHADOW_EPSILON,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offset_moves_to_the_side_of_w() {
+        let p = Vec3::new(1.0, 2.0, 0.0);
+        let err = Vec3::splat(1e-6);
+        let above = offset_ray_origin(p, err, Vec3::Z, Vec3::new(0.3, 0.0, 1.0));
+        let below = offset_ray_origin(p, err, Vec3::Z, Vec3::new(0.3, 0.0, -1.0));
+        assert!(above.z > 0.0 && below.z < 0.0);
+        assert_eq!(above.x, p.x, "only normal components move");
+    }
+
+    #[test]
+    fn offset_scales_with_the_error_bound() {
+        // A point far from the origin has a larger error and moves further:
+        // no fixed epsilon, so tiny and huge scenes both work.
+        let small = offset_ray_origin(Vec3::new(1e-4, 0.0, 0.0), Vec3::splat(1e-11), Vec3::X, Vec3::X);
+        let large = offset_ray_origin(Vec3::new(1e5, 0.0, 0.0), Vec3::splat(1e-2), Vec3::X, Vec3::X);
+        assert!(small.x > 1e-4 && small.x - 1e-4 < 1e-9);
+        assert!(large.x > 1e5 && large.x - 1e5 < 0.1);
+    }
+
+    #[test]
+    fn shadow_ray_stops_short_of_its_end() {
+        let a = SurfacePoint {
+            p: Vec3::ZERO,
+            p_error: Vec3::splat(1e-7),
+            n: Vec3::Y,
+        };
+        let b = SurfacePoint {
+            p: Vec3::new(0.0, 2.0, 0.0),
+            p_error: Vec3::splat(1e-7),
+            n: -Vec3::Y,
+        };
+        let r = a.spawn_ray_to(&b);
+        assert!(r.o.y > 0.0);
+        assert!(r.at(r.t_max).y < 2.0);
+    }
+}

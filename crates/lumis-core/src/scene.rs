@@ -1,0 +1,23 @@
+//! What integrators may ask of a scene: ray queries and the lights.
+
+use crate::interaction::SurfaceInteraction;
+use crate::light::Light;
+use crate::light_sampler::LightSampler;
+use crate::ray::Ray;
+
+/// A render-ready scene as integrators see it.
+pub trait Scene: Sync {
+    /// The closest surface hit along `ray` within `[0, ray.t_max]`.
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>>;
+
+    /// Whether anything blocks `ray` within `[0, ray.t_max]` (shadow rays).
+    fn occluded(&self, ray: &Ray) -> bool;
+
+    fn lights(&self) -> &[Box<dyn Light>];
+
+    /// Indices into [`Scene::lights`] of the infinite lights, which escaping
+    /// rays see.
+    fn infinite_lights(&self) -> &[u32];
+
+    fn light_sampler(&self) -> &dyn LightSampler;
+}

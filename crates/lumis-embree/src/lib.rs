@@ -1,0 +1,22 @@
+//! A small safe wrapper over Embree 4 (`embree4-sys`).
+//!
+//! It covers what lumis needs and nothing more: a device whose errors become
+//! Rust errors, a scene built from triangle meshes and spheres whose buffers
+//! are shared with Embree (no second copy), and the two single-ray queries,
+//! `intersect1` for closest hits and `occluded1` for shadow rays.
+//!
+//! All `unsafe` code of lumis lives in this crate; each block says why it is
+//! sound.
+
+#![allow(unsafe_code)]
+
+mod buffer;
+mod device;
+mod scene;
+
+pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
+pub use device::{Device, EmbreeError};
+pub use scene::{BuildQuality, Hit, Ray, Scene, SceneBuilder, SceneOptions};
+
+/// The geometry id Embree reports when nothing was hit.
+pub const INVALID_ID: u32 = embree4_sys::RTC_INVALID_GEOMETRY_ID;

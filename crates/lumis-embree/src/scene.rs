@@ -1,0 +1,414 @@
+//! Building an Embree scene and tracing single rays through it.
+
+use std::sync::Arc;
+
+use embree4_sys as sys;
+
+use crate::buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
+use crate::device::{Device, EmbreeError};
+
+/// Embree's BVH build quality (`RTC_BUILD_QUALITY_*`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BuildQuality {
+    Low,
+    #[default]
+    Medium,
+    High,
+}
+
+/// Scene-wide settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneOptions {
+    pub quality: BuildQuality,
+    /// `RTC_SCENE_FLAG_ROBUST`: watertight traversal at some cost in speed.
+    pub robust: bool,
+    /// `RTC_SCENE_FLAG_COMPACT`: a smaller BVH at some cost in speed.
+    pub compact: bool,
+}
+
+/// A ray segment `org + t dir`, `t` in `[tnear, tfar]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    pub org: [f32; 3],
+    pub dir: [f32; 3],
+    pub tnear: f32,
+    pub tfar: f32,
+}
+
+/// The closest hit along a ray, as Embree reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    /// Barycentric coordinates of the hit: weights of vertices 1 and 2.
+    pub u: f32,
+    pub v: f32,
+    /// Unnormalized geometric normal (for triangles `(v1 - v0) x (v2 - v0)`).
+    pub ng: [f32; 3],
+    pub geom_id: u32,
+    pub prim_id: u32,
+}
+
+/// What the scene keeps alive because Embree reads it in place.
+enum SharedStorage {
+    Triangles {
+        _vertices: Arc<PaddedBuffer<Vertex>>,
+        _indices: Arc<PaddedBuffer<Triangle>>,
+    },
+    Spheres {
+        _points: Arc<PaddedBuffer<SpherePoint>>,
+    },
+}
+
+/// Collects geometries; [`SceneBuilder::commit`] builds the BVH.
+pub struct SceneBuilder {
+    device: Device,
+    raw: sys::RTCScene,
+    storage: Vec<SharedStorage>,
+    options: SceneOptions,
+}
+
+/// A committed scene, ready for queries from any number of threads.
+pub struct Scene {
+    device: Device,
+    raw: sys::RTCScene,
+    _storage: Vec<SharedStorage>,
+}
+
+// SAFETY: a committed Embree scene is immutable and rtcIntersect1/rtcOccluded1
+// are thread-safe on it (Embree 4 API docs); the shared buffers it reads are
+// owned by `_storage` and never mutated.
+unsafe impl Send for Scene {}
+// SAFETY: as above.
+unsafe impl Sync for Scene {}
+
+impl SceneBuilder {
+    pub fn new(device: &Device, options: SceneOptions) -> Result<Self, EmbreeError> {
+        // SAFETY: the device is alive for the call (and for the scene: it is
+        // stored in the builder and then in the Scene).
+        let raw = unsafe { sys::rtcNewScene(device.raw()) };
+        device.take_error()?;
+        let mut flags = sys::RTCSceneFlags::NONE;
+        if options.robust {
+            flags |= sys::RTCSceneFlags::ROBUST;
+        }
+        if options.compact {
+            flags |= sys::RTCSceneFlags::COMPACT;
+        }
+        let quality = match options.quality {
+            BuildQuality::Low => sys::RTCBuildQuality::LOW,
+            BuildQuality::Medium => sys::RTCBuildQuality::MEDIUM,
+            BuildQuality::High => sys::RTCBuildQuality::HIGH,
+        };
+        // SAFETY: `raw` is the scene just created.
+        unsafe {
+            sys::rtcSetSceneFlags(raw, flags);
+            sys::rtcSetSceneBuildQuality(raw, quality);
+        }
+        device.take_error()?;
+        Ok(Self {
+            device: device.clone(),
+            raw,
+            storage: Vec::new(),
+            options,
+        })
+    }
+
+    fn geometry_quality(&self) -> sys::RTCBuildQuality {
+        match self.options.quality {
+            BuildQuality::Low => sys::RTCBuildQuality::LOW,
+            BuildQuality::Medium => sys::RTCBuildQuality::MEDIUM,
+            BuildQuality::High => sys::RTCBuildQuality::HIGH,
+        }
+    }
+
+    /// Adds a triangle mesh that reads `vertices` and `indices` in place.
+    /// Returns the geometry id that hits will report.
+    pub fn add_triangle_mesh(
+        &mut self,
+        vertices: Arc<PaddedBuffer<Vertex>>,
+        indices: Arc<PaddedBuffer<Triangle>>,
+    ) -> Result<u32, EmbreeError> {
+        let count = vertices.len() as u32;
+        if let Some(bad) = indices.iter().flatten().find(|&&i| i >= count) {
+            return Err(EmbreeError {
+                code: "INVALID_ARGUMENT".into(),
+                message: format!("triangle index {bad} out of range for {count} vertices"),
+            });
+        }
+        // SAFETY: the device is alive; the geometry is released below after
+        // being attached (the scene then holds its own reference).
+        let geometry =
+            unsafe { sys::rtcNewGeometry(self.device.raw(), sys::RTCGeometryType::TRIANGLE) };
+        self.device.take_error()?;
+        // SAFETY: both buffers are padded by one element (PaddedBuffer), have
+        // the declared strides and counts, and are kept alive by `storage`
+        // for as long as the scene exists; nothing mutates them.
+        unsafe {
+            sys::rtcSetSharedGeometryBuffer(
+                geometry,
+                sys::RTCBufferType::VERTEX,
+                0,
+                sys::RTCFormat::FLOAT3,
+                vertices.padded_ptr().cast(),
+                0,
+                std::mem::size_of::<Vertex>(),
+                vertices.len(),
+            );
+            sys::rtcSetSharedGeometryBuffer(
+                geometry,
+                sys::RTCBufferType::INDEX,
+                0,
+                sys::RTCFormat::UINT3,
+                indices.padded_ptr().cast(),
+                0,
+                std::mem::size_of::<Triangle>(),
+                indices.len(),
+            );
+        }
+        let id = self.attach(geometry)?;
+        self.storage.push(SharedStorage::Triangles {
+            _vertices: vertices,
+            _indices: indices,
+        });
+        Ok(id)
+    }
+
+    /// Adds spheres (`RTC_GEOMETRY_TYPE_SPHERE_POINT`), one primitive per point.
+    pub fn add_spheres(&mut self, points: Arc<PaddedBuffer<SpherePoint>>) -> Result<u32, EmbreeError> {
+        // SAFETY: as in add_triangle_mesh.
+        let geometry = unsafe {
+            sys::rtcNewGeometry(self.device.raw(), sys::RTCGeometryType::SPHERE_POINT)
+        };
+        self.device.take_error()?;
+        // SAFETY: the buffer is padded, holds `len()` FLOAT4 items and lives
+        // in `storage` as long as the scene.
+        unsafe {
+            sys::rtcSetSharedGeometryBuffer(
+                geometry,
+                sys::RTCBufferType::VERTEX,
+                0,
+                sys::RTCFormat::FLOAT4,
+                points.padded_ptr().cast(),
+                0,
+                std::mem::size_of::<SpherePoint>(),
+                points.len(),
+            );
+        }
+        let id = self.attach(geometry)?;
+        self.storage.push(SharedStorage::Spheres { _points: points });
+        Ok(id)
+    }
+
+    /// Commits and attaches a new geometry, then drops our reference to it.
+    fn attach(&mut self, geometry: sys::RTCGeometry) -> Result<u32, EmbreeError> {
+        // SAFETY: `geometry` is live and its buffers are set; after
+        // rtcAttachGeometry the scene holds a reference, so releasing ours is
+        // the documented ownership pattern.
+        let id = unsafe {
+            sys::rtcSetGeometryBuildQuality(geometry, self.geometry_quality());
+            sys::rtcCommitGeometry(geometry);
+            let id = sys::rtcAttachGeometry(self.raw, geometry);
+            sys::rtcReleaseGeometry(geometry);
+            id
+        };
+        self.device.take_error()?;
+        Ok(id)
+    }
+
+    /// Builds the BVH.
+    pub fn commit(self) -> Result<Scene, EmbreeError> {
+        // SAFETY: the scene and every buffer it references are alive.
+        unsafe { sys::rtcCommitScene(self.raw) };
+        self.device.take_error()?;
+        let this = std::mem::ManuallyDrop::new(self);
+        // SAFETY: moving fields out of a ManuallyDrop builder whose Drop
+        // (which would release the scene) never runs.
+        let (device, storage) = unsafe { (std::ptr::read(&this.device), std::ptr::read(&this.storage)) };
+        Ok(Scene {
+            device,
+            raw: this.raw,
+            _storage: storage,
+        })
+    }
+}
+
+impl Drop for SceneBuilder {
+    fn drop(&mut self) {
+        // SAFETY: an uncommitted scene we own; released exactly once.
+        unsafe { sys::rtcReleaseScene(self.raw) }
+    }
+}
+
+impl Drop for Scene {
+    fn drop(&mut self) {
+        // SAFETY: we own the only reference; the buffers in `_storage` are
+        // dropped after this (fields drop after `drop` returns).
+        unsafe { sys::rtcReleaseScene(self.raw) }
+    }
+}
+
+fn raw_ray(ray: &Ray) -> sys::RTCRay {
+    sys::RTCRay {
+        org_x: ray.org[0],
+        org_y: ray.org[1],
+        org_z: ray.org[2],
+        tnear: ray.tnear,
+        dir_x: ray.dir[0],
+        dir_y: ray.dir[1],
+        dir_z: ray.dir[2],
+        time: 0.0,
+        tfar: ray.tfar,
+        mask: u32::MAX,
+        id: 0,
+        flags: 0,
+    }
+}
+
+fn empty_hit() -> sys::RTCHit {
+    sys::RTCHit {
+        Ng_x: 0.0,
+        Ng_y: 0.0,
+        Ng_z: 0.0,
+        u: 0.0,
+        v: 0.0,
+        primID: sys::RTC_INVALID_GEOMETRY_ID,
+        geomID: sys::RTC_INVALID_GEOMETRY_ID,
+        instID: [sys::RTC_INVALID_GEOMETRY_ID; 1],
+    }
+}
+
+impl Scene {
+    pub fn device(&self) -> &Device {
+        &self.device
+    }
+
+    /// The closest hit in `[tnear, tfar]`, if any.
+    #[inline]
+    pub fn intersect1(&self, ray: &Ray) -> Option<Hit> {
+        let mut rayhit = sys::RTCRayHit {
+            ray: raw_ray(ray),
+            hit: empty_hit(),
+        };
+        // SAFETY: the scene is committed and alive; `rayhit` is a properly
+        // aligned RTCRayHit (bindgen keeps RTC_ALIGN(16)); null arguments
+        // select Embree's defaults.
+        unsafe { sys::rtcIntersect1(self.raw, &mut rayhit, std::ptr::null_mut()) };
+        if rayhit.hit.geomID == sys::RTC_INVALID_GEOMETRY_ID {
+            return None;
+        }
+        Some(Hit {
+            t: rayhit.ray.tfar,
+            u: rayhit.hit.u,
+            v: rayhit.hit.v,
+            ng: [rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z],
+            geom_id: rayhit.hit.geomID,
+            prim_id: rayhit.hit.primID,
+        })
+    }
+
+    /// Whether anything blocks the segment `[tnear, tfar]` (a shadow ray).
+    #[inline]
+    pub fn occluded1(&self, ray: &Ray) -> bool {
+        let mut raw = raw_ray(ray);
+        // SAFETY: as in intersect1, with an RTCRay.
+        unsafe { sys::rtcOccluded1(self.raw, &mut raw, std::ptr::null_mut()) };
+        // Embree sets tfar to -inf when the ray is occluded.
+        raw.tfar == f32::NEG_INFINITY
+    }
+
+    /// Scene bounds as `(lower, upper)`.
+    pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+        let mut b = sys::RTCBounds {
+            lower_x: 0.0,
+            lower_y: 0.0,
+            lower_z: 0.0,
+            align0: 0.0,
+            upper_x: 0.0,
+            upper_y: 0.0,
+            upper_z: 0.0,
+            align1: 0.0,
+        };
+        // SAFETY: committed scene; `b` is a valid, aligned RTCBounds.
+        unsafe { sys::rtcGetSceneBounds(self.raw, &mut b) };
+        ([b.lower_x, b.lower_y, b.lower_z], [b.upper_x, b.upper_y, b.upper_z])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_quad(device: &Device) -> Scene {
+        let mut builder = SceneBuilder::new(device, SceneOptions::default()).unwrap();
+        let vertices = vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]];
+        let indices = vec![[0, 1, 2], [0, 2, 3]];
+        builder
+            .add_triangle_mesh(Arc::new(vertices.into()), Arc::new(indices.into()))
+            .unwrap();
+        builder.commit().unwrap()
+    }
+
+    fn ray(org: [f32; 3], dir: [f32; 3], tfar: f32) -> Ray {
+        Ray { org, dir, tnear: 0.0, tfar }
+    }
+
+    #[test]
+    fn hits_quad_and_reports_barycentrics() {
+        let device = Device::new().unwrap();
+        assert!(device.version() >= 40000, "Embree 4 expected");
+        let scene = unit_quad(&device);
+        let hit = scene.intersect1(&ray([0.5, -0.5, 2.0], [0.0, 0.0, -1.0], f32::INFINITY)).unwrap();
+        assert!((hit.t - 2.0).abs() < 1e-6);
+        assert_eq!(hit.geom_id, 0);
+        assert_eq!(hit.prim_id, 0);
+        // p = (1-u-v) v0 + u v1 + v v2 = (0.5, -0.5): u = 0.5, v = 0.25.
+        assert!((hit.u - 0.5).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6, "{hit:?}");
+        assert!(hit.ng[2] > 0.0);
+        assert!(scene.intersect1(&ray([2.0, 0.0, 2.0], [0.0, 0.0, -1.0], f32::INFINITY)).is_none());
+    }
+
+    #[test]
+    fn occlusion_respects_segment_length() {
+        let device = Device::new().unwrap();
+        let scene = unit_quad(&device);
+        assert!(scene.occluded1(&ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], 2.0)));
+        assert!(!scene.occluded1(&ray([0.0, 0.0, 1.0], [0.0, 0.0, -1.0], 0.5)));
+    }
+
+    #[test]
+    fn spheres_are_hit_from_outside_and_inside() {
+        let device = Device::new().unwrap();
+        let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        builder
+            .add_spheres(Arc::new(vec![[0.0, 0.0, 0.0, 1.0]].into()))
+            .unwrap();
+        let scene = builder.commit().unwrap();
+        let outside = scene.intersect1(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0], f32::INFINITY)).unwrap();
+        assert!((outside.t - 4.0).abs() < 1e-5);
+        let inside = scene.intersect1(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY)).unwrap();
+        assert!((inside.t - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn out_of_range_index_is_an_error() {
+        let device = Device::new().unwrap();
+        let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        let err = builder
+            .add_triangle_mesh(Arc::new(vec![[0.0; 3]; 3].into()), Arc::new(vec![[0, 1, 3]].into()))
+            .unwrap_err();
+        assert!(err.message.contains("out of range"), "{err}");
+    }
+
+    #[test]
+    fn embree_errors_become_rust_errors() {
+        let device = Device::new().unwrap();
+        let builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        // REFIT is a geometry-only build quality: Embree reports
+        // an error through the device callback.
+        // SAFETY: a live, uncommitted scene.
+        unsafe { sys::rtcSetSceneBuildQuality(builder.raw, sys::RTCBuildQuality::REFIT) };
+        let err = device.take_error().unwrap_err();
+        assert!(err.message.contains("build quality"), "{err}");
+        assert!(device.take_error().is_ok(), "an error is reported once");
+    }
+}
