@@ -1,0 +1,150 @@
+//! Warps from `[0,1)^2` to shapes and directions, each with its density.
+//!
+//! Directions are in a local frame with `z` up; densities are w.r.t. solid
+//! angle for directions and w.r.t. area for points.
+
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+
+use glam::{Vec2, Vec3};
+
+/// Concentric map of the square to the unit disk (Shirley and Chiu 1997,
+/// "A Low Distortion Map Between Disk and Square"): keeps strata compact.
+#[inline]
+pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, FRAC_PI_4 * (o.y / o.x))
+    } else {
+        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted hemisphere by Malley's method: project the concentric
+/// disk up onto the hemisphere. Density `cos theta / pi`.
+#[inline]
+pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = square_to_concentric_disk(u);
+    let z = (1.0 - d.x * d.x - d.y * d.y).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    if cos_theta > 0.0 {
+        cos_theta * FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
+/// Uniform hemisphere: `z = u0`. Density `1 / (2 pi)`.
+#[inline]
+pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+#[inline]
+pub fn uniform_hemisphere_pdf(cos_theta: f32) -> f32 {
+    if cos_theta >= 0.0 {
+        0.5 * FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
+/// Uniform sphere: `z = 1 - 2 u0`. Density `1 / (4 pi)`.
+#[inline]
+pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+pub const UNIFORM_SPHERE_PDF: f32 = 0.25 * FRAC_1_PI;
+
+/// Uniform barycentrics on a triangle: `b0 = 1 - sqrt(u0)`, `b1 = u1 sqrt(u0)`
+/// (Shirley and Chiu / pbrt-v3 `UniformSampleTriangle`). Returns `(b0, b1)`;
+/// `b2 = 1 - b0 - b1`. Density `1 / area` on the triangle.
+#[inline]
+pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
+    let s = u.x.sqrt();
+    Vec2::new(1.0 - s, u.y * s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Pcg32;
+
+    fn grid(n: usize) -> impl Iterator<Item = Vec2> {
+        (0..n * n).map(move |i| Vec2::new(((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32))
+    }
+
+    #[test]
+    fn disk_points_lie_in_disk_and_cover_it_uniformly() {
+        let mut inside_half = 0;
+        let n = 200;
+        for u in grid(n) {
+            let d = square_to_concentric_disk(u);
+            assert!(d.length() <= 1.0 + 1e-6);
+            if d.length() < std::f32::consts::FRAC_1_SQRT_2 {
+                inside_half += 1;
+            }
+        }
+        // Area-preserving: the disk of radius 1/sqrt(2) holds half the points.
+        let frac = inside_half as f32 / (n * n) as f32;
+        assert!((frac - 0.5).abs() < 0.01, "{frac}");
+    }
+
+    #[test]
+    fn hemisphere_warps_are_unit_and_upper() {
+        for u in grid(64) {
+            for w in [square_to_cosine_hemisphere(u), square_to_uniform_hemisphere(u)] {
+                assert!((w.length() - 1.0).abs() < 1e-5 && w.z >= 0.0);
+            }
+            assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    /// Monte Carlo check of E[g(w)] against the exact integral of g pdf:
+    /// for the cosine warp, E[cos theta] = 2/3 and E[cos^2] = 1/2.
+    #[test]
+    fn cosine_hemisphere_moments() {
+        let mut rng = Pcg32::new(3, 5);
+        let n = 400_000;
+        let (mut m1, mut m2) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let w = square_to_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+            m1 += w.z as f64;
+            m2 += (w.z * w.z) as f64;
+        }
+        let (m1, m2) = (m1 / n as f64, m2 / n as f64);
+        // Var[cos] = 1/2 - 4/9 = 1/18: sigma_mean = sqrt(1/18/n) ~ 3.7e-4.
+        assert!((m1 - 2.0 / 3.0).abs() < 5.0 * 3.7e-4, "{m1}");
+        assert!((m2 - 0.5).abs() < 2e-3, "{m2}");
+    }
+
+    #[test]
+    fn triangle_barycentrics_are_valid_and_uniform() {
+        let n = 200;
+        let mut near_v0 = 0;
+        for u in grid(n) {
+            let b = square_to_uniform_triangle(u);
+            assert!(b.x >= 0.0 && b.y >= 0.0 && b.x + b.y <= 1.0 + 1e-6);
+            // The sub-triangle b0 > 1/2 has a quarter of the area.
+            if b.x > 0.5 {
+                near_v0 += 1;
+            }
+        }
+        let frac = near_v0 as f32 / (n * n) as f32;
+        assert!((frac - 0.25).abs() < 0.01, "{frac}");
+    }
+}

@@ -1,0 +1,191 @@
+//! `diffuse`: the Lambertian BRDF `f = R / pi`.
+
+use std::f32::consts::FRAC_1_PI;
+
+use lumis_core::{
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Rgb,
+    Vec2, Vec3,
+};
+use lumis_sampling::warp;
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Bsdf,
+    name: "diffuse",
+    doc: "Lambertian reflection f = R/pi, one-sided unless two_sided",
+    params: &[
+        ParamSpec::required("reflectance", ParamType::Rgb, "albedo R in linear RGB, each channel in [0, 1]"),
+        ParamSpec::with_default(
+            "two_sided",
+            ParamType::Bool,
+            "false",
+            "reflect on both sides (one-sided surfaces are black from behind, like Mitsuba's)",
+        ),
+        ParamSpec::with_default(
+            "sampling",
+            ParamType::String,
+            "\"cosine\"",
+            "\"cosine\" (Malley: pdf cos/pi, zero variance for f cos) or \"uniform\" (pdf 1/(2 pi), for comparison)",
+        ),
+    ],
+};
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DiffuseSampling {
+    Cosine,
+    Uniform,
+}
+
+#[derive(Debug, Clone)]
+pub struct Diffuse {
+    reflectance: Rgb,
+    two_sided: bool,
+    sampling: DiffuseSampling,
+}
+
+impl Diffuse {
+    pub fn new(reflectance: Rgb, two_sided: bool, sampling: DiffuseSampling) -> Self {
+        Self {
+            reflectance,
+            two_sided,
+            sampling,
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let reflectance: Rgb = params.get("reflectance")?;
+        if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
+            return Err(params.error(
+                "reflectance",
+                format!("each channel must be in [0, 1] (energy conservation), got {reflectance:?}"),
+            ));
+        }
+        let sampling = match params.get_choice("sampling", &["cosine", "uniform"])?.as_str() {
+            "uniform" => DiffuseSampling::Uniform,
+            _ => DiffuseSampling::Cosine,
+        };
+        Ok(Self::new(reflectance, params.get("two_sided")?, sampling))
+    }
+
+    /// Maps `(wo, wi)` into the upper hemisphere if this side reflects;
+    /// `None` when the pair gets no reflection.
+    #[inline]
+    fn oriented(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
+        if wo.z > 0.0 && wi.z > 0.0 {
+            Some((wo, wi))
+        } else if self.two_sided && wo.z < 0.0 && wi.z < 0.0 {
+            Some((-wo, -wi))
+        } else {
+            None
+        }
+    }
+
+    #[inline]
+    fn pdf_upper(&self, cos_theta: f32) -> f32 {
+        match self.sampling {
+            DiffuseSampling::Cosine => warp::cosine_hemisphere_pdf(cos_theta),
+            DiffuseSampling::Uniform => warp::uniform_hemisphere_pdf(cos_theta),
+        }
+    }
+}
+
+impl Bsdf for Diffuse {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::DIFFUSE_REFLECTION
+    }
+
+    #[inline]
+    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        match self.oriented(wo, wi) {
+            Some(_) => self.reflectance * FRAC_1_PI,
+            None => Rgb::BLACK,
+        }
+    }
+
+    #[inline]
+    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let flip = if wo.z > 0.0 {
+            1.0
+        } else if self.two_sided && wo.z < 0.0 {
+            -1.0
+        } else {
+            return None;
+        };
+        let local = match self.sampling {
+            DiffuseSampling::Cosine => warp::square_to_cosine_hemisphere(u2),
+            DiffuseSampling::Uniform => warp::square_to_uniform_hemisphere(u2),
+        };
+        let pdf = self.pdf_upper(local.z);
+        if pdf == 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            f: self.reflectance * FRAC_1_PI,
+            wi: Vec3::new(local.x, local.y, local.z * flip),
+            pdf,
+            flags: BsdfFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    #[inline]
+    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        match self.oriented(wo, wi) {
+            Some((_, wi)) => self.pdf_upper(wi.z),
+            None => 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lumis_sampling::Pcg32;
+
+    fn estimate_albedo(bsdf: &Diffuse, wo: Vec3, n: u32) -> Rgb {
+        let mut rng = Pcg32::new(11, 13);
+        let ctx = BsdfContext::default();
+        let mut sum = Rgb::BLACK;
+        for _ in 0..n {
+            let u = Vec2::new(rng.next_f32(), rng.next_f32());
+            if let Some(s) = bsdf.sample_f(&ctx, wo, rng.next_f32(), u) {
+                assert!((s.pdf - bsdf.pdf(&ctx, wo, s.wi)).abs() < 1e-5 * s.pdf.max(1.0));
+                assert_eq!(s.f, bsdf.f(&ctx, wo, s.wi));
+                sum += s.f * s.wi.z.abs() / s.pdf;
+            }
+        }
+        sum / n as f32
+    }
+
+    #[test]
+    fn albedo_is_reflectance_for_both_sampling_modes() {
+        let r = Rgb::new(0.2, 0.5, 0.9);
+        let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let cosine = estimate_albedo(&Diffuse::new(r, false, DiffuseSampling::Cosine), wo, 10_000);
+        // Cosine sampling of a Lambertian has zero variance: f cos / pdf = R.
+        assert!((cosine - r).max_component().abs() < 1e-5, "{cosine:?}");
+        let uniform = estimate_albedo(&Diffuse::new(r, false, DiffuseSampling::Uniform), wo, 400_000);
+        // Uniform: estimator 2 R cos, std of mean = R sqrt(1/3)/sqrt(n) ~ 1e-3 R.
+        assert!(((uniform - r) / r).map(f32::abs).max_component() < 5e-3, "{uniform:?}");
+    }
+
+    #[test]
+    fn one_sided_is_black_from_behind_two_sided_is_not() {
+        let ctx = BsdfContext::default();
+        let below = Vec3::new(0.0, 0.6, -0.8);
+        let one = Diffuse::new(Rgb::WHITE, false, DiffuseSampling::Cosine);
+        assert!(one.sample_f(&ctx, below, 0.5, Vec2::splat(0.3)).is_none());
+        assert!(one.f(&ctx, below, -Vec3::Z).is_black());
+        let two = Diffuse::new(Rgb::WHITE, true, DiffuseSampling::Cosine);
+        let s = two.sample_f(&ctx, below, 0.5, Vec2::splat(0.3)).unwrap();
+        assert!(s.wi.z < 0.0 && s.pdf > 0.0);
+        assert!(two.f(&ctx, Vec3::Z, -Vec3::Z).is_black(), "no transmission");
+    }
+
+    #[test]
+    fn reciprocity() {
+        let ctx = BsdfContext::default();
+        let b = Diffuse::new(Rgb::splat(0.7), true, DiffuseSampling::Cosine);
+        let (a, c) = (Vec3::new(0.1, 0.2, 0.97).normalize(), Vec3::new(-0.6, 0.0, 0.8));
+        assert_eq!(b.f(&ctx, a, c), b.f(&ctx, c, a));
+    }
+}
