@@ -28,6 +28,8 @@ pub enum ParamType {
     /// Two non-negative integers, e.g. a resolution.
     UIntPair,
     FloatArray,
+    /// `[[x, y, z], ...]`, e.g. mesh positions.
+    Vec3Array,
     IntArray,
     StringArray,
     Table,
@@ -45,6 +47,7 @@ impl ParamType {
             ParamType::Vec3 => "vec3",
             ParamType::UIntPair => "[uint, uint]",
             ParamType::FloatArray => "[float]",
+            ParamType::Vec3Array => "[vec3]",
             ParamType::IntArray => "[int]",
             ParamType::StringArray => "[string]",
             ParamType::Table => "table",

@@ -1,0 +1,156 @@
+//! `lumis render`: load, render, write EXR and PNG, report.
+
+use std::path::{Path, PathBuf};
+
+use lumis_core::{Error, RenderStats, Result};
+use lumis_image::Image;
+use lumis_render::{render, RenderSettings};
+use lumis_scene::LoadedScene;
+
+/// What `lumis render` was asked to do.
+#[derive(Debug, Clone, Default)]
+pub struct RenderArgs {
+    pub scene: PathBuf,
+    pub spp: Option<u32>,
+    pub seed: Option<u64>,
+    /// 0 = one thread per core.
+    pub threads: usize,
+    pub output: Option<PathBuf>,
+    /// `key.path=value` overrides, applied in order.
+    pub set: Vec<String>,
+    pub progress: bool,
+    pub verbose: bool,
+}
+
+/// The outcome of a render, for the summary line and for tests.
+pub struct RenderReport {
+    pub image: Image,
+    pub exr: PathBuf,
+    pub png: PathBuf,
+    pub spp: u32,
+    pub seconds: f64,
+    pub stats: RenderStats,
+}
+
+impl RenderReport {
+    /// The one-line summary printed at the end of a render.
+    pub fn summary(&self) -> String {
+        let secs = self.seconds.max(1e-9);
+        format!(
+            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} shadow), {} NaN/Inf samples -> {}",
+            self.image.width,
+            self.image.height,
+            self.spp,
+            self.seconds,
+            self.stats.samples as f64 / secs * 1e-6,
+            self.stats.total_rays() as f64 / secs * 1e-6,
+            self.stats.rays,
+            self.stats.shadow_rays,
+            self.stats.nonfinite,
+            self.exr.display(),
+        )
+    }
+}
+
+/// `PATH.exr` and `PATH.png` for an output argument (with or without `.exr`).
+pub fn output_paths(output: &Path) -> (PathBuf, PathBuf) {
+    let stem = if output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+        output.with_extension("")
+    } else {
+        output.to_path_buf()
+    };
+    let with = |ext: &str| {
+        let mut s = stem.clone().into_os_string();
+        s.push(".");
+        s.push(ext);
+        PathBuf::from(s)
+    };
+    (with("exr"), with("png"))
+}
+
+/// Loads the scene, applying `--spp`/`--seed` as overrides so they reach the
+/// same parameters a scene file sets.
+pub fn load(args: &RenderArgs, registry: &lumis_core::Registry) -> Result<LoadedScene> {
+    let mut set = args.set.clone();
+    if let Some(spp) = args.spp {
+        set.push(format!("sampler.spp={spp}"));
+    }
+    if let Some(seed) = args.seed {
+        set.push(format!("seed={seed}"));
+    }
+    lumis_scene::load_file(&args.scene, &set, registry)
+}
+
+/// Describes what the loader decided the scene needs (`-v`).
+fn describe(loaded: &LoadedScene) -> String {
+    let c = loaded.scene.counts();
+    let lights = c.area_lights + c.delta_lights + c.infinite_lights;
+    format!(
+        "scene '{}': {} meshes ({} triangles), {} spheres; {} lights ({} area, {} delta, {} infinite); \
+         shading normals: {}; MIS: {}",
+        loaded.name,
+        c.meshes,
+        c.triangles,
+        c.spheres,
+        lights,
+        c.area_lights,
+        c.delta_lights,
+        c.infinite_lights,
+        if c.shading_normals { "interpolated" } else { "flat (none stored)" },
+        if c.area_lights + c.infinite_lights > 0 {
+            "used where the integrator's strategy asks for it"
+        } else {
+            "never needed (only delta lights)"
+        },
+    )
+}
+
+/// Renders a scene file and writes `PATH.exr` and `PATH.png`.
+pub fn render_scene_file(args: &RenderArgs, registry: &lumis_core::Registry) -> Result<RenderReport> {
+    let loaded = load(args, registry)?;
+    if args.verbose {
+        eprintln!("{}", describe(&loaded));
+    }
+    let output = match (&args.output, &loaded.output) {
+        (Some(o), _) => o.clone(),
+        (None, Some(o)) => o.clone(),
+        (None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
+    };
+    let (exr, png) = output_paths(&output);
+    let settings = RenderSettings {
+        spp: loaded.sampler.samples_per_pixel(),
+        seed: loaded.seed,
+        threads: args.threads,
+        progress: args.progress,
+    };
+    let out = render(
+        &loaded.camera,
+        &loaded.scene,
+        loaded.integrator.as_ref(),
+        loaded.sampler.as_ref(),
+        &settings,
+    )?;
+    lumis_image::write_exr(&exr, &out.image).map_err(|e| Error::msg(e.to_string()))?;
+    lumis_image::write_png(&png, &out.image).map_err(|e| Error::msg(e.to_string()))?;
+    Ok(RenderReport {
+        image: out.image,
+        exr,
+        png,
+        spp: settings.spp,
+        seconds: out.seconds,
+        stats: out.stats,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_paths_add_both_extensions() {
+        let (e, p) = output_paths(Path::new("out/box.exr"));
+        assert_eq!((e.to_str().unwrap(), p.to_str().unwrap()), ("out/box.exr", "out/box.png"));
+        let (e, p) = output_paths(Path::new("box.v2"));
+        assert_eq!((e.to_str().unwrap(), p.to_str().unwrap()), ("box.v2.exr", "box.v2.png"));
+    }
+}

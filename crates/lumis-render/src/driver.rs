@@ -1,0 +1,164 @@
+//! The render loop: tiles on a rayon pool, a box-filtered film, a progress
+//! bar, and counters.
+
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use lumis_core::{Error, Integrator, RenderStats, Result, Sampler, Scene, UVec2};
+use lumis_image::Image;
+use rayon::prelude::*;
+
+use crate::camera::PerspectiveCamera;
+
+/// Tile edge in pixels: small enough to balance load, large enough that
+/// per-tile overhead (sampler clone, progress update) does not show.
+pub const TILE_SIZE: u32 = 16;
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    pub spp: u32,
+    pub seed: u64,
+    /// Worker threads; 0 means one per core.
+    pub threads: usize,
+    /// Draw a progress bar on stderr (hidden when stderr is not a terminal).
+    pub progress: bool,
+}
+
+pub struct RenderOutput {
+    pub image: Image,
+    pub stats: RenderStats,
+    pub seconds: f64,
+}
+
+struct Tile {
+    min: UVec2,
+    max: UVec2,
+}
+
+fn tiles(resolution: UVec2) -> Vec<Tile> {
+    let mut out = Vec::new();
+    for y in (0..resolution.y).step_by(TILE_SIZE as usize) {
+        for x in (0..resolution.x).step_by(TILE_SIZE as usize) {
+            out.push(Tile {
+                min: UVec2::new(x, y),
+                max: UVec2::new((x + TILE_SIZE).min(resolution.x), (y + TILE_SIZE).min(resolution.y)),
+            });
+        }
+    }
+    out
+}
+
+/// Renders one tile. Each pixel's samples are summed in order on one thread,
+/// so the result does not depend on the thread count.
+fn render_tile(
+    tile: &Tile,
+    camera: &PerspectiveCamera,
+    scene: &dyn Scene,
+    integrator: &dyn Integrator,
+    sampler: &mut dyn Sampler,
+    settings: &RenderSettings,
+) -> (Vec<[f32; 3]>, RenderStats) {
+    let mut stats = RenderStats::default();
+    let mut pixels = Vec::with_capacity(((tile.max.x - tile.min.x) * (tile.max.y - tile.min.y)) as usize);
+    for y in tile.min.y..tile.max.y {
+        for x in tile.min.x..tile.max.x {
+            let pixel = UVec2::new(x, y);
+            let mut sum = [0.0f64; 3];
+            for index in 0..settings.spp {
+                sampler.start_pixel_sample(pixel, index, settings.seed);
+                // Box filter of radius 1/2: uniform over the pixel, weight 1.
+                let ray = camera.generate_ray(pixel, sampler.get_pixel_2d());
+                let l = integrator.li(&ray, scene, sampler, &mut stats);
+                stats.samples += 1;
+                if !l.is_finite() {
+                    stats.nonfinite += 1;
+                    continue;
+                }
+                sum[0] += l.r as f64;
+                sum[1] += l.g as f64;
+                sum[2] += l.b as f64;
+            }
+            let inv = 1.0 / settings.spp as f64;
+            pixels.push(sum.map(|s| (s * inv) as f32));
+        }
+    }
+    (pixels, stats)
+}
+
+/// Renders the image seen by `camera`. Samples whose radiance is NaN or
+/// infinite are counted in the stats and contribute zero.
+pub fn render(
+    camera: &PerspectiveCamera,
+    scene: &dyn Scene,
+    integrator: &dyn Integrator,
+    sampler: &dyn Sampler,
+    settings: &RenderSettings,
+) -> Result<RenderOutput> {
+    if settings.spp == 0 {
+        return Err(Error::msg("spp must be at least 1"));
+    }
+    let resolution = camera.resolution();
+    let tiles = tiles(resolution);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(settings.threads)
+        .build()
+        .map_err(|e| Error::msg(format!("cannot start {} render threads: {e}", settings.threads)))?;
+
+    let progress = if settings.progress {
+        let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta}")
+                .expect("static template is valid"),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+
+    let start = Instant::now();
+    let rendered: Vec<(Vec<[f32; 3]>, RenderStats)> = pool.install(|| {
+        tiles
+            .par_iter()
+            .map_init(
+                || sampler.clone_sampler(),
+                |tile_sampler, tile| {
+                    let out = render_tile(tile, camera, scene, integrator, tile_sampler.as_mut(), settings);
+                    progress.inc(1);
+                    out
+                },
+            )
+            .collect()
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+
+    let mut image = Image::new(resolution.x as usize, resolution.y as usize);
+    let mut stats = RenderStats::default();
+    for (tile, (pixels, tile_stats)) in tiles.iter().zip(rendered) {
+        stats += tile_stats;
+        let width = (tile.max.x - tile.min.x) as usize;
+        for (i, p) in pixels.into_iter().enumerate() {
+            image.set(tile.min.x as usize + i % width, tile.min.y as usize + i / width, p);
+        }
+    }
+    Ok(RenderOutput { image, stats, seconds })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tiles_cover_the_image_once() {
+        let res = UVec2::new(37, 20);
+        let mut covered = vec![0u8; (res.x * res.y) as usize];
+        for t in tiles(res) {
+            for y in t.min.y..t.max.y {
+                for x in t.min.x..t.max.x {
+                    covered[(y * res.x + x) as usize] += 1;
+                }
+            }
+        }
+        assert!(covered.iter().all(|&c| c == 1));
+    }
+}

@@ -1,0 +1,8 @@
+//! Turning a scene into an image: the camera, the film and the driver that
+//! splits the image into tiles and renders them on a thread pool.
+
+mod camera;
+mod driver;
+
+pub use camera::PerspectiveCamera;
+pub use driver::{render, RenderOutput, RenderSettings, TILE_SIZE};

@@ -1,0 +1,499 @@
+//! From a TOML scene file to a render-ready scene.
+//!
+//! The loader reads the document (with locations for every key), applies
+//! `--set` overrides, instantiates only the plugins the scene names through
+//! the [`Registry`], loads geometry into Embree, and creates an area light
+//! for every emissive shape.
+
+mod render_scene;
+mod shapes;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use lumis_core::doc::{self, Node, Table, Value};
+use lumis_core::registry::TableRef;
+use lumis_core::{
+    Bsdf, Error, Integrator, Light, LightKind, LightShape, Location, ParamSpec, ParamType, Params, Registry,
+    Result, Sampler, UVec2, Vec3,
+};
+use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
+use lumis_render::PerspectiveCamera;
+
+pub use render_scene::{RenderScene, SceneCounts};
+
+use render_scene::{Geometry, NO_LIGHT};
+use shapes::{ShapeDesc, ShapeGeometry, SHAPE_TYPES};
+
+/// Everything `lumis render` needs.
+pub struct LoadedScene {
+    /// The scene file's stem, e.g. `cornell-box`.
+    pub name: String,
+    pub scene: RenderScene,
+    pub camera: PerspectiveCamera,
+    pub sampler: Box<dyn Sampler>,
+    pub integrator: Box<dyn Integrator>,
+    pub seed: u64,
+    /// `film.output`, resolved against the scene file's directory.
+    pub output: Option<PathBuf>,
+}
+
+const TOP_LEVEL_KEYS: &[&str] = &[
+    "film",
+    "camera",
+    "sampler",
+    "integrator",
+    "light_sampler",
+    "bsdf",
+    "shape",
+    "light",
+    "seed",
+];
+
+const FILM_PARAMS: &[ParamSpec] = &[
+    ParamSpec::with_default("resolution", ParamType::UIntPair, "[256, 256]", "image width and height in pixels"),
+    ParamSpec::optional("output", ParamType::String, "output EXR path, relative to the scene file"),
+    ParamSpec::optional("filter", ParamType::Table, "pixel filter: { type = \"box\" } (the default)"),
+];
+
+const CAMERA_PARAMS: &[ParamSpec] = &[
+    ParamSpec::required("origin", ParamType::Vec3, "eye position"),
+    ParamSpec::required("target", ParamType::Vec3, "point looked at"),
+    ParamSpec::with_default("up", ParamType::Vec3, "[0.0, 1.0, 0.0]", "up direction"),
+    ParamSpec::required("fov", ParamType::Float, "full angle of the smaller image axis, degrees, in (0, 180)"),
+];
+
+/// Reads and loads a scene file.
+pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Result<LoadedScene> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::msg(format!("cannot read scene '{}': {e}", path.display())))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
+    load_str(&text, &path.display().to_string(), &name, dir, overrides, registry)
+}
+
+/// Loads a scene from TOML text; `label` names it in error locations and
+/// relative paths resolve against `dir`.
+pub fn load_str(
+    text: &str,
+    label: &str,
+    name: &str,
+    dir: &Path,
+    overrides: &[String],
+    registry: &Registry,
+) -> Result<LoadedScene> {
+    let mut root = doc::parse(text, label)?;
+    for assignment in overrides {
+        doc::apply_override(&mut root, assignment)?;
+    }
+    let file_location = Location::File {
+        path: Arc::from(label),
+        line: 1,
+        column: 1,
+    };
+    for entry in &root.entries {
+        if !TOP_LEVEL_KEYS.contains(&entry.key.as_str()) {
+            return Err(Error::at(
+                &entry.key_location,
+                format!(
+                    "unknown top-level key '{}'; accepted: {}",
+                    entry.key,
+                    TOP_LEVEL_KEYS.join(", ")
+                ),
+            ));
+        }
+    }
+    let seed = match root.get("seed") {
+        None => 0,
+        Some(node) => match node.value {
+            Value::Int(s) if s >= 0 => s as u64,
+            _ => return Err(Error::at(&node.location, "seed: expected a non-negative integer")),
+        },
+    };
+
+    let (camera, output) = film_and_camera(&root, &file_location, dir)?;
+    let bsdfs = named_bsdfs(&root, registry)?;
+    let mut builder = SceneBuilder::new(&device()?, SceneOptions::default()).map_err(embree_error)?;
+    let mut geometries = Vec::new();
+    let mut lights: Vec<Box<dyn Light>> = Vec::new();
+    let mut counts = SceneCounts::default();
+
+    for (i, (table, location)) in tables_in(&root, "shape")?.into_iter().enumerate() {
+        let owner = format!("[[shape]] #{}", i + 1);
+        let (kind, kind_location) = type_of(table, &location, &owner)?;
+        let spec = SHAPE_TYPES
+            .iter()
+            .find(|(n, _)| *n == kind)
+            .map(|(_, s)| *s)
+            .ok_or_else(|| shapes::unknown_shape_type(kind, &kind_location))?;
+        let owner = format!("{owner} (type = \"{kind}\")");
+        let params = Params::new(owner.clone(), table, location.clone(), spec, &["type"])?;
+        let desc = shapes::parse_shape(kind, &params, table, dir)?;
+        params.finish()?;
+        let geometry = add_shape(&owner, desc, &bsdfs, registry, &mut builder, &mut lights, &mut counts)?;
+        geometries.push(geometry);
+    }
+
+    for (i, (table, location)) in tables_in(&root, "light")?.into_iter().enumerate() {
+        let owner = format!("[[light]] #{}", i + 1);
+        let (kind, kind_location) = type_of(table, &location, &owner)?;
+        let light = registry.create_light(
+            &TableRef {
+                owner: &owner,
+                table,
+                location: &location,
+                type_name: kind,
+                type_location: &kind_location,
+                structural: &["type"],
+            },
+            &LightShape::None,
+        )?;
+        lights.push(light);
+    }
+
+    let embree = builder.commit().map_err(embree_error)?;
+    let (center, radius) = render_scene::bounding_sphere(&embree);
+    let mut infinite_lights = Vec::new();
+    for (i, light) in lights.iter_mut().enumerate() {
+        light.preprocess(center, radius);
+        match light.kind() {
+            LightKind::Infinite => {
+                infinite_lights.push(i as u32);
+                counts.infinite_lights += 1;
+            }
+            LightKind::DeltaPosition => counts.delta_lights += 1,
+            LightKind::Area => {}
+        }
+    }
+
+    let light_sampler = {
+        let default_table = Table::default();
+        let (table, location) = match root.get("light_sampler") {
+            Some(node) => (as_table(node, "light_sampler")?, node.location.clone()),
+            None => (&default_table, Location::Builtin),
+        };
+        let (kind, kind_location) = match table.get("type") {
+            Some(_) => type_of(table, &location, "light_sampler")?,
+            None => ("uniform", Location::Builtin),
+        };
+        registry.create_light_sampler(
+            &TableRef {
+                owner: "light_sampler",
+                table,
+                location: &location,
+                type_name: kind,
+                type_location: &kind_location,
+                structural: &["type"],
+            },
+            &lights,
+        )?
+    };
+
+    let sampler = {
+        let (table, location) = required_table(&root, "sampler", &file_location)?;
+        let (kind, kind_location) = type_of(table, &location, "sampler")?;
+        registry.create_sampler(&TableRef {
+            owner: "sampler",
+            table,
+            location: &location,
+            type_name: kind,
+            type_location: &kind_location,
+            structural: &["type"],
+        })?
+    };
+    let integrator = {
+        let (table, location) = required_table(&root, "integrator", &file_location)?;
+        let (kind, kind_location) = type_of(table, &location, "integrator")?;
+        registry.create_integrator(&TableRef {
+            owner: "integrator",
+            table,
+            location: &location,
+            type_name: kind,
+            type_location: &kind_location,
+            structural: &["type"],
+        })?
+    };
+
+    let scene = RenderScene {
+        embree,
+        geometries,
+        bsdfs: bsdfs.into_iter().map(|(_, b)| b).collect(),
+        lights,
+        infinite_lights,
+        light_sampler,
+        counts,
+    };
+    Ok(LoadedScene {
+        name: name.to_string(),
+        scene,
+        camera,
+        sampler,
+        integrator,
+        seed,
+        output,
+    })
+}
+
+fn device() -> Result<Device> {
+    Device::new().map_err(embree_error)
+}
+
+fn embree_error(e: lumis_embree::EmbreeError) -> Error {
+    Error::msg(e.to_string())
+}
+
+fn as_table<'a>(node: &'a Node, what: &str) -> Result<&'a Table> {
+    match &node.value {
+        Value::Table(t) => Ok(t),
+        v => Err(Error::at(&node.location, format!("{what}: expected a table, found {}", v.type_name()))),
+    }
+}
+
+fn required_table<'a>(root: &'a Table, key: &str, file: &Location) -> Result<(&'a Table, Location)> {
+    match root.get(key) {
+        Some(node) => Ok((as_table(node, key)?, node.location.clone())),
+        None => Err(Error::at(file, format!("the scene needs a [{key}] table with a type"))),
+    }
+}
+
+/// The tables of an array of tables (`[[shape]]`), with their locations.
+fn tables_in<'a>(root: &'a Table, key: &str) -> Result<Vec<(&'a Table, Location)>> {
+    let Some(node) = root.get(key) else {
+        return Ok(Vec::new());
+    };
+    let Value::Array(items) = &node.value else {
+        return Err(Error::at(
+            &node.location,
+            format!("'{key}' must be an array of tables: write [[{key}]]"),
+        ));
+    };
+    items
+        .iter()
+        .map(|n| as_table(n, key).map(|t| (t, n.location.clone())))
+        .collect()
+}
+
+/// The `type = "..."` of a table, with its location.
+fn type_of<'a>(table: &'a Table, location: &Location, owner: &str) -> Result<(&'a str, Location)> {
+    match table.get("type") {
+        Some(Node {
+            value: Value::String(s),
+            location,
+        }) => Ok((s.as_str(), location.clone())),
+        Some(node) => Err(Error::at(
+            &node.location,
+            format!("{owner}: 'type' must be a string, found {}", node.value.type_name()),
+        )),
+        None => Err(Error::at(location, format!("{owner} needs a type = \"...\""))),
+    }
+}
+
+fn film_and_camera(root: &Table, file: &Location, dir: &Path) -> Result<(PerspectiveCamera, Option<PathBuf>)> {
+    let empty = Table::default();
+    let (film, film_location) = match root.get("film") {
+        Some(node) => (as_table(node, "film")?, node.location.clone()),
+        None => (&empty, file.clone()),
+    };
+    let film = Params::new("[film]", film, film_location, FILM_PARAMS, &[])?;
+    let resolution: UVec2 = film.get("resolution")?;
+    if resolution.x == 0 || resolution.y == 0 {
+        return Err(film.error("resolution", "width and height must be at least 1"));
+    }
+    let output = film.get_opt::<String>("output")?.map(|o| dir.join(o));
+    if let Some((filter, location)) = film.table("filter")? {
+        match type_of(filter, &location, "[film] filter")? {
+            ("box", _) if filter.entries.len() == 1 => {}
+            ("box", _) => return Err(Error::at(&location, "the box filter takes no parameters (radius 1/2 pixel)")),
+            (other, loc) => {
+                return Err(Error::at(&loc, format!("unknown pixel filter \"{other}\"; available: box")));
+            }
+        }
+    }
+    film.finish()?;
+
+    let (table, location) = required_table(root, "camera", file)?;
+    let (kind, kind_location) = type_of(table, &location, "[camera]")?;
+    if kind != "perspective" {
+        return Err(Error::at(
+            &kind_location,
+            format!("unknown camera type \"{kind}\"; available: perspective"),
+        ));
+    }
+    let cam = Params::new("[camera] (type = \"perspective\")", table, location.clone(), CAMERA_PARAMS, &["type"])?;
+    let fov: f32 = cam.get("fov")?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(cam.error("fov", format!("must be in (0, 180) degrees, got {fov}")));
+    }
+    let camera = PerspectiveCamera::new(
+        cam.get("origin")?,
+        cam.get("target")?,
+        cam.get("up")?,
+        fov,
+        resolution,
+    )
+    .map_err(|e| Error::at(&location, format!("[camera]: {}", e.message)))?;
+    cam.finish()?;
+    Ok((camera, output))
+}
+
+/// Instantiates every `[[bsdf]]`, checking names are present and unique.
+fn named_bsdfs(root: &Table, registry: &Registry) -> Result<Vec<(String, Arc<dyn Bsdf>)>> {
+    let mut out: Vec<(String, Arc<dyn Bsdf>)> = Vec::new();
+    for (i, (table, location)) in tables_in(root, "bsdf")?.into_iter().enumerate() {
+        let name = match table.get("name") {
+            Some(Node {
+                value: Value::String(s),
+                ..
+            }) => s.clone(),
+            Some(node) => return Err(Error::at(&node.location, "[[bsdf]] name must be a string")),
+            None => {
+                return Err(Error::at(
+                    &location,
+                    format!("[[bsdf]] #{} needs a name = \"...\" that shapes refer to", i + 1),
+                ))
+            }
+        };
+        if out.iter().any(|(n, _)| *n == name) {
+            let at = &table.get("name").expect("checked above").location;
+            return Err(Error::at(at, format!("a [[bsdf]] named \"{name}\" already exists")));
+        }
+        let owner = format!("bsdf \"{name}\"");
+        let (kind, kind_location) = type_of(table, &location, &owner)?;
+        let bsdf = registry.create_bsdf(&TableRef {
+            owner: &owner,
+            table,
+            location: &location,
+            type_name: kind,
+            type_location: &kind_location,
+            structural: &["type", "name"],
+        })?;
+        out.push((name, bsdf));
+    }
+    Ok(out)
+}
+
+/// Adds one shape to Embree and creates its area lights.
+fn add_shape(
+    owner: &str,
+    desc: ShapeDesc,
+    bsdfs: &[(String, Arc<dyn Bsdf>)],
+    registry: &Registry,
+    builder: &mut SceneBuilder,
+    lights: &mut Vec<Box<dyn Light>>,
+    counts: &mut SceneCounts,
+) -> Result<Geometry> {
+    let bsdf = bsdfs.iter().position(|(n, _)| *n == desc.bsdf).ok_or_else(|| {
+        let names: Vec<&str> = bsdfs.iter().map(|(n, _)| n.as_str()).collect();
+        Error::at(
+            &desc.bsdf_location,
+            format!(
+                "{owner}: no [[bsdf]] named \"{}\"; defined: {}",
+                desc.bsdf,
+                if names.is_empty() { "none".into() } else { names.join(", ") }
+            ),
+        )
+    })? as u32;
+    let orientation = if desc.flip_normals { -1.0 } else { 1.0 };
+    let emission_owner = format!("{owner} emission");
+    let emission = desc.emission.as_ref();
+    let has_emission = emission.is_some();
+    let mut make_light = |default_type: &str, shape: LightShape| -> Result<Option<u32>> {
+        let Some((table, location)) = emission else {
+            return Ok(None);
+        };
+        let table: &Table = table;
+        let (kind, kind_location) = match table.get("type") {
+            Some(_) => type_of(table, location, &emission_owner)?,
+            None => (default_type, location.clone()),
+        };
+        let light = registry.create_light(
+            &TableRef {
+                owner: &emission_owner,
+                table,
+                location,
+                type_name: kind,
+                type_location: &kind_location,
+                structural: &["type"],
+            },
+            &shape,
+        )?;
+        lights.push(light);
+        counts.area_lights += 1;
+        Ok(Some(lights.len() as u32 - 1))
+    };
+
+    match desc.geometry {
+        ShapeGeometry::Mesh {
+            positions,
+            indices,
+            normals,
+            quad,
+        } => {
+            let light_indices = match quad {
+                Some((corner, edge_u, edge_v)) => {
+                    let (edge_u, edge_v) = if desc.flip_normals { (edge_v, edge_u) } else { (edge_u, edge_v) };
+                    match make_light("quad", LightShape::Quad { corner, edge_u, edge_v })? {
+                        Some(i) => vec![i; indices.len()],
+                        None => Vec::new(),
+                    }
+                }
+                None if has_emission => {
+                    let mut per_triangle = Vec::with_capacity(indices.len());
+                    for t in &indices {
+                        let [a, b, c] = t.map(|i| Vec3::from(positions[i as usize]));
+                        let p = if desc.flip_normals { [a, c, b] } else { [a, b, c] };
+                        // Zero-area triangles cannot emit; they keep no light.
+                        let degenerate = (b - a).cross(c - a).length_squared() == 0.0;
+                        per_triangle.push(if degenerate {
+                            NO_LIGHT
+                        } else {
+                            make_light("triangle", LightShape::Triangle { p })?.unwrap_or(NO_LIGHT)
+                        });
+                    }
+                    per_triangle
+                }
+                None => Vec::new(),
+            };
+            counts.meshes += 1;
+            counts.triangles += indices.len();
+            counts.shading_normals |= normals.is_some();
+            let vertices = Arc::new(PaddedBuffer::new(positions));
+            let indices = Arc::new(PaddedBuffer::new(indices));
+            builder
+                .add_triangle_mesh(vertices.clone(), indices.clone())
+                .map_err(|e| Error::msg(format!("{owner}: {e}")))?;
+            Ok(Geometry::Mesh {
+                vertices,
+                indices,
+                normals,
+                bsdf,
+                lights: light_indices,
+                orientation,
+            })
+        }
+        ShapeGeometry::Sphere { center, radius } => {
+            let light = make_light(
+                "sphere",
+                LightShape::Sphere {
+                    center,
+                    radius,
+                    inward: desc.flip_normals,
+                },
+            )?;
+            counts.spheres += 1;
+            builder
+                .add_spheres(Arc::new(PaddedBuffer::new(vec![[center.x, center.y, center.z, radius]])))
+                .map_err(|e| Error::msg(format!("{owner}: {e}")))?;
+            Ok(Geometry::Sphere {
+                center,
+                radius,
+                bsdf,
+                light,
+                orientation,
+            })
+        }
+    }
+}

@@ -1,0 +1,204 @@
+//! The render-ready scene: Embree geometry plus what shading needs per hit.
+
+use std::sync::Arc;
+
+use lumis_core::interaction::HitLight;
+use lumis_core::math::{gamma, Frame};
+use lumis_core::ray::SurfacePoint;
+use lumis_core::{Bsdf, Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3};
+use lumis_embree::{PaddedBuffer, Triangle, Vertex};
+
+/// Marks a triangle without an area light in [`Geometry::Mesh::lights`].
+pub(crate) const NO_LIGHT: u32 = u32::MAX;
+
+/// Per-geometry shading data, indexed by Embree geometry id.
+pub(crate) enum Geometry {
+    Mesh {
+        vertices: Arc<PaddedBuffer<Vertex>>,
+        indices: Arc<PaddedBuffer<Triangle>>,
+        /// Per-vertex shading normals; `None` means flat shading (and no
+        /// interpolation cost).
+        normals: Option<Vec<Vec3>>,
+        bsdf: u32,
+        /// Light index per triangle (`NO_LIGHT` if none); empty when the
+        /// mesh does not emit.
+        lights: Vec<u32>,
+        /// -1 flips the geometric normal (and so the front side).
+        orientation: f32,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        bsdf: u32,
+        light: Option<u32>,
+        orientation: f32,
+    },
+}
+
+/// What [`RenderScene`] was built from, for `lumis render -v`.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct SceneCounts {
+    pub meshes: usize,
+    pub triangles: usize,
+    pub spheres: usize,
+    pub area_lights: usize,
+    pub delta_lights: usize,
+    pub infinite_lights: usize,
+    pub shading_normals: bool,
+}
+
+pub struct RenderScene {
+    pub(crate) embree: lumis_embree::Scene,
+    pub(crate) geometries: Vec<Geometry>,
+    pub(crate) bsdfs: Vec<Arc<dyn Bsdf>>,
+    pub(crate) lights: Vec<Box<dyn Light>>,
+    pub(crate) infinite_lights: Vec<u32>,
+    pub(crate) light_sampler: Box<dyn LightSampler>,
+    pub(crate) counts: SceneCounts,
+}
+
+impl RenderScene {
+    pub fn counts(&self) -> &SceneCounts {
+        &self.counts
+    }
+
+    /// The Embree scene, for benchmarks that trace the same rays bare.
+    pub fn embree(&self) -> &lumis_embree::Scene {
+        &self.embree
+    }
+
+    /// Bounding sphere of the geometry: `(center, radius)`.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        bounding_sphere(&self.embree)
+    }
+
+    #[inline]
+    fn light_ref(&self, index: u32) -> Option<HitLight<'_>> {
+        (index != NO_LIGHT).then(|| HitLight {
+            index,
+            light: self.lights[index as usize].as_ref(),
+        })
+    }
+}
+
+pub(crate) fn bounding_sphere(scene: &lumis_embree::Scene) -> (Vec3, f32) {
+    let (lo, hi) = scene.bounds();
+    let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+    if !(lo.is_finite() && hi.is_finite()) || lo.cmpgt(hi).any() {
+        return (Vec3::ZERO, 0.0);
+    }
+    let center = 0.5 * (lo + hi);
+    (center, (hi - center).length())
+}
+
+#[inline]
+fn to_embree(ray: &Ray) -> lumis_embree::Ray {
+    lumis_embree::Ray {
+        org: ray.o.into(),
+        dir: ray.d.into(),
+        tnear: 0.0,
+        tfar: ray.t_max,
+    }
+}
+
+impl Scene for RenderScene {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
+        let hit = self.embree.intersect1(&to_embree(ray))?;
+        let wo = -ray.d.normalize();
+        match &self.geometries[hit.geom_id as usize] {
+            Geometry::Mesh {
+                vertices,
+                indices,
+                normals,
+                bsdf,
+                lights,
+                orientation,
+            } => {
+                let tri = indices[hit.prim_id as usize];
+                let [p0, p1, p2] = tri.map(|i| Vec3::from(vertices[i as usize]));
+                let (b1, b2) = (hit.u, hit.v);
+                let b0 = 1.0 - b1 - b2;
+                // Recompute the hit from barycentrics and bound its error
+                // (pbrt-v4 Triangle::InteractionFromIntersection, eq. 6.37):
+                // the ray origin offset then needs no scene-scale epsilon.
+                let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
+                let p = q0 + q1 + q2;
+                let p_error = gamma(7) * (q0.abs() + q1.abs() + q2.abs());
+                let n = (p1 - p0).cross(p2 - p0).normalize() * *orientation;
+                let ns = match normals {
+                    Some(ns) => {
+                        let [n0, n1, n2] = tri.map(|i| ns[i as usize]);
+                        let s = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+                        // Keep the shading normal on the geometric side.
+                        if s == Vec3::ZERO {
+                            n
+                        } else if s.dot(n) < 0.0 {
+                            -s
+                        } else {
+                            s
+                        }
+                    }
+                    None => n,
+                };
+                let light = lights.get(hit.prim_id as usize).and_then(|&i| self.light_ref(i));
+                Some(SurfaceInteraction {
+                    point: SurfacePoint { p, p_error, n },
+                    t: hit.t,
+                    shading: Frame::from_z(ns),
+                    uv: Vec2::new(b1, b2),
+                    wo,
+                    bsdf: self.bsdfs[*bsdf as usize].as_ref(),
+                    light,
+                })
+            }
+            Geometry::Sphere {
+                center,
+                radius,
+                bsdf,
+                light,
+                orientation,
+            } => {
+                // Reproject onto the surface (pbrt-v4 Sphere, section 6.8.5):
+                // the error is then gamma(5) |p| in the sphere's frame.
+                let local = ray.at(hit.t) - *center;
+                let local = local * (*radius / local.length());
+                let p = *center + local;
+                let p_error = gamma(5) * local.abs() + gamma(1) * center.abs();
+                let outward = local / *radius;
+                let n = outward * *orientation;
+                let phi = outward.y.atan2(outward.x);
+                let uv = Vec2::new(
+                    (phi * 0.5 * std::f32::consts::FRAC_1_PI).rem_euclid(1.0),
+                    outward.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
+                );
+                Some(SurfaceInteraction {
+                    point: SurfacePoint { p, p_error, n },
+                    t: hit.t,
+                    shading: Frame::from_z(n),
+                    uv,
+                    wo,
+                    bsdf: self.bsdfs[*bsdf as usize].as_ref(),
+                    light: light.and_then(|i| self.light_ref(i)),
+                })
+            }
+        }
+    }
+
+    #[inline]
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.embree.occluded1(&to_embree(ray))
+    }
+
+    fn lights(&self) -> &[Box<dyn Light>] {
+        &self.lights
+    }
+
+    fn infinite_lights(&self) -> &[u32] {
+        &self.infinite_lights
+    }
+
+    fn light_sampler(&self) -> &dyn LightSampler {
+        self.light_sampler.as_ref()
+    }
+}
