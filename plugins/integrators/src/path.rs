@@ -96,15 +96,17 @@ impl PathIntegrator {
             "light" => Strategy::Light,
             _ => Strategy::Mis,
         };
-        // The heuristic only matters for MIS, and beta only for the power
-        // heuristic: reading them conditionally makes Params reject a key
-        // that would be silently ignored.
-        let mut heuristic = Heuristic::Balance;
-        if strategy == Strategy::Mis {
-            if params.get_choice("heuristic", &["balance", "power"])? == "power" {
-                let beta = params.get_positive("beta")?;
-                heuristic = Heuristic::Power { beta };
-            }
+        // Heuristic and beta are validated whatever the strategy, so that
+        // `--set integrator.strategy=bsdf` works on a scene that sets them;
+        // they only change the estimate when strategy = "mis".
+        let heuristic = match params.get_choice("heuristic", &["balance", "power"])?.as_str() {
+            "balance" => Heuristic::Balance,
+            _ => Heuristic::Power {
+                beta: params.get_positive("beta")?,
+            },
+        };
+        if params.is_given("beta") && heuristic == Heuristic::Balance {
+            return Err(params.error("beta", "only applies to heuristic = \"power\""));
         }
         Ok(Self::new(max_depth, rr_depth, strategy, heuristic))
     }
@@ -270,9 +272,8 @@ mod tests {
         assert_eq!(p.max_depth, 3);
         assert_eq!(build("").unwrap().heuristic, Heuristic::Power { beta: 2.0 });
         let err = build("heuristic = \"balance\"\nbeta = 3.0\n").unwrap_err().to_string();
-        assert!(err.contains("'beta' is not used"), "{err}");
-        let err = build("strategy = \"bsdf\"\nheuristic = \"power\"\n").unwrap_err().to_string();
-        assert!(err.contains("'heuristic' is not used"), "{err}");
+        assert!(err.contains("'beta': only applies"), "{err}");
+        assert_eq!(build("strategy = \"bsdf\"\nheuristic = \"power\"\n").unwrap().strategy, Strategy::Bsdf);
         assert!(build("max_depth = 0\n").is_err());
         assert!(build("strategy = \"nee\"\n").is_err());
     }

@@ -1,0 +1,59 @@
+//! The Cornell box of `scenes/cornell-box.toml` against an established
+//! renderer's converged image, estimator agreement, and determinism.
+
+use lumis_image::read_exr;
+use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scenes_dir};
+
+const BLOCK: usize = 32;
+
+/// Pixel means agree with Mitsuba 3's 8192-spp reference of the same scene
+/// (`scenes/reference/cornell_box_mitsuba.py`) in every 32x32 block.
+#[test]
+fn matches_mitsuba_reference() {
+    let reference = read_exr(&scenes_dir().join("reference/cornell-box-mitsuba.exr")).expect("reference image");
+    let out = render_toml(&read_scene("cornell-box.toml"), &["sampler.spp=32"], 0);
+    assert_eq!(out.stats.nonfinite, 0);
+    let blocks = (256 / BLOCK) * (256 / BLOCK) * 3;
+    let worst = assert_same_mean(&out.image, &reference, BLOCK, bonferroni_z(1e-3, blocks), "lumis vs Mitsuba");
+    eprintln!("largest block z-score against Mitsuba: {worst:.2}");
+}
+
+/// BSDF-only, light-only and MIS estimators (balance and power) are all
+/// unbiased: their images of the same pixels agree in the mean.
+#[test]
+fn estimators_agree_in_the_mean() {
+    let scene = read_scene("cornell-box.toml");
+    let render = |overrides: &[&str]| {
+        let mut all = vec!["film.resolution=[64, 64]", "sampler.spp=64"];
+        all.extend_from_slice(overrides);
+        render_toml(&scene, &all, 0).image
+    };
+    let mis_power = render(&["integrator.strategy=mis", "integrator.heuristic=power", "seed=1"]);
+    let others = [
+        ("bsdf", render(&["integrator.strategy=bsdf", "seed=2"])),
+        ("light", render(&["integrator.strategy=light", "seed=3"])),
+        ("mis-balance", render(&["integrator.strategy=mis", "integrator.heuristic=balance", "seed=4"])),
+    ];
+    let block = 16;
+    let tests = others.len() * (64 / block) * (64 / block) * 3;
+    let z = bonferroni_z(1e-3, tests);
+    for (name, image) in &others {
+        assert_same_mean(image, &mis_power, block, z, &format!("{name} vs mis-power"));
+    }
+}
+
+/// The same scene, seed and spp give a bit-identical image on 1 and 2 threads.
+#[test]
+fn bit_identical_for_any_thread_count() {
+    let scene = read_scene("cornell-box.toml");
+    let overrides = ["film.resolution=[48, 40]", "sampler.spp=4", "seed=7"];
+    let one = render_toml(&scene, &overrides, 1);
+    let two = render_toml(&scene, &overrides, 2);
+    let three = render_toml(&scene, &overrides, 3);
+    assert!(one.image.pixels.iter().any(|p| p[0] > 0.0));
+    assert_eq!(one.image, two.image);
+    assert_eq!(one.image, three.image);
+    assert_eq!(one.stats, two.stats);
+    let other_seed = render_toml(&scene, &["film.resolution=[48, 40]", "sampler.spp=4", "seed=8"], 2);
+    assert_ne!(one.image, other_seed.image);
+}
