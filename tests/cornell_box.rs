@@ -10,11 +10,18 @@ const BLOCK: usize = 32;
 /// (`scenes/reference/cornell_box_mitsuba.py`) in every 32x32 block.
 #[test]
 fn matches_mitsuba_reference() {
-    let reference = read_exr(&scenes_dir().join("reference/cornell-box-mitsuba.exr")).expect("reference image");
+    let reference =
+        read_exr(&scenes_dir().join("reference/cornell-box-mitsuba.exr")).expect("reference image");
     let out = render_toml(&read_scene("cornell-box.toml"), &["sampler.spp=32"], 0);
     assert_eq!(out.stats.nonfinite, 0);
     let blocks = (256 / BLOCK) * (256 / BLOCK) * 3;
-    let worst = assert_same_mean(&out.image, &reference, BLOCK, bonferroni_z(1e-3, blocks), "lumis vs Mitsuba");
+    let worst = assert_same_mean(
+        &out.image,
+        &reference,
+        BLOCK,
+        bonferroni_z(1e-3, blocks),
+        "lumis vs Mitsuba",
+    );
     eprintln!("largest block z-score against Mitsuba: {worst:.2}");
 }
 
@@ -28,11 +35,22 @@ fn estimators_agree_in_the_mean() {
         all.extend_from_slice(overrides);
         render_toml(&scene, &all, 0).image
     };
-    let mis_power = render(&["integrator.strategy=mis", "integrator.heuristic=power", "seed=1"]);
+    let mis_power = render(&[
+        "integrator.strategy=mis",
+        "integrator.heuristic=power",
+        "seed=1",
+    ]);
     let others = [
         ("bsdf", render(&["integrator.strategy=bsdf", "seed=2"])),
         ("light", render(&["integrator.strategy=light", "seed=3"])),
-        ("mis-balance", render(&["integrator.strategy=mis", "integrator.heuristic=balance", "seed=4"])),
+        (
+            "mis-balance",
+            render(&[
+                "integrator.strategy=mis",
+                "integrator.heuristic=balance",
+                "seed=4",
+            ]),
+        ),
     ];
     let block = 16;
     let tests = others.len() * (64 / block) * (64 / block) * 3;
@@ -54,6 +72,10 @@ fn bit_identical_for_any_thread_count() {
     assert_eq!(one.image, two.image);
     assert_eq!(one.image, three.image);
     assert_eq!(one.stats, two.stats);
-    let other_seed = render_toml(&scene, &["film.resolution=[48, 40]", "sampler.spp=4", "seed=8"], 2);
+    let other_seed = render_toml(
+        &scene,
+        &["film.resolution=[48, 40]", "sampler.spp=4", "seed=8"],
+        2,
+    );
     assert_ne!(one.image, other_seed.image);
 }

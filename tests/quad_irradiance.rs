@@ -90,7 +90,11 @@ fn rectangle_light_matches_form_factor() {
         &["integrator.strategy=light"],
         &["integrator.strategy=mis", "integrator.heuristic=balance"],
         &["integrator.strategy=mis", "integrator.heuristic=power"],
-        &["integrator.strategy=mis", "integrator.heuristic=power", "integrator.beta=3.0"],
+        &[
+            "integrator.strategy=mis",
+            "integrator.heuristic=power",
+            "integrator.beta=3.0",
+        ],
     ];
     let z = bonferroni_z(1e-3, cases.len() + 1);
     for overrides in cases {
@@ -101,7 +105,9 @@ fn rectangle_light_matches_form_factor() {
 #[test]
 fn point_light_matches_inverse_square_law() {
     let (px, py, pz, intensity) = (0.2f64, 1.0f64, 0.1f64, 2.0f64);
-    let light = format!("[[light]]\ntype = \"point\"\nposition = [{px}, {py}, {pz}]\nintensity = {intensity}\n");
+    let light = format!(
+        "[[light]]\ntype = \"point\"\nposition = [{px}, {py}, {pz}]\nintensity = {intensity}\n"
+    );
     let d2 = px * px + py * py + pz * pz;
     // L = rho/pi * I cos(theta) / d^2 with cos(theta) = py / d.
     let expected = RHO / std::f64::consts::PI * intensity * (py / d2.sqrt()) / d2;

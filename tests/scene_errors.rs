@@ -34,14 +34,19 @@ fn with(extra: &str) -> String {
 
 fn assert_contains(err: &str, parts: &[&str]) {
     for part in parts {
-        assert!(err.contains(part), "error does not mention '{part}':\n{err}");
+        assert!(
+            err.contains(part),
+            "error does not mention '{part}':\n{err}"
+        );
     }
 }
 
 #[test]
 fn base_scene_loads() {
     let registry = lumis_cli::builtin_registry().unwrap();
-    let toml = with("[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"white\"\n");
+    let toml = with(
+        "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"white\"\n",
+    );
     lumis_scene::load_str(&toml, "ok.toml", "ok", &scenes_dir(), &[], &registry).unwrap();
 }
 
@@ -64,7 +69,14 @@ fn bad_toml() {
 #[test]
 fn unknown_plugin_type_lists_the_available_ones() {
     let err = load(&BASE.replace("type = \"diffuse\"", "type = \"difuse\""));
-    assert_contains(&err, &["bad.toml:15:8", "unknown bsdf type \"difuse\"", "available: diffuse"]);
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:15:8",
+            "unknown bsdf type \"difuse\"",
+            "available: diffuse",
+        ],
+    );
 }
 
 #[test]
@@ -72,7 +84,12 @@ fn unknown_key_names_the_plugin_and_the_accepted_keys() {
     let err = load(&BASE.replace("reflectance = 0.5", "reflectence = 0.5"));
     assert_contains(
         &err,
-        &["bad.toml:16:1", "unknown key 'reflectence'", "bsdf \"white\"", "reflectance, two_sided, sampling"],
+        &[
+            "bad.toml:16:1",
+            "unknown key 'reflectence'",
+            "bsdf \"white\"",
+            "reflectance, two_sided, sampling",
+        ],
     );
     let err = load(&with("[integrator2]\n"));
     assert_contains(&err, &["unknown top-level key 'integrator2'"]);
@@ -81,14 +98,26 @@ fn unknown_key_names_the_plugin_and_the_accepted_keys() {
 #[test]
 fn wrong_type() {
     let err = load(&BASE.replace("spp = 1", "spp = \"many\""));
-    assert_contains(&err, &["bad.toml:10:7", "'spp'", "expected an integer, found a string"]);
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:10:7",
+            "'spp'",
+            "expected an integer, found a string",
+        ],
+    );
     let err = load(&BASE.replace("resolution = [8, 8]", "resolution = 8"));
-    assert_contains(&err, &["bad.toml:2:14", "'resolution'", "expected an array of 2"]);
+    assert_contains(
+        &err,
+        &["bad.toml:2:14", "'resolution'", "expected an array of 2"],
+    );
 }
 
 #[test]
 fn out_of_range_values() {
-    let err = load(&with("[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = -1.0\nbsdf = \"white\"\n"));
+    let err = load(&with(
+        "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = -1.0\nbsdf = \"white\"\n",
+    ));
     assert_contains(&err, &["bad.toml:20:10", "'radius'", "positive"]);
     let err = load(&BASE.replace("fov = 40.0", "fov = 180.0"));
     assert_contains(&err, &["bad.toml:7:7", "'fov'", "(0, 180)"]);
@@ -103,21 +132,44 @@ fn mesh_index_out_of_range() {
     let err = load(&with(
         "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\nindices = [0, 1, 3]\nbsdf = \"white\"\n",
     ));
-    assert_contains(&err, &["bad.toml:20:11", "index 3", "out of range for 3 positions"]);
+    assert_contains(
+        &err,
+        &["bad.toml:20:11", "index 3", "out of range for 3 positions"],
+    );
 }
 
 #[test]
 fn missing_obj_file_and_unknown_bsdf_name() {
-    let err = load(&with("[[shape]]\ntype = \"obj\"\nfile = \"nope.obj\"\nbsdf = \"white\"\n"));
+    let err = load(&with(
+        "[[shape]]\ntype = \"obj\"\nfile = \"nope.obj\"\nbsdf = \"white\"\n",
+    ));
     assert_contains(&err, &["bad.toml:19:8", "cannot load OBJ", "nope.obj"]);
-    let err = load(&with("[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"whte\"\n"));
-    assert_contains(&err, &["bad.toml:21:8", "no [[bsdf]] named \"whte\"", "defined: white"]);
+    let err = load(&with(
+        "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"whte\"\n",
+    ));
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:21:8",
+            "no [[bsdf]] named \"whte\"",
+            "defined: white",
+        ],
+    );
 }
 
 #[test]
 fn setting_that_does_not_apply_is_rejected() {
-    let err = load(&BASE.replace("type = \"path\"", "type = \"path\"\nheuristic = \"balance\"\nbeta = 3.0"));
-    assert_contains(&err, &["bad.toml:14:8", "'beta': only applies to heuristic = \"power\""]);
+    let err = load(&BASE.replace(
+        "type = \"path\"",
+        "type = \"path\"\nheuristic = \"balance\"\nbeta = 3.0",
+    ));
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:14:8",
+            "'beta': only applies to heuristic = \"power\"",
+        ],
+    );
 }
 
 #[test]

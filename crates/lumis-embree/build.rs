@@ -63,7 +63,9 @@ fn find_pkg_config(tried: &mut Vec<String>) -> Option<PathBuf> {
             match dir {
                 Some(dir) => Some(dir),
                 None => {
-                    tried.push("pkg-config embree4: found, but it names no library directory".into());
+                    tried.push(
+                        "pkg-config embree4: found, but it names no library directory".into(),
+                    );
                     None
                 }
             }
@@ -143,15 +145,29 @@ fn download_and_unpack(cache: &Path) -> Result<(), String> {
     // The wheel is tagged cp311; pinning interpreter and platform tags lets any
     // Python 3 with pip download it (we only want the shared libraries inside).
     let status = Command::new(&python)
-        .args(["-m", "pip", "download", "--quiet", "--no-deps", "--only-binary=:all:"])
-        .args(["--python-version", "3.11", "--platform", "manylinux_2_28_x86_64"])
+        .args([
+            "-m",
+            "pip",
+            "download",
+            "--quiet",
+            "--no-deps",
+            "--only-binary=:all:",
+        ])
+        .args([
+            "--python-version",
+            "3.11",
+            "--platform",
+            "manylinux_2_28_x86_64",
+        ])
         .arg("--dest")
         .arg(&staging)
         .arg(WHEEL)
         .status()
         .map_err(|e| format!("cannot run `{python} -m pip`: {e}"))?;
     if !status.success() {
-        return Err(format!("`{python} -m pip download {WHEEL}` failed ({status})"));
+        return Err(format!(
+            "`{python} -m pip download {WHEEL}` failed ({status})"
+        ));
     }
     let wheel = fs::read_dir(&staging)
         .map_err(|e| e.to_string())?

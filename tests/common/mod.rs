@@ -11,8 +11,15 @@ use lumis_render::{render, RenderOutput, RenderSettings};
 pub fn render_toml(toml: &str, overrides: &[&str], threads: usize) -> RenderOutput {
     let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let loaded = lumis_scene::load_str(toml, "test.toml", "test", &scenes_dir(), &overrides, &registry)
-        .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
+    let loaded = lumis_scene::load_str(
+        toml,
+        "test.toml",
+        "test",
+        &scenes_dir(),
+        &overrides,
+        &registry,
+    )
+    .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
     let settings = RenderSettings {
         spp: loaded.sampler.samples_per_pixel(),
         seed: loaded.seed,
@@ -31,7 +38,9 @@ pub fn render_toml(toml: &str, overrides: &[&str], threads: usize) -> RenderOutp
 
 /// The repository's `scenes/` directory.
 pub fn scenes_dir() -> std::path::PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("scenes")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join("scenes")
 }
 
 pub fn read_scene(name: &str) -> String {
@@ -52,7 +61,11 @@ pub fn mean_and_se(values: &[f64]) -> (f64, f64) {
 /// spread of the differences measures the noise of both images). Returns
 /// the largest |z| seen; panics with the block if one exceeds `z`.
 pub fn assert_same_mean(a: &Image, b: &Image, block: usize, z: f64, what: &str) -> f64 {
-    assert_eq!((a.width, a.height), (b.width, b.height), "{what}: sizes differ");
+    assert_eq!(
+        (a.width, a.height),
+        (b.width, b.height),
+        "{what}: sizes differ"
+    );
     let mut worst = 0.0f64;
     for by in (0..a.height).step_by(block) {
         for bx in (0..a.width).step_by(block) {
@@ -67,7 +80,10 @@ pub fn assert_same_mean(a: &Image, b: &Image, block: usize, z: f64, what: &str) 
                 // Blocks where both images are exactly equal everywhere (e.g.
                 // black) have se = 0 and mean = 0: nothing to test.
                 if se == 0.0 {
-                    assert_eq!(mean, 0.0, "{what}: block ({bx}, {by}) channel {c} differs by a constant");
+                    assert_eq!(
+                        mean, 0.0,
+                        "{what}: block ({bx}, {by}) channel {c} differs by a constant"
+                    );
                     continue;
                 }
                 let score = mean / se;
@@ -109,7 +125,8 @@ fn two_sided_tail(z: f64) -> f64 {
                 + t * (0.09678418
                     + t * (-0.18628806
                         + t * (0.27886807
-                            + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+                            + t * (-1.13520398
+                                + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
         .exp()
 }
 

@@ -7,7 +7,11 @@ use clap::{Parser, Subcommand};
 use lumis_cli::{builtin_registry, render_scene_file, RenderArgs};
 
 #[derive(Parser)]
-#[command(name = "lumis", version, about = "A Monte Carlo path tracer that measures what each sampling choice buys")]
+#[command(
+    name = "lumis",
+    version,
+    about = "A Monte Carlo path tracer that measures what each sampling choice buys"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

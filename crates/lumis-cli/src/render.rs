@@ -54,7 +54,10 @@ impl RenderReport {
 
 /// `PATH.exr` and `PATH.png` for an output argument (with or without `.exr`).
 pub fn output_paths(output: &Path) -> (PathBuf, PathBuf) {
-    let stem = if output.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr")) {
+    let stem = if output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
         output.with_extension("")
     } else {
         output.to_path_buf()
@@ -106,7 +109,10 @@ fn describe(loaded: &LoadedScene) -> String {
 }
 
 /// Renders a scene file and writes `PATH.exr` and `PATH.png`.
-pub fn render_scene_file(args: &RenderArgs, registry: &lumis_core::Registry) -> Result<RenderReport> {
+pub fn render_scene_file(
+    args: &RenderArgs,
+    registry: &lumis_core::Registry,
+) -> Result<RenderReport> {
     let loaded = load(args, registry)?;
     if args.verbose {
         eprintln!("{}", describe(&loaded));
@@ -117,6 +123,16 @@ pub fn render_scene_file(args: &RenderArgs, registry: &lumis_core::Registry) -> 
         (None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
     };
     let (exr, png) = output_paths(&output);
+    // Fail before rendering, not after, when the output cannot be written.
+    if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(Error::msg(format!(
+                "output directory '{}' does not exist (for {})",
+                dir.display(),
+                exr.display()
+            )));
+        }
+    }
     let settings = RenderSettings {
         spp: loaded.sampler.samples_per_pixel(),
         seed: loaded.seed,
@@ -149,8 +165,14 @@ mod tests {
     #[test]
     fn output_paths_add_both_extensions() {
         let (e, p) = output_paths(Path::new("out/box.exr"));
-        assert_eq!((e.to_str().unwrap(), p.to_str().unwrap()), ("out/box.exr", "out/box.png"));
+        assert_eq!(
+            (e.to_str().unwrap(), p.to_str().unwrap()),
+            ("out/box.exr", "out/box.png")
+        );
         let (e, p) = output_paths(Path::new("box.v2"));
-        assert_eq!((e.to_str().unwrap(), p.to_str().unwrap()), ("box.v2.exr", "box.v2.png"));
+        assert_eq!(
+            (e.to_str().unwrap(), p.to_str().unwrap()),
+            ("box.v2.exr", "box.v2.png")
+        );
     }
 }

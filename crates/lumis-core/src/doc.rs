@@ -64,7 +64,10 @@ impl Table {
     }
 
     pub fn get_mut(&mut self, key: &str) -> Option<&mut Node> {
-        self.entries.iter_mut().find(|e| e.key == key).map(|e| &mut e.node)
+        self.entries
+            .iter_mut()
+            .find(|e| e.key == key)
+            .map(|e| &mut e.node)
     }
 
     pub fn entry(&self, key: &str) -> Option<&Entry> {
@@ -178,12 +181,15 @@ fn parse_float(text: &str) -> f64 {
 /// TOML value; if it is not one it is taken as a string (`sampler.type=sobol`).
 pub fn apply_override(root: &mut Table, assignment: &str) -> Result<()> {
     let location = Location::Override(Arc::from(assignment));
-    let (path, value_text) = assignment.split_once('=').ok_or_else(|| {
-        Error::at(&location, "expected key.path=value")
-    })?;
+    let (path, value_text) = assignment
+        .split_once('=')
+        .ok_or_else(|| Error::at(&location, "expected key.path=value"))?;
     let segments: Vec<&str> = path.trim().split('.').collect();
     if segments.iter().any(|s| s.is_empty()) {
-        return Err(Error::at(&location, format!("empty segment in key path '{path}'")));
+        return Err(Error::at(
+            &location,
+            format!("empty segment in key path '{path}'"),
+        ));
     }
     let value = parse_override_value(value_text.trim(), &location);
     let last = segments.len() - 1;
@@ -221,7 +227,12 @@ pub fn apply_override(root: &mut Table, assignment: &str) -> Result<()> {
                     format!("'{walked}' is an array: name an element, e.g. '{walked}.0.key=value'"),
                 ))
             }
-            _ => return Err(Error::at(&location, format!("'{walked}' is {found}, not a table"))),
+            _ => {
+                return Err(Error::at(
+                    &location,
+                    format!("'{walked}' is {found}, not a table"),
+                ))
+            }
         };
     }
     table.insert(segments[last], Node { value, location });
@@ -257,7 +268,9 @@ fn relocate(node: &mut Node, location: &Location) {
 pub fn select_in_array<'t>(items: &'t mut [Node], selector: &str) -> Option<&'t mut Table> {
     let by_index = selector.parse::<usize>().ok();
     let position = items.iter().position(|n| match &n.value {
-        Value::Table(t) => matches!(t.get("name"), Some(Node { value: Value::String(s), .. }) if s == selector),
+        Value::Table(t) => {
+            matches!(t.get("name"), Some(Node { value: Value::String(s), .. }) if s == selector)
+        }
         _ => false,
     });
     let i = position.or(by_index)?;
@@ -277,7 +290,9 @@ mod tests {
     fn locations_point_at_lines() {
         let doc = parse(SCENE, "s.toml").unwrap();
         let film = doc.entry("film").unwrap();
-        let Value::Table(film) = &film.node.value else { panic!() };
+        let Value::Table(film) = &film.node.value else {
+            panic!()
+        };
         let res = film.entry("resolution").unwrap();
         assert_eq!(res.key_location.to_string(), "s.toml:2:1");
         assert_eq!(res.node.location.to_string(), "s.toml:2:14");
@@ -297,17 +312,30 @@ mod tests {
         apply_override(&mut doc, "bsdf.red.reflectance=0.25").unwrap();
         apply_override(&mut doc, "bsdf.0.reflectance=0.75").unwrap();
         apply_override(&mut doc, "sampler.type=sobol").unwrap();
-        let Value::Table(film) = &doc.get("film").unwrap().value else { panic!() };
+        let Value::Table(film) = &doc.get("film").unwrap().value else {
+            panic!()
+        };
         assert!(matches!(&film.get("resolution").unwrap().value, Value::Array(a) if a.len() == 2));
-        let Value::Array(bsdfs) = &doc.get("bsdf").unwrap().value else { panic!() };
-        let Value::Table(white) = &bsdfs[0].value else { panic!() };
+        let Value::Array(bsdfs) = &doc.get("bsdf").unwrap().value else {
+            panic!()
+        };
+        let Value::Table(white) = &bsdfs[0].value else {
+            panic!()
+        };
         assert_eq!(white.get("reflectance").unwrap().value, Value::Float(0.75));
-        let Value::Table(red) = &bsdfs[1].value else { panic!() };
+        let Value::Table(red) = &bsdfs[1].value else {
+            panic!()
+        };
         let r = red.get("reflectance").unwrap();
         assert_eq!(r.value, Value::Float(0.25));
         assert_eq!(r.location.to_string(), "--set bsdf.red.reflectance=0.25");
-        let Value::Table(sampler) = &doc.get("sampler").unwrap().value else { panic!() };
-        assert_eq!(sampler.get("type").unwrap().value, Value::String("sobol".into()));
+        let Value::Table(sampler) = &doc.get("sampler").unwrap().value else {
+            panic!()
+        };
+        assert_eq!(
+            sampler.get("type").unwrap().value,
+            Value::String("sobol".into())
+        );
     }
 
     #[test]

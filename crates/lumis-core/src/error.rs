@@ -6,7 +6,11 @@ use std::sync::Arc;
 /// Where a value came from: a line of a scene file, or a command-line override.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
-    File { path: Arc<str>, line: u32, column: u32 },
+    File {
+        path: Arc<str>,
+        line: u32,
+        column: u32,
+    },
     Override(Arc<str>),
     /// Built into lumis (a parameter default, a programmatic table).
     Builtin,

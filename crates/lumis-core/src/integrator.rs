@@ -11,5 +11,11 @@ use crate::stats::RenderStats;
 /// The render driver owns tiles, film and threads; an integrator only turns
 /// one camera ray into one radiance estimate, counting the rays it traces.
 pub trait Integrator: Send + Sync {
-    fn li(&self, ray: &Ray, scene: &dyn Scene, sampler: &mut dyn Sampler, stats: &mut RenderStats) -> Rgb;
+    fn li(
+        &self,
+        ray: &Ray,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb;
 }

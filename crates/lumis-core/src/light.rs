@@ -37,11 +37,19 @@ pub enum LightShape {
     None,
     /// A parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`;
     /// its front side faces `normalize(edge_u x edge_v)`.
-    Quad { corner: Vec3, edge_u: Vec3, edge_v: Vec3 },
+    Quad {
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+    },
     /// A triangle; the front side faces `normalize((p1 - p0) x (p2 - p0))`.
     Triangle { p: [Vec3; 3] },
     /// A sphere; the front side faces outward unless `inward`.
-    Sphere { center: Vec3, radius: f32, inward: bool },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        inward: bool,
+    },
 }
 
 /// A light source. Each shape brings its own sampling and density.

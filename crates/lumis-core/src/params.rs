@@ -84,7 +84,12 @@ impl ParamSpec {
         }
     }
 
-    pub const fn with_default(name: &'static str, ty: ParamType, default: &'static str, doc: &'static str) -> Self {
+    pub const fn with_default(
+        name: &'static str,
+        ty: ParamType,
+        default: &'static str,
+        doc: &'static str,
+    ) -> Self {
         Self {
             name,
             ty,
@@ -114,7 +119,10 @@ impl ParamSpec {
                 self.name, e.message
             ))
         })?;
-        let mut node = table.get("v").cloned().ok_or_else(|| Error::msg("default lost"))?;
+        let mut node = table
+            .get("v")
+            .cloned()
+            .ok_or_else(|| Error::msg("default lost"))?;
         set_builtin(&mut node);
         Ok(Some(node))
     }
@@ -214,7 +222,10 @@ impl FromParam for Rgb {
             Value::Array(_) => floats::<3>(node)
                 .map(Rgb::from)
                 .map_err(|_| "expected [r, g, b] or one number".to_string()),
-            v => Err(format!("expected [r, g, b] or one number, found {}", v.type_name())),
+            v => Err(format!(
+                "expected [r, g, b] or one number, found {}",
+                v.type_name()
+            )),
         }
     }
 }
@@ -250,7 +261,10 @@ impl FromParam for UVec2 {
 impl<T: FromParam> FromParam for Vec<T> {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
         let Value::Array(items) = &node.value else {
-            return Err(format!("expected an array, found {}", node.value.type_name()));
+            return Err(format!(
+                "expected an array, found {}",
+                node.value.type_name()
+            ));
         };
         items
             .iter()
@@ -306,7 +320,11 @@ impl<'a> Params<'a> {
     }
 
     /// A `Params` over a table built in code (tests, programmatic scenes).
-    pub fn from_table(owner: impl Into<String>, table: &'a Table, spec: &'a [ParamSpec]) -> Result<Self> {
+    pub fn from_table(
+        owner: impl Into<String>,
+        table: &'a Table,
+        spec: &'a [ParamSpec],
+    ) -> Result<Self> {
         Self::new(owner, table, Location::Builtin, spec, &["type", "name"])
     }
 
@@ -315,12 +333,15 @@ impl<'a> Params<'a> {
     }
 
     fn spec_index(&self, name: &str) -> usize {
-        self.spec.iter().position(|s| s.name == name).unwrap_or_else(|| {
-            panic!(
-                "plugin bug: {} reads parameter '{name}' it did not declare",
-                self.owner
-            )
-        })
+        self.spec
+            .iter()
+            .position(|s| s.name == name)
+            .unwrap_or_else(|| {
+                panic!(
+                    "plugin bug: {} reads parameter '{name}' it did not declare",
+                    self.owner
+                )
+            })
     }
 
     /// The node for `name` (given, or its default), marking it read.
@@ -346,7 +367,8 @@ impl<'a> Params<'a> {
     }
 
     fn convert<T: FromParam>(&self, name: &str, node: &Node) -> Result<T> {
-        T::from_node(node).map_err(|e| Error::at(&node.location, format!("{} key '{name}': {e}", self.owner)))
+        T::from_node(node)
+            .map_err(|e| Error::at(&node.location, format!("{} key '{name}': {e}", self.owner)))
     }
 
     /// The value of `name`, or its declared default.
@@ -355,7 +377,10 @@ impl<'a> Params<'a> {
             Some((node, _)) => self.convert(name, &node),
             None => Err(Error::at(
                 &self.location,
-                format!("plugin bug: {} reads optional '{name}' with get(); use get_opt()", self.owner),
+                format!(
+                    "plugin bug: {} reads optional '{name}' with get(); use get_opt()",
+                    self.owner
+                ),
             )),
         }
     }
@@ -387,7 +412,11 @@ impl<'a> Params<'a> {
             }) => Ok(Some((t, location.clone()))),
             Some(node) => Err(Error::at(
                 &node.location,
-                format!("{} key '{name}': expected a table, found {}", self.owner, node.value.type_name()),
+                format!(
+                    "{} key '{name}': expected a table, found {}",
+                    self.owner,
+                    node.value.type_name()
+                ),
             )),
         }
     }
@@ -414,7 +443,10 @@ impl<'a> Params<'a> {
     pub fn get_choice(&self, name: &str, choices: &[&str]) -> Result<String> {
         let v: String = self.get(name)?;
         if !choices.contains(&v.as_str()) {
-            return Err(self.error(name, format!("must be one of {}, got \"{v}\"", quoted(choices))));
+            return Err(self.error(
+                name,
+                format!("must be one of {}, got \"{v}\"", quoted(choices)),
+            ));
         }
         Ok(v)
     }
@@ -446,7 +478,11 @@ impl<'a> Params<'a> {
 }
 
 fn quoted(choices: &[&str]) -> String {
-    choices.iter().map(|c| format!("\"{c}\"")).collect::<Vec<_>>().join(", ")
+    choices
+        .iter()
+        .map(|c| format!("\"{c}\""))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn accepted(spec: &[ParamSpec], structural: &[&str]) -> String {
@@ -497,11 +533,19 @@ mod tests {
     #[test]
     fn unknown_key_names_key_owner_and_accepted_keys() {
         let t = params("reflectance = 0.5\nreflectence = 0.5\n");
-        let err = Params::new("bsdf \"w\"", &t, Location::Builtin, SPEC, &["type"]).err().unwrap();
+        let err = Params::new("bsdf \"w\"", &t, Location::Builtin, SPEC, &["type"])
+            .err()
+            .unwrap();
         let text = err.to_string();
         assert!(text.starts_with("t.toml:2:1"), "{text}");
-        assert!(text.contains("'reflectence'") && text.contains("bsdf \"w\""), "{text}");
-        assert!(text.contains("reflectance, max_depth, heuristic, beta"), "{text}");
+        assert!(
+            text.contains("'reflectence'") && text.contains("bsdf \"w\""),
+            "{text}"
+        );
+        assert!(
+            text.contains("reflectance, max_depth, heuristic, beta"),
+            "{text}"
+        );
     }
 
     #[test]
@@ -509,7 +553,10 @@ mod tests {
         let t = params("reflectance = \"red\"\n");
         let p = Params::new("bsdf", &t, Location::Builtin, SPEC, &[]).unwrap();
         let err = p.get::<Rgb>("reflectance").unwrap_err().to_string();
-        assert!(err.starts_with("t.toml:1:15") && err.contains("expected [r, g, b]"), "{err}");
+        assert!(
+            err.starts_with("t.toml:1:15") && err.contains("expected [r, g, b]"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -533,8 +580,15 @@ mod tests {
     fn range_and_choice_checks() {
         let t = params("reflectance = -1\nheuristic = \"max\"\n");
         let p = Params::new("x", &t, Location::Builtin, SPEC, &[]).unwrap();
-        assert!(p.get_positive("reflectance").unwrap_err().to_string().contains("positive"));
-        let err = p.get_choice("heuristic", &["balance", "power"]).unwrap_err().to_string();
+        assert!(p
+            .get_positive("reflectance")
+            .unwrap_err()
+            .to_string()
+            .contains("positive"));
+        let err = p
+            .get_choice("heuristic", &["balance", "power"])
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("\"balance\", \"power\""), "{err}");
     }
 }

@@ -44,15 +44,32 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     if w.dot(n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
+    let po = p + offset;
+    Vec3::new(
+        step_toward(po.x, offset.x),
+        step_toward(po.y, offset.y),
+        step_toward(po.z, offset.z),
+    )
+}
+
+/// `next_float_up(v)` if `direction > 0`, `next_float_down(v)` if `< 0`,
+/// else `v`; the common finite, non-zero case is one integer add on the
+/// bits (moving away from zero increments them, toward zero decrements).
+#[inline(always)]
+fn step_toward(v: f32, direction: f32) -> f32 {
+    if direction == 0.0 {
+        return v;
     }
-    po
+    if v == 0.0 || !v.is_finite() {
+        return if direction > 0.0 {
+            next_float_up(v)
+        } else {
+            next_float_down(v)
+        };
+    }
+    let away_from_zero = (v > 0.0) == (direction > 0.0);
+    let bits = v.to_bits();
+    f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
 }
 
 /// A point on a surface with its rounding-error bound and geometric normal,
@@ -110,11 +127,47 @@ mod tests {
     }
 
     #[test]
+    fn step_matches_next_float() {
+        for v in [
+            1.0f32,
+            -1.0,
+            0.0,
+            -0.0,
+            3.5e-38,
+            -7.25e12,
+            f32::MAX,
+            f32::INFINITY,
+        ] {
+            assert_eq!(
+                step_toward(v, 1.0).to_bits(),
+                next_float_up(v).to_bits(),
+                "{v}"
+            );
+            assert_eq!(
+                step_toward(v, -2.0).to_bits(),
+                next_float_down(v).to_bits(),
+                "{v}"
+            );
+            assert_eq!(step_toward(v, 0.0).to_bits(), v.to_bits());
+        }
+    }
+
+    #[test]
     fn offset_scales_with_the_error_bound() {
         // A point far from the origin has a larger error and moves further:
         // no fixed epsilon, so tiny and huge scenes both work.
-        let small = offset_ray_origin(Vec3::new(1e-4, 0.0, 0.0), Vec3::splat(1e-11), Vec3::X, Vec3::X);
-        let large = offset_ray_origin(Vec3::new(1e5, 0.0, 0.0), Vec3::splat(1e-2), Vec3::X, Vec3::X);
+        let small = offset_ray_origin(
+            Vec3::new(1e-4, 0.0, 0.0),
+            Vec3::splat(1e-11),
+            Vec3::X,
+            Vec3::X,
+        );
+        let large = offset_ray_origin(
+            Vec3::new(1e5, 0.0, 0.0),
+            Vec3::splat(1e-2),
+            Vec3::X,
+            Vec3::X,
+        );
         assert!(small.x > 1e-4 && small.x - 1e-4 < 1e-9);
         assert!(large.x > 1e5 && large.x - 1e5 < 0.1);
     }

@@ -167,7 +167,11 @@ impl Registry {
         self.add(spec, Factory::Light(factory))
     }
 
-    pub fn add_light_sampler(&mut self, spec: PluginSpec, factory: LightSamplerFactory) -> Result<()> {
+    pub fn add_light_sampler(
+        &mut self,
+        spec: PluginSpec,
+        factory: LightSamplerFactory,
+    ) -> Result<()> {
         Self::check_kind(&spec, PluginKind::LightSampler)?;
         self.add(spec, Factory::LightSampler(factory))
     }
@@ -207,12 +211,22 @@ impl Registry {
                     "unknown {kind} type \"{}\" for {}; available: {}",
                     table.type_name,
                     table.owner,
-                    if names.is_empty() { "none".into() } else { names.join(", ") }
+                    if names.is_empty() {
+                        "none".into()
+                    } else {
+                        names.join(", ")
+                    }
                 ),
             ));
         };
         let owner = format!("{} (type = \"{}\")", table.owner, table.type_name);
-        let params = Params::new(owner, table.table, table.location.clone(), plugin.spec.params, table.structural)?;
+        let params = Params::new(
+            owner,
+            table.table,
+            table.location.clone(),
+            plugin.spec.params,
+            table.structural,
+        )?;
         Ok((plugin.factory, params))
     }
 
@@ -243,8 +257,13 @@ impl Registry {
         Ok(made)
     }
 
-    pub fn create_light_sampler(&self, table: &TableRef, lights: &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>> {
-        let (Factory::LightSampler(f), params) = self.lookup(PluginKind::LightSampler, table)? else {
+    pub fn create_light_sampler(
+        &self,
+        table: &TableRef,
+        lights: &[Box<dyn Light>],
+    ) -> Result<Box<dyn LightSampler>> {
+        let (Factory::LightSampler(f), params) = self.lookup(PluginKind::LightSampler, table)?
+        else {
             unreachable!("kind checked at registration")
         };
         let made = f(&params, lights)?;

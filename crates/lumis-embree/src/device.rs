@@ -49,7 +49,11 @@ impl std::fmt::Debug for Device {
     }
 }
 
-unsafe extern "C" fn error_callback(user: *mut c_void, code: sys::RTCError, message: *const c_char) {
+unsafe extern "C" fn error_callback(
+    user: *mut c_void,
+    code: sys::RTCError,
+    message: *const c_char,
+) {
     // SAFETY: `user` is the address of the boxed ErrorSlot owned by the
     // DeviceInner that registered this callback; Embree only calls it while
     // the device is alive. `message` is a NUL-terminated string or null.
@@ -57,7 +61,9 @@ unsafe extern "C" fn error_callback(user: *mut c_void, code: sys::RTCError, mess
     let message = if message.is_null() {
         String::new()
     } else {
-        unsafe { CStr::from_ptr(message) }.to_string_lossy().into_owned()
+        unsafe { CStr::from_ptr(message) }
+            .to_string_lossy()
+            .into_owned()
     };
     let error = EmbreeError {
         code: format!("{code:?}"),

@@ -10,6 +10,7 @@
 
 #![allow(unsafe_code)]
 
+pub mod bare;
 mod buffer;
 mod device;
 mod scene;

@@ -174,11 +174,13 @@ impl SceneBuilder {
     }
 
     /// Adds spheres (`RTC_GEOMETRY_TYPE_SPHERE_POINT`), one primitive per point.
-    pub fn add_spheres(&mut self, points: Arc<PaddedBuffer<SpherePoint>>) -> Result<u32, EmbreeError> {
+    pub fn add_spheres(
+        &mut self,
+        points: Arc<PaddedBuffer<SpherePoint>>,
+    ) -> Result<u32, EmbreeError> {
         // SAFETY: as in add_triangle_mesh.
-        let geometry = unsafe {
-            sys::rtcNewGeometry(self.device.raw(), sys::RTCGeometryType::SPHERE_POINT)
-        };
+        let geometry =
+            unsafe { sys::rtcNewGeometry(self.device.raw(), sys::RTCGeometryType::SPHERE_POINT) };
         self.device.take_error()?;
         // SAFETY: the buffer is padded, holds `len()` FLOAT4 items and lives
         // in `storage` as long as the scene.
@@ -195,7 +197,8 @@ impl SceneBuilder {
             );
         }
         let id = self.attach(geometry)?;
-        self.storage.push(SharedStorage::Spheres { _points: points });
+        self.storage
+            .push(SharedStorage::Spheres { _points: points });
         Ok(id)
     }
 
@@ -223,7 +226,8 @@ impl SceneBuilder {
         let this = std::mem::ManuallyDrop::new(self);
         // SAFETY: moving fields out of a ManuallyDrop builder whose Drop
         // (which would release the scene) never runs.
-        let (device, storage) = unsafe { (std::ptr::read(&this.device), std::ptr::read(&this.storage)) };
+        let (device, storage) =
+            unsafe { (std::ptr::read(&this.device), std::ptr::read(&this.storage)) };
         Ok(Scene {
             device,
             raw: this.raw,
@@ -264,7 +268,7 @@ fn raw_ray(ray: &Ray) -> sys::RTCRay {
     }
 }
 
-fn empty_hit() -> sys::RTCHit {
+pub(crate) fn empty_hit() -> sys::RTCHit {
     sys::RTCHit {
         Ng_x: 0.0,
         Ng_y: 0.0,
@@ -278,6 +282,10 @@ fn empty_hit() -> sys::RTCHit {
 }
 
 impl Scene {
+    pub(crate) fn raw(&self) -> sys::RTCScene {
+        self.raw
+    }
+
     pub fn device(&self) -> &Device {
         &self.device
     }
@@ -330,7 +338,10 @@ impl Scene {
         };
         // SAFETY: committed scene; `b` is a valid, aligned RTCBounds.
         unsafe { sys::rtcGetSceneBounds(self.raw, &mut b) };
-        ([b.lower_x, b.lower_y, b.lower_z], [b.upper_x, b.upper_y, b.upper_z])
+        (
+            [b.lower_x, b.lower_y, b.lower_z],
+            [b.upper_x, b.upper_y, b.upper_z],
+        )
     }
 }
 
@@ -340,7 +351,12 @@ mod tests {
 
     fn unit_quad(device: &Device) -> Scene {
         let mut builder = SceneBuilder::new(device, SceneOptions::default()).unwrap();
-        let vertices = vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]];
+        let vertices = vec![
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ];
         let indices = vec![[0, 1, 2], [0, 2, 3]];
         builder
             .add_triangle_mesh(Arc::new(vertices.into()), Arc::new(indices.into()))
@@ -349,7 +365,12 @@ mod tests {
     }
 
     fn ray(org: [f32; 3], dir: [f32; 3], tfar: f32) -> Ray {
-        Ray { org, dir, tnear: 0.0, tfar }
+        Ray {
+            org,
+            dir,
+            tnear: 0.0,
+            tfar,
+        }
     }
 
     #[test]
@@ -357,14 +378,21 @@ mod tests {
         let device = Device::new().unwrap();
         assert!(device.version() >= 40000, "Embree 4 expected");
         let scene = unit_quad(&device);
-        let hit = scene.intersect1(&ray([0.5, -0.5, 2.0], [0.0, 0.0, -1.0], f32::INFINITY)).unwrap();
+        let hit = scene
+            .intersect1(&ray([0.5, -0.5, 2.0], [0.0, 0.0, -1.0], f32::INFINITY))
+            .unwrap();
         assert!((hit.t - 2.0).abs() < 1e-6);
         assert_eq!(hit.geom_id, 0);
         assert_eq!(hit.prim_id, 0);
         // p = (1-u-v) v0 + u v1 + v v2 = (0.5, -0.5): u = 0.5, v = 0.25.
-        assert!((hit.u - 0.5).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6, "{hit:?}");
+        assert!(
+            (hit.u - 0.5).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6,
+            "{hit:?}"
+        );
         assert!(hit.ng[2] > 0.0);
-        assert!(scene.intersect1(&ray([2.0, 0.0, 2.0], [0.0, 0.0, -1.0], f32::INFINITY)).is_none());
+        assert!(scene
+            .intersect1(&ray([2.0, 0.0, 2.0], [0.0, 0.0, -1.0], f32::INFINITY))
+            .is_none());
     }
 
     #[test]
@@ -383,9 +411,13 @@ mod tests {
             .add_spheres(Arc::new(vec![[0.0, 0.0, 0.0, 1.0]].into()))
             .unwrap();
         let scene = builder.commit().unwrap();
-        let outside = scene.intersect1(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0], f32::INFINITY)).unwrap();
+        let outside = scene
+            .intersect1(&ray([0.0, 0.0, 5.0], [0.0, 0.0, -1.0], f32::INFINITY))
+            .unwrap();
         assert!((outside.t - 4.0).abs() < 1e-5);
-        let inside = scene.intersect1(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY)).unwrap();
+        let inside = scene
+            .intersect1(&ray([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], f32::INFINITY))
+            .unwrap();
         assert!((inside.t - 1.0).abs() < 1e-5);
     }
 
@@ -394,7 +426,10 @@ mod tests {
         let device = Device::new().unwrap();
         let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
         let err = builder
-            .add_triangle_mesh(Arc::new(vec![[0.0; 3]; 3].into()), Arc::new(vec![[0, 1, 3]].into()))
+            .add_triangle_mesh(
+                Arc::new(vec![[0.0; 3]; 3].into()),
+                Arc::new(vec![[0, 1, 3]].into()),
+            )
             .unwrap_err();
         assert!(err.message.contains("out of range"), "{err}");
     }

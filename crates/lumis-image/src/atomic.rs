@@ -74,7 +74,11 @@ mod tests {
         });
         assert!(err.unwrap_err().to_string().contains("render interrupted"));
         assert!(!target.exists());
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "temporary file removed");
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            0,
+            "temporary file removed"
+        );
     }
 
     #[test]
@@ -92,7 +96,9 @@ mod tests {
     #[test]
     fn missing_directory_is_an_error_naming_the_path() {
         let target = std::env::temp_dir().join("lumis-no-such-dir-xyz/out.exr");
-        let err = write_atomically(&target, |_| Ok(())).unwrap_err().to_string();
+        let err = write_atomically(&target, |_| Ok(()))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("lumis-no-such-dir-xyz"), "{err}");
     }
 }

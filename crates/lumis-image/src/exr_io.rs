@@ -15,7 +15,10 @@ pub fn write_exr(path: &Path, image: &Image) -> Result<(), ImageError> {
     });
     let exr_image = exr::image::Image::from_channels((image.width, image.height), channels);
     write_atomically(path, |w| {
-        exr_image.write().to_buffered(&mut *w).map_err(|e| e.to_string())?;
+        exr_image
+            .write()
+            .to_buffered(&mut *w)
+            .map_err(|e| e.to_string())?;
         flush(w)
     })
 }
@@ -27,7 +30,9 @@ pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
         .largest_resolution_level()
         .rgba_channels(
             |resolution, _| Image::new(resolution.width(), resolution.height()),
-            |image: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| image.set(pos.x(), pos.y(), [r, g, b]),
+            |image: &mut Image, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                image.set(pos.x(), pos.y(), [r, g, b])
+            },
         )
         .first_valid_layer()
         .all_attributes()

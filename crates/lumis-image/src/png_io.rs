@@ -57,7 +57,8 @@ mod tests {
         image.set(1, 2, [1.0, 0.5, 0.0]);
         let path = std::env::temp_dir().join(format!("lumis-png-{}.png", std::process::id()));
         write_png(&path, &image).unwrap();
-        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
         let reader = decoder.read_info().unwrap();
         assert_eq!((reader.info().width, reader.info().height), (4, 3));
         std::fs::remove_file(&path).unwrap();

@@ -17,12 +17,22 @@ pub struct PerspectiveCamera {
 }
 
 impl PerspectiveCamera {
-    pub fn new(origin: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, resolution: UVec2) -> Result<Self> {
+    pub fn new(
+        origin: Vec3,
+        target: Vec3,
+        up: Vec3,
+        fov_degrees: f32,
+        resolution: UVec2,
+    ) -> Result<Self> {
         if !(fov_degrees > 0.0 && fov_degrees < 180.0) {
-            return Err(Error::msg(format!("fov must be in (0, 180) degrees, got {fov_degrees}")));
+            return Err(Error::msg(format!(
+                "fov must be in (0, 180) degrees, got {fov_degrees}"
+            )));
         }
         if resolution.x == 0 || resolution.y == 0 {
-            return Err(Error::msg(format!("resolution must be positive, got {resolution}")));
+            return Err(Error::msg(format!(
+                "resolution must be positive, got {resolution}"
+            )));
         }
         let forward = (target - origin).normalize_or_zero();
         if forward == Vec3::ZERO {
@@ -30,7 +40,9 @@ impl PerspectiveCamera {
         }
         let right = forward.cross(up).normalize_or_zero();
         if right == Vec3::ZERO || !right.is_finite() {
-            return Err(Error::msg("camera up vector is zero or parallel to the view direction"));
+            return Err(Error::msg(
+                "camera up vector is zero or parallel to the view direction",
+            ));
         }
         let up = right.cross(forward);
         let tan_half = (fov_degrees.to_radians() * 0.5).tan();
@@ -70,8 +82,14 @@ mod tests {
     use super::*;
 
     fn camera() -> PerspectiveCamera {
-        PerspectiveCamera::new(Vec3::new(0.0, 0.0, 3.9), Vec3::new(0.0, 0.0, 2.9), Vec3::Y, 90.0, UVec2::new(4, 2))
-            .unwrap()
+        PerspectiveCamera::new(
+            Vec3::new(0.0, 0.0, 3.9),
+            Vec3::new(0.0, 0.0, 2.9),
+            Vec3::Y,
+            90.0,
+            UVec2::new(4, 2),
+        )
+        .unwrap()
     }
 
     #[test]
@@ -91,6 +109,9 @@ mod tests {
         assert!(bad(0.0, Vec3::Y).is_err());
         assert!(bad(180.0, Vec3::Y).is_err());
         assert!(bad(45.0, Vec3::Z).is_err());
-        assert!(PerspectiveCamera::new(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0, UVec2::new(2, 2)).is_err());
+        assert!(
+            PerspectiveCamera::new(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0, UVec2::new(2, 2))
+                .is_err()
+        );
     }
 }

@@ -41,7 +41,10 @@ fn tiles(resolution: UVec2) -> Vec<Tile> {
         for x in (0..resolution.x).step_by(TILE_SIZE as usize) {
             out.push(Tile {
                 min: UVec2::new(x, y),
-                max: UVec2::new((x + TILE_SIZE).min(resolution.x), (y + TILE_SIZE).min(resolution.y)),
+                max: UVec2::new(
+                    (x + TILE_SIZE).min(resolution.x),
+                    (y + TILE_SIZE).min(resolution.y),
+                ),
             });
         }
     }
@@ -59,7 +62,8 @@ fn render_tile(
     settings: &RenderSettings,
 ) -> (Vec<[f32; 3]>, RenderStats) {
     let mut stats = RenderStats::default();
-    let mut pixels = Vec::with_capacity(((tile.max.x - tile.min.x) * (tile.max.y - tile.min.y)) as usize);
+    let mut pixels =
+        Vec::with_capacity(((tile.max.x - tile.min.x) * (tile.max.y - tile.min.y)) as usize);
     for y in tile.min.y..tile.max.y {
         for x in tile.min.x..tile.max.x {
             let pixel = UVec2::new(x, y);
@@ -102,13 +106,21 @@ pub fn render(
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads)
         .build()
-        .map_err(|e| Error::msg(format!("cannot start {} render threads: {e}", settings.threads)))?;
+        .map_err(|e| {
+            Error::msg(format!(
+                "cannot start {} render threads: {e}",
+                settings.threads
+            ))
+        })?;
 
     let progress = if settings.progress {
-        let bar = ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
+        let bar =
+            ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
         bar.set_style(
-            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta}")
-                .expect("static template is valid"),
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta}",
+            )
+            .expect("static template is valid"),
         );
         bar
     } else {
@@ -122,7 +134,14 @@ pub fn render(
             .map_init(
                 || sampler.clone_sampler(),
                 |tile_sampler, tile| {
-                    let out = render_tile(tile, camera, scene, integrator, tile_sampler.as_mut(), settings);
+                    let out = render_tile(
+                        tile,
+                        camera,
+                        scene,
+                        integrator,
+                        tile_sampler.as_mut(),
+                        settings,
+                    );
                     progress.inc(1);
                     out
                 },
@@ -138,10 +157,18 @@ pub fn render(
         stats += tile_stats;
         let width = (tile.max.x - tile.min.x) as usize;
         for (i, p) in pixels.into_iter().enumerate() {
-            image.set(tile.min.x as usize + i % width, tile.min.y as usize + i / width, p);
+            image.set(
+                tile.min.x as usize + i % width,
+                tile.min.y as usize + i / width,
+                p,
+            );
         }
     }
-    Ok(RenderOutput { image, stats, seconds })
+    Ok(RenderOutput {
+        image,
+        stats,
+        seconds,
+    })
 }
 
 #[cfg(test)]

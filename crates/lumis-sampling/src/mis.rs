@@ -28,7 +28,11 @@ pub fn power_heuristic(nf: u32, pf: f32, ng: u32, pg: f32, beta: f32) -> f32 {
         return 1.0;
     }
     let ratio = g / f;
-    let r = if beta == 2.0 { ratio * ratio } else { ratio.powf(beta) };
+    let r = if beta == 2.0 {
+        ratio * ratio
+    } else {
+        ratio.powf(beta)
+    };
     1.0 / (1.0 + r)
 }
 

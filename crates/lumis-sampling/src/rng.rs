@@ -81,7 +81,14 @@ mod tests {
         // pcg32-demo from pcg-c-basic: pcg32_srandom_r(&rng, 42u, 54u),
         // first six outputs.
         let mut rng = Pcg32::new(42, 54);
-        let expected = [0xa15c02b7u32, 0x7b47f409, 0xba1d3330, 0x83d2f293, 0xbfa4784b, 0xcbed606e];
+        let expected = [
+            0xa15c02b7u32,
+            0x7b47f409,
+            0xba1d3330,
+            0x83d2f293,
+            0xbfa4784b,
+            0xcbed606e,
+        ];
         for e in expected {
             assert_eq!(rng.next_u32(), e);
         }

@@ -85,7 +85,12 @@ mod tests {
     use crate::Pcg32;
 
     fn grid(n: usize) -> impl Iterator<Item = Vec2> {
-        (0..n * n).map(move |i| Vec2::new(((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32))
+        (0..n * n).map(move |i| {
+            Vec2::new(
+                ((i % n) as f32 + 0.5) / n as f32,
+                ((i / n) as f32 + 0.5) / n as f32,
+            )
+        })
     }
 
     #[test]
@@ -107,7 +112,10 @@ mod tests {
     #[test]
     fn hemisphere_warps_are_unit_and_upper() {
         for u in grid(64) {
-            for w in [square_to_cosine_hemisphere(u), square_to_uniform_hemisphere(u)] {
+            for w in [
+                square_to_cosine_hemisphere(u),
+                square_to_uniform_hemisphere(u),
+            ] {
                 assert!((w.length() - 1.0).abs() < 1e-5 && w.z >= 0.0);
             }
             assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);

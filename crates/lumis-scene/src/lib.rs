@@ -14,8 +14,8 @@ use std::sync::Arc;
 use lumis_core::doc::{self, Node, Table, Value};
 use lumis_core::registry::TableRef;
 use lumis_core::{
-    Bsdf, Error, Integrator, Light, LightKind, LightShape, Location, ParamSpec, ParamType, Params, Registry,
-    Result, Sampler, UVec2, Vec3,
+    Bsdf, Error, Integrator, Light, LightKind, LightShape, Location, ParamSpec, ParamType, Params,
+    Registry, Result, Sampler, UVec2, Vec3,
 };
 use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
 use lumis_render::PerspectiveCamera;
@@ -51,16 +51,33 @@ const TOP_LEVEL_KEYS: &[&str] = &[
 ];
 
 const FILM_PARAMS: &[ParamSpec] = &[
-    ParamSpec::with_default("resolution", ParamType::UIntPair, "[256, 256]", "image width and height in pixels"),
-    ParamSpec::optional("output", ParamType::String, "output EXR path, relative to the scene file"),
-    ParamSpec::optional("filter", ParamType::Table, "pixel filter: { type = \"box\" } (the default)"),
+    ParamSpec::with_default(
+        "resolution",
+        ParamType::UIntPair,
+        "[256, 256]",
+        "image width and height in pixels",
+    ),
+    ParamSpec::optional(
+        "output",
+        ParamType::String,
+        "output EXR path, relative to the scene file",
+    ),
+    ParamSpec::optional(
+        "filter",
+        ParamType::Table,
+        "pixel filter: { type = \"box\" } (the default)",
+    ),
 ];
 
 const CAMERA_PARAMS: &[ParamSpec] = &[
     ParamSpec::required("origin", ParamType::Vec3, "eye position"),
     ParamSpec::required("target", ParamType::Vec3, "point looked at"),
     ParamSpec::with_default("up", ParamType::Vec3, "[0.0, 1.0, 0.0]", "up direction"),
-    ParamSpec::required("fov", ParamType::Float, "full angle of the smaller image axis, degrees, in (0, 180)"),
+    ParamSpec::required(
+        "fov",
+        ParamType::Float,
+        "full angle of the smaller image axis, degrees, in (0, 180)",
+    ),
 ];
 
 /// Reads and loads a scene file.
@@ -72,7 +89,14 @@ pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Resu
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
-    load_str(&text, &path.display().to_string(), &name, dir, overrides, registry)
+    load_str(
+        &text,
+        &path.display().to_string(),
+        &name,
+        dir,
+        overrides,
+        registry,
+    )
 }
 
 /// Loads a scene from TOML text; `label` names it in error locations and
@@ -110,13 +134,19 @@ pub fn load_str(
         None => 0,
         Some(node) => match node.value {
             Value::Int(s) if s >= 0 => s as u64,
-            _ => return Err(Error::at(&node.location, "seed: expected a non-negative integer")),
+            _ => {
+                return Err(Error::at(
+                    &node.location,
+                    "seed: expected a non-negative integer",
+                ))
+            }
         },
     };
 
     let (camera, output) = film_and_camera(&root, &file_location, dir)?;
     let bsdfs = named_bsdfs(&root, registry)?;
-    let mut builder = SceneBuilder::new(&device()?, SceneOptions::default()).map_err(embree_error)?;
+    let mut builder =
+        SceneBuilder::new(&device()?, SceneOptions::default()).map_err(embree_error)?;
     let mut geometries = Vec::new();
     let mut lights: Vec<Box<dyn Light>> = Vec::new();
     let mut counts = SceneCounts::default();
@@ -133,7 +163,15 @@ pub fn load_str(
         let params = Params::new(owner.clone(), table, location.clone(), spec, &["type"])?;
         let desc = shapes::parse_shape(kind, &params, table, dir)?;
         params.finish()?;
-        let geometry = add_shape(&owner, desc, &bsdfs, registry, &mut builder, &mut lights, &mut counts)?;
+        let geometry = add_shape(
+            &owner,
+            desc,
+            &bsdfs,
+            registry,
+            &mut builder,
+            &mut lights,
+            &mut counts,
+        )?;
         geometries.push(geometry);
     }
 
@@ -248,14 +286,24 @@ fn embree_error(e: lumis_embree::EmbreeError) -> Error {
 fn as_table<'a>(node: &'a Node, what: &str) -> Result<&'a Table> {
     match &node.value {
         Value::Table(t) => Ok(t),
-        v => Err(Error::at(&node.location, format!("{what}: expected a table, found {}", v.type_name()))),
+        v => Err(Error::at(
+            &node.location,
+            format!("{what}: expected a table, found {}", v.type_name()),
+        )),
     }
 }
 
-fn required_table<'a>(root: &'a Table, key: &str, file: &Location) -> Result<(&'a Table, Location)> {
+fn required_table<'a>(
+    root: &'a Table,
+    key: &str,
+    file: &Location,
+) -> Result<(&'a Table, Location)> {
     match root.get(key) {
         Some(node) => Ok((as_table(node, key)?, node.location.clone())),
-        None => Err(Error::at(file, format!("the scene needs a [{key}] table with a type"))),
+        None => Err(Error::at(
+            file,
+            format!("the scene needs a [{key}] table with a type"),
+        )),
     }
 }
 
@@ -285,13 +333,23 @@ fn type_of<'a>(table: &'a Table, location: &Location, owner: &str) -> Result<(&'
         }) => Ok((s.as_str(), location.clone())),
         Some(node) => Err(Error::at(
             &node.location,
-            format!("{owner}: 'type' must be a string, found {}", node.value.type_name()),
+            format!(
+                "{owner}: 'type' must be a string, found {}",
+                node.value.type_name()
+            ),
         )),
-        None => Err(Error::at(location, format!("{owner} needs a type = \"...\""))),
+        None => Err(Error::at(
+            location,
+            format!("{owner} needs a type = \"...\""),
+        )),
     }
 }
 
-fn film_and_camera(root: &Table, file: &Location, dir: &Path) -> Result<(PerspectiveCamera, Option<PathBuf>)> {
+fn film_and_camera(
+    root: &Table,
+    file: &Location,
+    dir: &Path,
+) -> Result<(PerspectiveCamera, Option<PathBuf>)> {
     let empty = Table::default();
     let (film, film_location) = match root.get("film") {
         Some(node) => (as_table(node, "film")?, node.location.clone()),
@@ -306,9 +364,17 @@ fn film_and_camera(root: &Table, file: &Location, dir: &Path) -> Result<(Perspec
     if let Some((filter, location)) = film.table("filter")? {
         match type_of(filter, &location, "[film] filter")? {
             ("box", _) if filter.entries.len() == 1 => {}
-            ("box", _) => return Err(Error::at(&location, "the box filter takes no parameters (radius 1/2 pixel)")),
+            ("box", _) => {
+                return Err(Error::at(
+                    &location,
+                    "the box filter takes no parameters (radius 1/2 pixel)",
+                ))
+            }
             (other, loc) => {
-                return Err(Error::at(&loc, format!("unknown pixel filter \"{other}\"; available: box")));
+                return Err(Error::at(
+                    &loc,
+                    format!("unknown pixel filter \"{other}\"; available: box"),
+                ));
             }
         }
     }
@@ -322,7 +388,13 @@ fn film_and_camera(root: &Table, file: &Location, dir: &Path) -> Result<(Perspec
             format!("unknown camera type \"{kind}\"; available: perspective"),
         ));
     }
-    let cam = Params::new("[camera] (type = \"perspective\")", table, location.clone(), CAMERA_PARAMS, &["type"])?;
+    let cam = Params::new(
+        "[camera] (type = \"perspective\")",
+        table,
+        location.clone(),
+        CAMERA_PARAMS,
+        &["type"],
+    )?;
     let fov: f32 = cam.get("fov")?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err(cam.error("fov", format!("must be in (0, 180) degrees, got {fov}")));
@@ -352,13 +424,19 @@ fn named_bsdfs(root: &Table, registry: &Registry) -> Result<Vec<(String, Arc<dyn
             None => {
                 return Err(Error::at(
                     &location,
-                    format!("[[bsdf]] #{} needs a name = \"...\" that shapes refer to", i + 1),
+                    format!(
+                        "[[bsdf]] #{} needs a name = \"...\" that shapes refer to",
+                        i + 1
+                    ),
                 ))
             }
         };
         if out.iter().any(|(n, _)| *n == name) {
             let at = &table.get("name").expect("checked above").location;
-            return Err(Error::at(at, format!("a [[bsdf]] named \"{name}\" already exists")));
+            return Err(Error::at(
+                at,
+                format!("a [[bsdf]] named \"{name}\" already exists"),
+            ));
         }
         let owner = format!("bsdf \"{name}\"");
         let (kind, kind_location) = type_of(table, &location, &owner)?;
@@ -385,17 +463,24 @@ fn add_shape(
     lights: &mut Vec<Box<dyn Light>>,
     counts: &mut SceneCounts,
 ) -> Result<Geometry> {
-    let bsdf = bsdfs.iter().position(|(n, _)| *n == desc.bsdf).ok_or_else(|| {
-        let names: Vec<&str> = bsdfs.iter().map(|(n, _)| n.as_str()).collect();
-        Error::at(
-            &desc.bsdf_location,
-            format!(
-                "{owner}: no [[bsdf]] named \"{}\"; defined: {}",
-                desc.bsdf,
-                if names.is_empty() { "none".into() } else { names.join(", ") }
-            ),
-        )
-    })? as u32;
+    let bsdf = bsdfs
+        .iter()
+        .position(|(n, _)| *n == desc.bsdf)
+        .ok_or_else(|| {
+            let names: Vec<&str> = bsdfs.iter().map(|(n, _)| n.as_str()).collect();
+            Error::at(
+                &desc.bsdf_location,
+                format!(
+                    "{owner}: no [[bsdf]] named \"{}\"; defined: {}",
+                    desc.bsdf,
+                    if names.is_empty() {
+                        "none".into()
+                    } else {
+                        names.join(", ")
+                    }
+                ),
+            )
+        })? as u32;
     let orientation = if desc.flip_normals { -1.0 } else { 1.0 };
     let emission_owner = format!("{owner} emission");
     let emission = desc.emission.as_ref();
@@ -434,8 +519,19 @@ fn add_shape(
         } => {
             let light_indices = match quad {
                 Some((corner, edge_u, edge_v)) => {
-                    let (edge_u, edge_v) = if desc.flip_normals { (edge_v, edge_u) } else { (edge_u, edge_v) };
-                    match make_light("quad", LightShape::Quad { corner, edge_u, edge_v })? {
+                    let (edge_u, edge_v) = if desc.flip_normals {
+                        (edge_v, edge_u)
+                    } else {
+                        (edge_u, edge_v)
+                    };
+                    match make_light(
+                        "quad",
+                        LightShape::Quad {
+                            corner,
+                            edge_u,
+                            edge_v,
+                        },
+                    )? {
                         Some(i) => vec![i; indices.len()],
                         None => Vec::new(),
                     }
@@ -444,7 +540,11 @@ fn add_shape(
                     let mut per_triangle = Vec::with_capacity(indices.len());
                     for t in &indices {
                         let [a, b, c] = t.map(|i| Vec3::from(positions[i as usize]));
-                        let p = if desc.flip_normals { [a, c, b] } else { [a, b, c] };
+                        let p = if desc.flip_normals {
+                            [a, c, b]
+                        } else {
+                            [a, b, c]
+                        };
                         // Zero-area triangles cannot emit; they keep no light.
                         let degenerate = (b - a).cross(c - a).length_squared() == 0.0;
                         per_triangle.push(if degenerate {
@@ -485,7 +585,9 @@ fn add_shape(
             )?;
             counts.spheres += 1;
             builder
-                .add_spheres(Arc::new(PaddedBuffer::new(vec![[center.x, center.y, center.z, radius]])))
+                .add_spheres(Arc::new(PaddedBuffer::new(vec![[
+                    center.x, center.y, center.z, radius,
+                ]])))
                 .map_err(|e| Error::msg(format!("{owner}: {e}")))?;
             Ok(Geometry::Sphere {
                 center,

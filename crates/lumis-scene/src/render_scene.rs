@@ -141,7 +141,9 @@ impl Scene for RenderScene {
                     }
                     None => n,
                 };
-                let light = lights.get(hit.prim_id as usize).and_then(|&i| self.light_ref(i));
+                let light = lights
+                    .get(hit.prim_id as usize)
+                    .and_then(|&i| self.light_ref(i));
                 Some(SurfaceInteraction {
                     point: SurfacePoint { p, p_error, n },
                     t: hit.t,

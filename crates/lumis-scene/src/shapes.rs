@@ -49,12 +49,28 @@ macro_rules! shape_params {
 pub(crate) const QUAD_PARAMS: &[ParamSpec] = shape_params![
     ParamSpec::required("corner", ParamType::Vec3, "one corner of the parallelogram"),
     ParamSpec::required("edge_u", ParamType::Vec3, "first edge from the corner"),
-    ParamSpec::required("edge_v", ParamType::Vec3, "second edge; the front faces edge_u x edge_v"),
+    ParamSpec::required(
+        "edge_v",
+        ParamType::Vec3,
+        "second edge; the front faces edge_u x edge_v"
+    ),
 ];
 pub(crate) const MESH_PARAMS: &[ParamSpec] = shape_params![
-    ParamSpec::required("positions", ParamType::Vec3Array, "vertex positions [[x, y, z], ...]"),
-    ParamSpec::required("indices", ParamType::IntArray, "three vertex indices per triangle; CCW = front"),
-    ParamSpec::optional("normals", ParamType::Vec3Array, "per-vertex shading normals"),
+    ParamSpec::required(
+        "positions",
+        ParamType::Vec3Array,
+        "vertex positions [[x, y, z], ...]"
+    ),
+    ParamSpec::required(
+        "indices",
+        ParamType::IntArray,
+        "three vertex indices per triangle; CCW = front"
+    ),
+    ParamSpec::optional(
+        "normals",
+        ParamType::Vec3Array,
+        "per-vertex shading normals"
+    ),
 ];
 pub(crate) const OBJ_PARAMS: &[ParamSpec] = shape_params![ParamSpec::required(
     "file",
@@ -74,7 +90,12 @@ pub(crate) const SHAPE_TYPES: &[(&str, &[ParamSpec])] = &[
 ];
 
 /// Parses one shape table whose `type` is `kind`.
-pub(crate) fn parse_shape<'a>(kind: &str, params: &Params<'a>, table: &'a Table, scene_dir: &Path) -> Result<ShapeDesc<'a>> {
+pub(crate) fn parse_shape<'a>(
+    kind: &str,
+    params: &Params<'a>,
+    table: &'a Table,
+    scene_dir: &Path,
+) -> Result<ShapeDesc<'a>> {
     let geometry = match kind {
         "quad" => quad(params)?,
         "mesh" => mesh(params)?,
@@ -87,7 +108,10 @@ pub(crate) fn parse_shape<'a>(kind: &str, params: &Params<'a>, table: &'a Table,
         other => unreachable!("shape type {other} checked by the caller"),
     };
     let bsdf: String = params.get("bsdf")?;
-    let bsdf_location = table.get("bsdf").map(|n| n.location.clone()).unwrap_or(Location::Builtin);
+    let bsdf_location = table
+        .get("bsdf")
+        .map(|n| n.location.clone())
+        .unwrap_or(Location::Builtin);
     Ok(ShapeDesc {
         geometry,
         bsdf,
@@ -103,7 +127,10 @@ fn quad(params: &Params) -> Result<ShapeGeometry> {
     let edge_v: Vec3 = params.get("edge_v")?;
     let area = edge_u.cross(edge_v).length();
     if !(area > 0.0 && area.is_finite()) {
-        return Err(params.error("edge_v", "is parallel to edge_u (or zero): the quad has no area"));
+        return Err(params.error(
+            "edge_v",
+            "is parallel to edge_u (or zero): the quad has no area",
+        ));
     }
     let c = corner;
     let positions = vec![c, c + edge_u, c + edge_u + edge_v, c + edge_v]
@@ -121,14 +148,21 @@ fn quad(params: &Params) -> Result<ShapeGeometry> {
 fn mesh(params: &Params) -> Result<ShapeGeometry> {
     let positions: Vec<Vec3> = params.get("positions")?;
     let flat: Vec<i64> = params.get("indices")?;
-    if flat.len() % 3 != 0 || flat.is_empty() {
+    if !flat.len().is_multiple_of(3) || flat.is_empty() {
         return Err(params.error(
             "indices",
-            format!("needs three indices per triangle, got {} values", flat.len()),
+            format!(
+                "needs three indices per triangle, got {} values",
+                flat.len()
+            ),
         ));
     }
     let n = positions.len();
-    if let Some((i, bad)) = flat.iter().enumerate().find(|(_, &v)| v < 0 || v as usize >= n) {
+    if let Some((i, bad)) = flat
+        .iter()
+        .enumerate()
+        .find(|(_, &v)| v < 0 || v as usize >= n)
+    {
         return Err(params.error(
             "indices",
             format!("index {bad} (element {i}) is out of range for {n} positions"),
@@ -137,12 +171,18 @@ fn mesh(params: &Params) -> Result<ShapeGeometry> {
     let normals: Option<Vec<Vec3>> = params.get_opt("normals")?;
     if let Some(ns) = &normals {
         if ns.len() != n {
-            return Err(params.error("normals", format!("has {} entries for {n} positions", ns.len())));
+            return Err(params.error(
+                "normals",
+                format!("has {} entries for {n} positions", ns.len()),
+            ));
         }
     }
     Ok(ShapeGeometry::Mesh {
         positions: positions.into_iter().map(Into::into).collect(),
-        indices: flat.chunks_exact(3).map(|t| [t[0] as u32, t[1] as u32, t[2] as u32]).collect(),
+        indices: flat
+            .chunks_exact(3)
+            .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
+            .collect(),
         normals,
         quad: None,
     })
@@ -169,7 +209,11 @@ fn obj(params: &Params, scene_dir: &Path) -> Result<ShapeGeometry> {
         let count = mesh.positions.len() / 3;
         positions.extend(mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
         if mesh.normals.len() == mesh.positions.len() {
-            normals.extend(mesh.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
+            normals.extend(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
         } else {
             all_have_normals = false;
         }
@@ -177,19 +221,27 @@ fn obj(params: &Params, scene_dir: &Path) -> Result<ShapeGeometry> {
             if let Some(&bad) = t.iter().find(|&&i| i as usize >= count) {
                 return Err(params.error(
                     "file",
-                    format!("'{}': face index {bad} out of range for {count} vertices", path.display()),
+                    format!(
+                        "'{}': face index {bad} out of range for {count} vertices",
+                        path.display()
+                    ),
                 ));
             }
             indices.push([base + t[0], base + t[1], base + t[2]]);
         }
     }
     if indices.is_empty() {
-        return Err(params.error("file", format!("'{}' contains no triangles", path.display())));
+        return Err(params.error(
+            "file",
+            format!("'{}' contains no triangles", path.display()),
+        ));
     }
     Ok(ShapeGeometry::Mesh {
         positions,
         indices,
-        normals: all_have_normals.then_some(normals).filter(|n| !n.is_empty()),
+        normals: all_have_normals
+            .then_some(normals)
+            .filter(|n| !n.is_empty()),
         quad: None,
     })
 }
@@ -199,6 +251,9 @@ pub(crate) fn unknown_shape_type(kind: &str, location: &Location) -> Error {
     let names: Vec<&str> = SHAPE_TYPES.iter().map(|(n, _)| *n).collect();
     Error::at(
         location,
-        format!("unknown shape type \"{kind}\"; available: {}", names.join(", ")),
+        format!(
+            "unknown shape type \"{kind}\"; available: {}",
+            names.join(", ")
+        ),
     )
 }

@@ -3,8 +3,8 @@
 use std::f32::consts::FRAC_1_PI;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Rgb,
-    Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -56,10 +56,15 @@ impl Diffuse {
         if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
             return Err(params.error(
                 "reflectance",
-                format!("each channel must be in [0, 1] (energy conservation), got {reflectance:?}"),
+                format!(
+                    "each channel must be in [0, 1] (energy conservation), got {reflectance:?}"
+                ),
             ));
         }
-        let sampling = match params.get_choice("sampling", &["cosine", "uniform"])?.as_str() {
+        let sampling = match params
+            .get_choice("sampling", &["cosine", "uniform"])?
+            .as_str()
+        {
             "uniform" => DiffuseSampling::Uniform,
             _ => DiffuseSampling::Cosine,
         };
@@ -163,9 +168,16 @@ mod tests {
         let cosine = estimate_albedo(&Diffuse::new(r, false, DiffuseSampling::Cosine), wo, 10_000);
         // Cosine sampling of a Lambertian has zero variance: f cos / pdf = R.
         assert!((cosine - r).max_component().abs() < 1e-5, "{cosine:?}");
-        let uniform = estimate_albedo(&Diffuse::new(r, false, DiffuseSampling::Uniform), wo, 400_000);
+        let uniform = estimate_albedo(
+            &Diffuse::new(r, false, DiffuseSampling::Uniform),
+            wo,
+            400_000,
+        );
         // Uniform: estimator 2 R cos, std of mean = R sqrt(1/3)/sqrt(n) ~ 1e-3 R.
-        assert!(((uniform - r) / r).map(f32::abs).max_component() < 5e-3, "{uniform:?}");
+        assert!(
+            ((uniform - r) / r).map(f32::abs).max_component() < 5e-3,
+            "{uniform:?}"
+        );
     }
 
     #[test]
@@ -185,7 +197,10 @@ mod tests {
     fn reciprocity() {
         let ctx = BsdfContext::default();
         let b = Diffuse::new(Rgb::splat(0.7), true, DiffuseSampling::Cosine);
-        let (a, c) = (Vec3::new(0.1, 0.2, 0.97).normalize(), Vec3::new(-0.6, 0.0, 0.8));
+        let (a, c) = (
+            Vec3::new(0.1, 0.2, 0.97).normalize(),
+            Vec3::new(-0.6, 0.0, 0.8),
+        );
         assert_eq!(b.f(&ctx, a, c), b.f(&ctx, c, a));
     }
 }

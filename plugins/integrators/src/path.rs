@@ -4,8 +4,8 @@
 
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    Integrator, LightKind, LightSampleContext, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Ray,
-    RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
+    Integrator, LightKind, LightSampleContext, ParamSpec, ParamType, Params, PluginKind,
+    PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -88,10 +88,16 @@ impl PathIntegrator {
     pub fn from_params(params: &Params) -> Result<Self> {
         let max_depth: u32 = params.get("max_depth")?;
         if max_depth == 0 {
-            return Err(params.error("max_depth", "must be at least 1 (1 = emitters seen directly)"));
+            return Err(params.error(
+                "max_depth",
+                "must be at least 1 (1 = emitters seen directly)",
+            ));
         }
         let rr_depth: u32 = params.get("rr_depth")?;
-        let strategy = match params.get_choice("strategy", &["bsdf", "light", "mis"])?.as_str() {
+        let strategy = match params
+            .get_choice("strategy", &["bsdf", "light", "mis"])?
+            .as_str()
+        {
             "bsdf" => Strategy::Bsdf,
             "light" => Strategy::Light,
             _ => Strategy::Mis,
@@ -99,7 +105,10 @@ impl PathIntegrator {
         // Heuristic and beta are validated whatever the strategy, so that
         // `--set integrator.strategy=bsdf` works on a scene that sets them;
         // they only change the estimate when strategy = "mis".
-        let heuristic = match params.get_choice("heuristic", &["balance", "power"])?.as_str() {
+        let heuristic = match params
+            .get_choice("heuristic", &["balance", "power"])?
+            .as_str()
+        {
             "balance" => Heuristic::Balance,
             _ => Heuristic::Power {
                 beta: params.get_positive("beta")?,
@@ -132,7 +141,10 @@ impl PathIntegrator {
             return Rgb::BLACK;
         };
         let wi = hit.shading.to_local(ls.wi);
-        let bsdf_ctx = BsdfContext { uv: hit.uv, ..Default::default() };
+        let bsdf_ctx = BsdfContext {
+            uv: hit.uv,
+            ..Default::default()
+        };
         let f = hit.bsdf.f(&bsdf_ctx, wo, wi) * wi.z.abs();
         if f.is_black() {
             return Rgb::BLACK;
@@ -143,10 +155,12 @@ impl PathIntegrator {
         }
         stats.light_samples += 1;
         let p_light = chosen.pmf * ls.pdf;
-        let weight = if light.kind() == LightKind::DeltaPosition || self.strategy == Strategy::Light {
+        let weight = if light.kind() == LightKind::DeltaPosition || self.strategy == Strategy::Light
+        {
             1.0
         } else {
-            self.heuristic.weight(p_light, hit.bsdf.pdf(&bsdf_ctx, wo, wi))
+            self.heuristic
+                .weight(p_light, hit.bsdf.pdf(&bsdf_ctx, wo, wi))
         };
         f * ls.l * (weight / p_light)
     }
@@ -176,7 +190,13 @@ impl PathIntegrator {
 }
 
 impl Integrator for PathIntegrator {
-    fn li(&self, camera_ray: &Ray, scene: &dyn Scene, sampler: &mut dyn Sampler, stats: &mut RenderStats) -> Rgb {
+    fn li(
+        &self,
+        camera_ray: &Ray,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
         let mut radiance = Rgb::BLACK;
         let mut beta = Rgb::WHITE;
         let mut ray = *camera_ray;
@@ -202,7 +222,14 @@ impl Integrator for PathIntegrator {
             if let Some(emitter) = hit.light {
                 let le = emitter.light.l(hit.p(), hit.n(), hit.uv, hit.wo);
                 if !le.is_black() {
-                    let w = self.emission_weight(scene, emitter.index, &prev, ray.d, bsdf_pdf, specular);
+                    let w = self.emission_weight(
+                        scene,
+                        emitter.index,
+                        &prev,
+                        ray.d,
+                        bsdf_pdf,
+                        specular,
+                    );
                     if w > 0.0 {
                         radiance += beta * le * w;
                         stats.bsdf_light_hits += u64::from(segments > 1);
@@ -217,7 +244,10 @@ impl Integrator for PathIntegrator {
                 radiance += beta * self.sample_direct(&hit, wo, scene, sampler, stats);
             }
 
-            let bsdf_ctx = BsdfContext { uv: hit.uv, ..Default::default() };
+            let bsdf_ctx = BsdfContext {
+                uv: hit.uv,
+                ..Default::default()
+            };
             let u1 = sampler.get_1d();
             let u2 = sampler.get_2d();
             let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) else {
@@ -271,9 +301,16 @@ mod tests {
         assert_eq!(p.heuristic, Heuristic::Balance);
         assert_eq!(p.max_depth, 3);
         assert_eq!(build("").unwrap().heuristic, Heuristic::Power { beta: 2.0 });
-        let err = build("heuristic = \"balance\"\nbeta = 3.0\n").unwrap_err().to_string();
+        let err = build("heuristic = \"balance\"\nbeta = 3.0\n")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("'beta': only applies"), "{err}");
-        assert_eq!(build("strategy = \"bsdf\"\nheuristic = \"power\"\n").unwrap().strategy, Strategy::Bsdf);
+        assert_eq!(
+            build("strategy = \"bsdf\"\nheuristic = \"power\"\n")
+                .unwrap()
+                .strategy,
+            Strategy::Bsdf
+        );
         assert!(build("max_depth = 0\n").is_err());
         assert!(build("strategy = \"nee\"\n").is_err());
     }

@@ -16,7 +16,9 @@ pub struct UniformLightSampler {
 
 impl UniformLightSampler {
     pub fn new(count: usize) -> Self {
-        Self { count: count as u32 }
+        Self {
+            count: count as u32,
+        }
     }
 }
 

@@ -8,7 +8,12 @@ use lumis_core::{LightSample, ParamSpec, ParamType, Params, Result, Rgb, Vec3};
 /// The keys of a shape's `emission = { ... }` table.
 pub const EMISSION_PARAMS: &[ParamSpec] = &[
     ParamSpec::required("radiance", ParamType::Rgb, "emitted radiance in linear RGB"),
-    ParamSpec::with_default("two_sided", ParamType::Bool, "false", "emit from the back side too"),
+    ParamSpec::with_default(
+        "two_sided",
+        ParamType::Bool,
+        "false",
+        "emit from the back side too",
+    ),
 ];
 
 /// Constant radiance leaving a surface.
@@ -22,7 +27,10 @@ impl Emission {
     pub fn from_params(params: &Params) -> Result<Self> {
         let radiance: Rgb = params.get("radiance")?;
         if !(radiance.min_component() >= 0.0 && radiance.is_finite()) {
-            return Err(params.error("radiance", format!("must be finite and non-negative, got {radiance:?}")));
+            return Err(params.error(
+                "radiance",
+                format!("must be finite and non-negative, got {radiance:?}"),
+            ));
         }
         Ok(Self {
             radiance,
@@ -72,7 +80,12 @@ pub fn area_sample(
     if !pdf.is_finite() || pdf <= 0.0 {
         return None;
     }
-    Some(LightSample { l, wi, pdf, p: point })
+    Some(LightSample {
+        l,
+        wi,
+        pdf,
+        p: point,
+    })
 }
 
 /// The solid-angle density of uniform area sampling for a ray from `ctx`

@@ -4,8 +4,8 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result,
-    Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind,
+    PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -13,7 +13,11 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "constant",
     doc: "constant environment radiance from all directions, sampled uniformly over the sphere",
-    params: &[ParamSpec::required("radiance", ParamType::Rgb, "radiance arriving from every direction")],
+    params: &[ParamSpec::required(
+        "radiance",
+        ParamType::Rgb,
+        "radiance arriving from every direction",
+    )],
 };
 
 #[derive(Debug, Clone)]
@@ -55,7 +59,8 @@ impl Light for ConstantLight {
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         let wi = warp::square_to_uniform_sphere(u);
         // A point beyond the scene's bounding sphere, for the shadow ray.
-        let far = ctx.p() + wi * (2.0 * (self.scene_radius + (ctx.p() - self.scene_center).length()));
+        let far =
+            ctx.p() + wi * (2.0 * (self.scene_radius + (ctx.p() - self.scene_center).length()));
         Some(LightSample {
             l: self.radiance,
             wi,

@@ -3,8 +3,8 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result,
-    Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind,
+    PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -13,7 +13,11 @@ pub const SPEC: PluginSpec = PluginSpec {
     doc: "isotropic point light: never hit by rays, sampled with probability 1 (MIS weight 1)",
     params: &[
         ParamSpec::required("position", ParamType::Vec3, "world-space position"),
-        ParamSpec::required("intensity", ParamType::Rgb, "radiant intensity I (W/sr); irradiance is I cos / d^2"),
+        ParamSpec::required(
+            "intensity",
+            ParamType::Rgb,
+            "radiant intensity I (W/sr); irradiance is I cos / d^2",
+        ),
     ],
 };
 
@@ -25,7 +29,10 @@ pub struct PointLight {
 
 impl PointLight {
     pub fn new(position: Vec3, intensity: Rgb) -> Self {
-        Self { position, intensity }
+        Self {
+            position,
+            intensity,
+        }
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
@@ -82,7 +89,9 @@ mod tests {
     #[test]
     fn inverse_square_falloff() {
         let l = PointLight::new(Vec3::new(0.0, 2.0, 0.0), Rgb::splat(8.0));
-        let s = l.sample_li(&LightSampleContext::at(Vec3::ZERO), Vec2::ZERO).unwrap();
+        let s = l
+            .sample_li(&LightSampleContext::at(Vec3::ZERO), Vec2::ZERO)
+            .unwrap();
         assert_eq!(s.l, Rgb::splat(2.0));
         assert_eq!(s.wi, Vec3::Y);
         assert_eq!(l.kind(), LightKind::DeltaPosition);

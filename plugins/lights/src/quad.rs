@@ -4,7 +4,8 @@ use lumis_core::interaction::LightSampleContext;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb,
+    Vec2, Vec3,
 };
 
 use crate::area::{area_pdf, area_sample, Emission, EMISSION_PARAMS};
@@ -31,7 +32,9 @@ impl QuadLight {
         let cross = edge_u.cross(edge_v);
         let area = cross.length();
         if !(area > 0.0 && area.is_finite()) {
-            return Err(Error::msg("quad light: the edges are parallel or degenerate (zero area)"));
+            return Err(Error::msg(
+                "quad light: the edges are parallel or degenerate (zero area)",
+            ));
         }
         Ok(Self {
             corner,
@@ -62,7 +65,7 @@ impl QuadLight {
             return None;
         }
         let t = self.normal.dot(self.corner - o) / denom;
-        if !(t > 0.0) {
+        if t.is_nan() || t <= 0.0 {
             return None;
         }
         let d = o + wi * t - self.corner;
@@ -97,7 +100,13 @@ impl Light for QuadLight {
 
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
         match self.intersect(ctx.p(), wi) {
-            Some(t) => area_pdf(t * wi.length(), wi.normalize(), self.normal, self.area, &self.emission),
+            Some(t) => area_pdf(
+                t * wi.length(),
+                wi.normalize(),
+                self.normal,
+                self.area,
+                &self.emission,
+            ),
             None => 0.0,
         }
     }
@@ -131,7 +140,9 @@ mod tests {
         let ctx = LightSampleContext::at(Vec3::new(0.2, 0.0, 0.1));
         let mut rng = Pcg32::new(1, 2);
         for _ in 0..1000 {
-            let s = l.sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32())).unwrap();
+            let s = l
+                .sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
             let pdf = l.pdf_li(&ctx, s.wi);
             assert!((s.pdf - pdf).abs() < 1e-3 * pdf, "{} vs {pdf}", s.pdf);
         }
@@ -148,7 +159,9 @@ mod tests {
         let n = 200_000;
         let mut est = 0.0f64;
         for _ in 0..n {
-            let s = l.sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32())).unwrap();
+            let s = l
+                .sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
             est += (s.l.r * s.wi.y / s.pdf) as f64;
         }
         est /= n as f64;
@@ -156,7 +169,11 @@ mod tests {
         let mut exact = 0.0f64;
         for i in 0..m {
             for j in 0..m {
-                let q = Vec3::new(-0.5 + (j as f32 + 0.5) / m as f32, 1.0, -0.5 + (i as f32 + 0.5) / m as f32);
+                let q = Vec3::new(
+                    -0.5 + (j as f32 + 0.5) / m as f32,
+                    1.0,
+                    -0.5 + (i as f32 + 0.5) / m as f32,
+                );
                 let d = q - p;
                 let r2 = d.length_squared() as f64;
                 let cos_p = (d.y as f64) / r2.sqrt();

@@ -4,7 +4,8 @@ use lumis_core::interaction::LightSampleContext;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb,
+    Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -30,7 +31,9 @@ impl TriangleLight {
         let cross = (p[1] - p[0]).cross(p[2] - p[0]);
         let len = cross.length();
         if !(len > 0.0 && len.is_finite()) {
-            return Err(Error::msg("triangle light: degenerate triangle (zero area)"));
+            return Err(Error::msg(
+                "triangle light: degenerate triangle (zero area)",
+            ));
         }
         Ok(Self {
             p,
@@ -123,12 +126,18 @@ mod tests {
             radiance: Rgb::WHITE,
             two_sided: true,
         };
-        let tri = [Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0)];
+        let tri = [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ];
         let l = TriangleLight::new(tri, emission).unwrap();
         let ctx = LightSampleContext::at(Vec3::new(0.3, -0.5, 0.2));
         let mut rng = Pcg32::new(9, 9);
         for _ in 0..1000 {
-            let s = l.sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32())).unwrap();
+            let s = l
+                .sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
             assert!((s.p.p.y - 1.0).abs() < 1e-6 && s.p.p.x + s.p.p.z <= 1.0 + 1e-5);
             let pdf = l.pdf_li(&ctx, s.wi);
             assert!((s.pdf - pdf).abs() < 1e-3 * pdf, "{} vs {pdf}", s.pdf);

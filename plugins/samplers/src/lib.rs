@@ -8,5 +8,7 @@ use lumis_core::{Registry, Result};
 
 /// Registers every sampler of this crate.
 pub fn register(registry: &mut Registry) -> Result<()> {
-    registry.add_sampler(independent::SPEC, |p| Ok(Box::new(IndependentSampler::from_params(p)?)))
+    registry.add_sampler(independent::SPEC, |p| {
+        Ok(Box::new(IndependentSampler::from_params(p)?))
+    })
 }

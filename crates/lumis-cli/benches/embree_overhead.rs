@@ -1,0 +1,142 @@
+//! lumis vs a bare Embree ray loop on the same rays.
+//!
+//! 1. Renders the Cornell box once through a recording scene that logs every
+//!    closest-hit and shadow query the path tracer makes.
+//! 2. Times the full path tracer (one thread) on the same scene, seed and spp.
+//! 3. Times a bare `embree4-sys` loop over the recorded rays (one thread).
+//!
+//! The ratio lumis/bare of rays per second says how much throughput
+//! everything that is not traversal (sampling, shading, light sampling, MIS,
+//! film) costs: 0.5 means as much time outside Embree as inside it.
+//!
+//! `cargo bench -p lumis-cli --bench embree_overhead [-- SCENE.toml SPP]`
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+use lumis_core::{Light, LightSampler, Ray, Scene, SurfaceInteraction};
+use lumis_embree::bare::{self, BareRay};
+use lumis_render::{render, RenderSettings};
+
+/// Delegates to the real scene and records every query.
+struct Recording<'a> {
+    inner: &'a dyn Scene,
+    rays: Mutex<Vec<BareRay>>,
+}
+
+impl Recording<'_> {
+    fn record(&self, ray: &Ray, shadow: bool) {
+        self.rays.lock().unwrap().push(BareRay {
+            org: ray.o.into(),
+            dir: ray.d.into(),
+            tfar: ray.t_max,
+            shadow,
+        });
+    }
+}
+
+impl Scene for Recording<'_> {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
+        self.record(ray, false);
+        self.inner.intersect(ray)
+    }
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.record(ray, true);
+        self.inner.occluded(ray)
+    }
+    fn lights(&self) -> &[Box<dyn Light>] {
+        self.inner.lights()
+    }
+    fn infinite_lights(&self) -> &[u32] {
+        self.inner.infinite_lights()
+    }
+    fn light_sampler(&self) -> &dyn LightSampler {
+        self.inner.light_sampler()
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    let scene_path = args.first().cloned().unwrap_or_else(|| {
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell-box.toml").to_string()
+    });
+    let spp: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(8);
+    let registry = lumis_cli::builtin_registry().expect("plugins register");
+    let loaded = lumis_scene::load_file(
+        scene_path.as_ref(),
+        &[format!("sampler.spp={spp}")],
+        &registry,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let settings = RenderSettings {
+        spp,
+        seed: loaded.seed,
+        threads: 1,
+        progress: false,
+    };
+    let run = |scene: &dyn Scene| {
+        render(
+            &loaded.camera,
+            scene,
+            loaded.integrator.as_ref(),
+            loaded.sampler.as_ref(),
+            &settings,
+        )
+        .unwrap()
+    };
+
+    let recording = Recording {
+        inner: &loaded.scene,
+        rays: Mutex::new(Vec::new()),
+    };
+    run(&recording);
+    let rays = recording.rays.into_inner().unwrap();
+
+    let repeats = 3;
+    let mut lumis_best = f64::INFINITY;
+    let mut bare_best = f64::INFINITY;
+    let mut stats = None;
+    for _ in 0..repeats {
+        let out = run(&loaded.scene);
+        lumis_best = lumis_best.min(out.seconds);
+        stats = Some(out.stats);
+        let start = Instant::now();
+        let hits = bare::trace(loaded.scene.embree(), &rays);
+        bare_best = bare_best.min(start.elapsed().as_secs_f64());
+        std::hint::black_box(hits);
+    }
+    let stats = stats.unwrap();
+    assert_eq!(
+        stats.total_rays(),
+        rays.len() as u64,
+        "the timed render traced the recorded rays"
+    );
+    let n = rays.len() as f64;
+    let lumis_rate = n / lumis_best;
+    let bare_rate = n / bare_best;
+    println!("scene {scene_path}, {spp} spp, 1 thread, best of {repeats}");
+    println!(
+        "rays: {} ({} closest-hit, {} shadow)",
+        rays.len(),
+        stats.rays,
+        stats.shadow_rays
+    );
+    println!(
+        "lumis path tracer: {:.3} s, {:.2} Mrays/s, {:.3} Msamples/s",
+        lumis_best,
+        lumis_rate * 1e-6,
+        stats.samples as f64 / lumis_best * 1e-6
+    );
+    println!(
+        "bare Embree loop:  {:.3} s, {:.2} Mrays/s",
+        bare_best,
+        bare_rate * 1e-6
+    );
+    println!(
+        "ratio lumis/bare rays per second: {:.3}",
+        lumis_rate / bare_rate
+    );
+}

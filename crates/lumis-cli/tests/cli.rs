@@ -1,0 +1,123 @@
+//! The `lumis` binary as a user runs it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn lumis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lumis"))
+        .args(args)
+        .output()
+        .expect("lumis runs")
+}
+
+fn scene(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lumis-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn help_documents_every_flag() {
+    let top = String::from_utf8(lumis(&["--help"]).stdout).unwrap();
+    assert!(top.contains("render"), "{top}");
+    let help = String::from_utf8(lumis(&["render", "--help"]).stdout).unwrap();
+    for flag in [
+        "--spp",
+        "--seed",
+        "--threads",
+        "--output",
+        "--set",
+        "--quiet",
+        "--verbose",
+    ] {
+        assert!(help.contains(flag), "render --help lacks {flag}:\n{help}");
+    }
+}
+
+#[test]
+fn renders_exr_and_png_with_a_summary() {
+    let dir = scratch("render");
+    let out = dir.join("box.exr");
+    let result = lumis(&[
+        "render",
+        &scene("cornell-box.toml"),
+        "--spp",
+        "2",
+        "--threads",
+        "2",
+        "--set",
+        "film.resolution=[32, 32]",
+        "--output",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let stdout = String::from_utf8(result.stdout).unwrap();
+    assert!(
+        result.status.success(),
+        "{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    for part in ["32x32", "2 spp", "Msamples/s", "Mrays/s", "0 NaN/Inf"] {
+        assert!(stdout.contains(part), "summary lacks '{part}': {stdout}");
+    }
+    let image = lumis_image::read_exr(&out).unwrap();
+    assert_eq!((image.width, image.height), (32, 32));
+    assert!(image.mean()[0] > 0.0);
+    assert!(dir.join("box.png").exists());
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        2,
+        "no temporary files left"
+    );
+}
+
+#[test]
+fn failed_render_leaves_no_image() {
+    let dir = scratch("fail");
+    let out = dir.join("missing-dir/box.exr");
+    let result = lumis(&[
+        "render",
+        &scene("cornell-box.toml"),
+        "--spp",
+        "1",
+        "--set",
+        "film.resolution=[8, 8]",
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(!result.status.success());
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error:") && stderr.contains("missing-dir"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+}
+
+#[test]
+fn scene_errors_exit_nonzero_with_the_location() {
+    let result = lumis(&[
+        "render",
+        &scene("cornell-box.toml"),
+        "--set",
+        "integrator.max_dpeth=3",
+        "-q",
+    ]);
+    assert!(!result.status.success());
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(
+        stderr.contains("--set integrator.max_dpeth=3")
+            && stderr.contains("unknown key 'max_dpeth'"),
+        "{stderr}"
+    );
+}
