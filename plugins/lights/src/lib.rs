@@ -7,6 +7,7 @@ mod point;
 mod quad;
 mod triangle;
 
+pub use area::Emission;
 pub use constant::ConstantLight;
 pub use point::PointLight;
 pub use quad::QuadLight;

@@ -1,0 +1,30 @@
+//! The statistical test kit of lumis.
+//!
+//! [`chi_square`] checks that a routine drawing directions is distributed
+//! exactly as the pdf it claims, with Pearson's chi-square test over a grid
+//! of equal-solid-angle bins (the approach of Mitsuba's and pbrt's sampling
+//! tests). [`adapters`] turn a BSDF's `sample_f`/`pdf` or a light's
+//! `sample_li`/`pdf_li` into such a pair.
+
+pub mod adapters;
+pub mod chi_square;
+
+pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+
+/// The per-test significance level that keeps the chance of any false
+/// alarm among `tests` tests at `alpha` (Šidák correction).
+pub fn corrected_significance(alpha: f64, tests: usize) -> f64 {
+    1.0 - (1.0 - alpha).powf(1.0 / tests.max(1) as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sidak_correction() {
+        assert!((corrected_significance(0.01, 1) - 0.01).abs() < 1e-12);
+        let a = corrected_significance(0.01, 100);
+        assert!((1.0 - (1.0 - a).powi(100) - 0.01).abs() < 1e-9);
+    }
+}
