@@ -95,7 +95,7 @@ fn main() {
     run(&recording);
     let rays = recording.rays.into_inner().unwrap();
 
-    let repeats = 3;
+    let repeats = 5;
     let mut lumis_best = f64::INFINITY;
     let mut bare_best = f64::INFINITY;
     let mut stats = None;

@@ -8,6 +8,8 @@ use crate::ray::Ray;
 /// A render-ready scene as integrators see it.
 pub trait Scene: Sync {
     /// The closest surface hit along `ray` within `[0, ray.t_max]`.
+    /// `ray.d` must be unit length (camera and BSDF rays are), so the hit's
+    /// `wo` is `-ray.d` without renormalising.
     fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>>;
 
     /// Whether anything blocks `ray` within `[0, ray.t_max]` (shadow rays).

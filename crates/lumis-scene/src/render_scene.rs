@@ -104,8 +104,9 @@ fn to_embree(ray: &Ray) -> lumis_embree::Ray {
 impl Scene for RenderScene {
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
+        debug_assert!((ray.d.length() - 1.0).abs() < 1e-3, "intersect expects a unit direction");
         let hit = self.embree.intersect1(&to_embree(ray))?;
-        let wo = -ray.d.normalize();
+        let wo = -ray.d;
         match &self.geometries[hit.geom_id as usize] {
             Geometry::Mesh {
                 vertices,
@@ -116,6 +117,7 @@ impl Scene for RenderScene {
                 orientation,
             } => {
                 let tri = indices[hit.prim_id as usize];
+                let vertices: &[Vertex] = vertices;
                 let [p0, p1, p2] = tri.map(|i| Vec3::from(vertices[i as usize]));
                 let (b1, b2) = (hit.u, hit.v);
                 let b0 = 1.0 - b1 - b2;
