@@ -2,8 +2,10 @@
 //! command, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
+mod listing;
 mod render;
 
+pub use listing::plugin_listing;
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
 
 use lumis_core::{Registry, Result};
@@ -16,5 +18,14 @@ pub fn builtin_registry() -> Result<Registry> {
     lumis_lights::register(&mut registry)?;
     lumis_light_samplers::register(&mut registry)?;
     lumis_integrators::register(&mut registry)?;
+    Ok(registry)
+}
+
+/// The built-in plugins plus every library on `LUMIS_PLUGIN_PATH`.
+pub fn registry_with_search_path() -> Result<Registry> {
+    let mut registry = builtin_registry()?;
+    for library in lumis_loader::libraries_on_search_path()? {
+        lumis_loader::load_library(&library, &mut registry)?;
+    }
     Ok(registry)
 }

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use lumis_cli::{builtin_registry, render_scene_file, RenderArgs};
+use lumis_cli::{plugin_listing, registry_with_search_path, render_scene_file, RenderArgs};
 
 #[derive(Parser)]
 #[command(
@@ -48,6 +48,13 @@ enum Command {
         #[arg(long, short)]
         verbose: bool,
     },
+    /// List every plugin (built-in, and libraries on LUMIS_PLUGIN_PATH or
+    /// given with --load) with its parameters: name, type, default, meaning.
+    Plugins {
+        /// Also load this plugin library (repeatable).
+        #[arg(long, value_name = "LIB.so")]
+        load: Vec<PathBuf>,
+    },
 }
 
 fn main() -> ExitCode {
@@ -62,7 +69,7 @@ fn main() -> ExitCode {
             set,
             quiet,
             verbose,
-        } => builtin_registry().and_then(|registry| {
+        } => registry_with_search_path().and_then(|registry| {
             let args = RenderArgs {
                 scene,
                 spp,
@@ -74,6 +81,13 @@ fn main() -> ExitCode {
                 verbose,
             };
             render_scene_file(&args, &registry).map(|report| println!("{}", report.summary()))
+        }),
+        Command::Plugins { load } => registry_with_search_path().and_then(|mut registry| {
+            for library in &load {
+                lumis_loader::load_library(library, &mut registry)?;
+            }
+            print!("{}", plugin_listing(&registry));
+            Ok(())
         }),
     };
     match result {

@@ -15,6 +15,7 @@ pub mod light;
 pub mod light_sampler;
 pub mod math;
 pub mod params;
+pub mod plugin;
 pub mod ray;
 pub mod registry;
 pub mod sampler;

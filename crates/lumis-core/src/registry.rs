@@ -90,6 +90,7 @@ pub struct Registered {
 }
 
 /// The plugins available to a scene.
+#[derive(Clone)]
 pub struct Registry {
     plugins: Vec<Registered>,
     source: Arc<str>,
@@ -125,6 +126,11 @@ impl Registry {
     /// Labels the plugins registered from now on (e.g. a library's path).
     pub fn set_source(&mut self, source: &str) {
         self.source = Arc::from(source);
+    }
+
+    /// Where plugins registered now are said to come from.
+    pub fn source(&self) -> &str {
+        &self.source
     }
 
     fn add(&mut self, spec: PluginSpec, factory: Factory) -> Result<()> {

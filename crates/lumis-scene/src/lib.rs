@@ -48,7 +48,15 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "shape",
     "light",
     "seed",
+    "plugins",
 ];
+
+const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
+    "load",
+    ParamType::StringArray,
+    "[]",
+    "plugin libraries to load, relative to the scene file",
+)];
 
 const FILM_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
@@ -141,6 +149,26 @@ pub fn load_str(
                 ))
             }
         },
+    };
+
+    // Plugins the scene loads go into a copy of the registry: the caller's
+    // stays as it was, and nothing but what this scene names is registered.
+    let with_scene_plugins;
+    let registry = match root.get("plugins") {
+        None => registry,
+        Some(node) => {
+            let table = as_table(node, "plugins")?;
+            let params = Params::new("[plugins]", table, node.location.clone(), PLUGINS_PARAMS, &[])?;
+            let libraries: Vec<String> = params.get("load")?;
+            params.finish()?;
+            let mut extended = registry.clone();
+            for library in libraries {
+                lumis_loader::load_library(&dir.join(&library), &mut extended)
+                    .map_err(|e| Error::at(&node.location, format!("[plugins] load: {}", e.message)))?;
+            }
+            with_scene_plugins = extended;
+            &with_scene_plugins
+        }
     };
 
     let (camera, output) = film_and_camera(&root, &file_location, dir)?;

@@ -1,0 +1,107 @@
+//! The declaration a dynamically loaded plugin exports.
+//!
+//! Rust has no stable ABI, so a plugin library is only sound to use when it
+//! was built by the same rustc from the same lumis-core as the host. The
+//! declaration carries both, plus an ABI version that comes first so it can
+//! always be read; the host checks all three before calling anything else.
+
+use crate::error::Result;
+use crate::registry::Registry;
+
+/// Bumped whenever [`PluginDeclaration`] or the plugin traits change shape.
+pub const PLUGIN_ABI_VERSION: u32 = 1;
+/// The compiler that built this copy of lumis-core.
+pub const RUSTC_VERSION: &str = env!("LUMIS_RUSTC_VERSION");
+/// The version of this copy of lumis-core.
+pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// The symbol [`lumis_plugin!`](crate::lumis_plugin) exports.
+pub const ENTRY_POINT: &str = "lumis_plugin_declaration";
+
+const TEXT: usize = 128;
+
+/// What a plugin library declares about itself. `repr(C)` with the ABI
+/// version first, and plain byte arrays for the versions, so a host can read
+/// them from any library before trusting anything else in it.
+#[repr(C)]
+pub struct PluginDeclaration {
+    pub abi_version: u32,
+    rustc_version: [u8; TEXT],
+    core_version: [u8; TEXT],
+    /// Called by the host with its registry once the versions match.
+    pub register: fn(&mut Registry) -> Result<()>,
+}
+
+const fn text(s: &str) -> [u8; TEXT] {
+    let bytes = s.as_bytes();
+    let mut out = [0u8; TEXT];
+    let mut i = 0;
+    while i < bytes.len() && i < TEXT - 1 {
+        out[i] = bytes[i];
+        i += 1;
+    }
+    out
+}
+
+fn read_text(bytes: &[u8; TEXT]) -> String {
+    let end = bytes.iter().position(|&b| b == 0).unwrap_or(TEXT);
+    String::from_utf8_lossy(&bytes[..end]).into_owned()
+}
+
+impl PluginDeclaration {
+    /// The declaration of a plugin built against this lumis-core.
+    pub const fn new(register: fn(&mut Registry) -> Result<()>) -> Self {
+        Self {
+            abi_version: PLUGIN_ABI_VERSION,
+            rustc_version: text(RUSTC_VERSION),
+            core_version: text(CORE_VERSION),
+            register,
+        }
+    }
+
+    pub fn rustc_version(&self) -> String {
+        read_text(&self.rustc_version)
+    }
+
+    pub fn core_version(&self) -> String {
+        read_text(&self.core_version)
+    }
+}
+
+/// Exports a plugin's entry point. In the plugin crate (built with
+/// `crate-type = ["cdylib", "rlib"]`):
+///
+/// ```ignore
+/// pub fn register(registry: &mut lumis_core::Registry) -> lumis_core::Result<()> {
+///     registry.add_bsdf(MY_SPEC, |p| Ok(std::sync::Arc::new(MyBsdf::from_params(p)?)))
+/// }
+/// lumis_core::lumis_plugin!(register);
+/// ```
+///
+/// The entry point only returns a pointer to a static, so no panic can
+/// cross it; the host calls `register` inside `catch_unwind`.
+#[macro_export]
+macro_rules! lumis_plugin {
+    ($register:path) => {
+        #[allow(unsafe_code)]
+        #[no_mangle]
+        pub extern "C" fn lumis_plugin_declaration() -> *const $crate::plugin::PluginDeclaration {
+            static DECLARATION: $crate::plugin::PluginDeclaration = $crate::plugin::PluginDeclaration::new($register);
+            &DECLARATION
+        }
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn declaration_carries_versions() {
+        let d = PluginDeclaration::new(|_| Ok(()));
+        assert_eq!(d.abi_version, PLUGIN_ABI_VERSION);
+        assert!(d.rustc_version().starts_with("rustc "), "{}", d.rustc_version());
+        assert_eq!(d.core_version(), CORE_VERSION);
+        let mut r = Registry::new();
+        (d.register)(&mut r).unwrap();
+    }
+}

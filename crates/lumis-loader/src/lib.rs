@@ -1,0 +1,161 @@
+//! Loading plugin libraries at run time.
+//!
+//! The rules that keep this sound (DESIGN.md, "Plugins"):
+//! - the library's declaration is checked first: ABI version, rustc version
+//!   and lumis-core version must equal the host's, or nothing else in the
+//!   library is touched;
+//! - the registry is passed in, never shared through globals;
+//! - calls into the library run inside `catch_unwind`;
+//! - a library is never unloaded (thread-local destructors and vtables of
+//!   objects it created must outlive every use), so it is leaked on purpose.
+
+#![allow(unsafe_code)]
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+use libloading::{Library, Symbol};
+use lumis_core::plugin::{PluginDeclaration, CORE_VERSION, ENTRY_POINT, PLUGIN_ABI_VERSION, RUSTC_VERSION};
+use lumis_core::{Error, Registry, Result};
+
+/// The environment variable listing directories whose plugin libraries are
+/// loaded at start-up, separated by `:`.
+pub const PLUGIN_PATH_VAR: &str = "LUMIS_PLUGIN_PATH";
+
+type Entry = extern "C" fn() -> *const PluginDeclaration;
+
+fn describe_panic(payload: Box<dyn std::any::Any + Send>) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
+}
+
+/// Loads the plugin library at `path` and registers its plugins, labelled
+/// with the path so clashes name both sources.
+pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
+    let shown = path.display();
+    if !path.exists() {
+        return Err(Error::msg(format!("plugin library '{shown}' does not exist")));
+    }
+    // SAFETY: loading runs the library's initialisers. This is the point
+    // of a plugin system: the user asked for this library. Everything after
+    // is guarded by the declaration check.
+    let library = unsafe { Library::new(path) }.map_err(|e| {
+        Error::msg(format!("'{shown}' is not a loadable shared library: {e}"))
+    })?;
+    // SAFETY: the symbol, if present, was exported by `lumis_plugin!` with
+    // exactly this signature; a library that exports the name with another
+    // signature is not a lumis plugin and breaks the contract it claims.
+    let entry: Symbol<Entry> = unsafe { library.get(ENTRY_POINT.as_bytes()) }.map_err(|_| {
+        Error::msg(format!(
+            "'{shown}' has no {ENTRY_POINT} entry point: it is not a lumis plugin \
+             (a plugin crate calls lumis_core::lumis_plugin!(register))"
+        ))
+    })?;
+    let declaration = catch_unwind(|| entry())
+        .map_err(|p| Error::msg(format!("'{shown}': entry point panicked: {}", describe_panic(p))))?;
+    if declaration.is_null() {
+        return Err(Error::msg(format!("'{shown}': entry point returned no declaration")));
+    }
+    // SAFETY: non-null, points at the plugin's static declaration, which
+    // lives as long as the library (forever: it is never unloaded). Only the
+    // leading u32 is read before the ABI version is known to match.
+    let abi = unsafe { std::ptr::addr_of!((*declaration).abi_version).read() };
+    if abi != PLUGIN_ABI_VERSION {
+        return Err(Error::msg(format!(
+            "'{shown}' uses plugin ABI version {abi}, this lumis uses {PLUGIN_ABI_VERSION}: \
+             rebuild the plugin against this lumis-core"
+        )));
+    }
+    // SAFETY: same ABI version, so the layout of the declaration is ours.
+    let declaration = unsafe { &*declaration };
+    let rustc = declaration.rustc_version();
+    if rustc != RUSTC_VERSION {
+        return Err(Error::msg(format!(
+            "'{shown}' was built by {rustc}, lumis by {RUSTC_VERSION}: rebuild the plugin with \
+             the same toolchain (e.g. `rustup run <version> cargo build --release`)"
+        )));
+    }
+    let core = declaration.core_version();
+    if core != CORE_VERSION {
+        return Err(Error::msg(format!(
+            "'{shown}' was built against lumis-core {core}, lumis has {CORE_VERSION}: point the \
+             plugin's lumis-core dependency at this lumis and rebuild"
+        )));
+    }
+    let previous = registry.source().to_string();
+    registry.set_source(&shown.to_string());
+    let registered = catch_unwind(AssertUnwindSafe(|| (declaration.register)(registry)));
+    registry.set_source(&previous);
+    match registered {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => return Err(e.context(format!("'{shown}' failed to register"))),
+        Err(p) => {
+            return Err(Error::msg(format!(
+                "'{shown}' panicked while registering: {}",
+                describe_panic(p)
+            )))
+        }
+    }
+    // Never unloaded: objects the plugin creates point into it.
+    std::mem::forget(library);
+    Ok(())
+}
+
+/// The plugin libraries (`*.so`, `*.dylib`, `*.dll`) in the directories of
+/// `LUMIS_PLUGIN_PATH`, sorted for a reproducible registration order.
+pub fn libraries_on_search_path() -> Result<Vec<PathBuf>> {
+    let Some(value) = std::env::var_os(PLUGIN_PATH_VAR) else {
+        return Ok(Vec::new());
+    };
+    let mut found = Vec::new();
+    for dir in std::env::split_paths(&value).filter(|d| !d.as_os_str().is_empty()) {
+        let entries = std::fs::read_dir(&dir).map_err(|e| {
+            Error::msg(format!("{PLUGIN_PATH_VAR} names '{}', which cannot be read: {e}", dir.display()))
+        })?;
+        let mut libs: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| {
+                p.extension()
+                    .is_some_and(|x| x == std::env::consts::DLL_EXTENSION)
+            })
+            .collect();
+        libs.sort();
+        found.extend(libs);
+    }
+    Ok(found)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn missing_file_and_non_library_have_their_own_errors() {
+        let mut r = Registry::new();
+        let err = load_library(Path::new("/no/such/libplugin.so"), &mut r).unwrap_err();
+        assert!(err.message.contains("does not exist"), "{err}");
+        let text = std::env::temp_dir().join(format!("lumis-not-a-lib-{}.so", std::process::id()));
+        std::fs::write(&text, b"not an ELF file").unwrap();
+        let err = load_library(&text, &mut r).unwrap_err();
+        std::fs::remove_file(&text).unwrap();
+        assert!(err.message.contains("not a loadable shared library"), "{err}");
+    }
+
+    #[test]
+    fn library_without_entry_point_is_refused() {
+        // libm is a real shared library that is not a lumis plugin.
+        let libm = ["/lib/x86_64-linux-gnu/libm.so.6", "/usr/lib/x86_64-linux-gnu/libm.so.6", "/lib64/libm.so.6"]
+            .into_iter()
+            .map(Path::new)
+            .find(|p| p.exists());
+        let Some(libm) = libm else {
+            eprintln!("no libm found at the usual paths; entry-point test covered by tests/plugins.rs");
+            return;
+        };
+        let err = load_library(libm, &mut Registry::new()).unwrap_err();
+        assert!(err.message.contains("no lumis_plugin_declaration entry point"), "{err}");
+    }
+}

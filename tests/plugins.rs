@@ -1,0 +1,132 @@
+//! A user's BSDF as a dynamic library: built as a cdylib the way a user
+//! builds it, loaded through a scene's `[plugins]` table and through
+//! `LUMIS_PLUGIN_PATH`, rendered, and compared with the same BSDF linked in.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use lumis_render::{render, RenderSettings};
+use lumis_tests::{assert_same_mean, bonferroni_z, scenes_dir};
+
+/// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
+fn build_example_plugin() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["build", "-p", "example-bsdf", "--message-format=json"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    let name = format!("{}example_bsdf.{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_EXTENSION);
+    stdout
+        .split('"')
+        .find(|s| s.ends_with(&name))
+        .map(PathBuf::from)
+        .unwrap_or_else(|| panic!("cargo reported no {name}:\n{stdout}"))
+}
+
+fn scene(plugins: &str, seed: u32) -> String {
+    format!(
+        r#"seed = {seed}
+{plugins}
+[film]
+resolution = [32, 32]
+[camera]
+type = "perspective"
+origin = [0.0, 0.0, 3.9]
+target = [0.0, 0.0, 2.9]
+fov = 39.3077
+[sampler]
+type = "independent"
+spp = 64
+[integrator]
+type = "path"
+max_depth = 5
+[[bsdf]]
+name = "glossy"
+type = "phong"
+diffuse = 0.3
+specular = 0.6
+exponent = 20.0
+[[bsdf]]
+name = "white"
+type = "diffuse"
+reflectance = 0.8
+[[shape]]
+type = "obj"
+file = "cornell-box/back.obj"
+bsdf = "glossy"
+[[shape]]
+type = "obj"
+file = "cornell-box/floor.obj"
+bsdf = "glossy"
+[[shape]]
+type = "obj"
+file = "cornell-box/light.obj"
+bsdf = "white"
+emission = {{ radiance = [18.387, 13.9873, 6.75357] }}
+"#
+    )
+}
+
+fn render_with(registry: &lumis_core::Registry, toml: &str) -> lumis_image::Image {
+    let loaded = lumis_scene::load_str(toml, "plugin.toml", "plugin", &scenes_dir(), &[], registry)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let settings = RenderSettings {
+        spp: loaded.sampler.samples_per_pixel(),
+        seed: loaded.seed,
+        threads: 0,
+        progress: false,
+    };
+    render(&loaded.camera, &loaded.scene, loaded.integrator.as_ref(), loaded.sampler.as_ref(), &settings)
+        .unwrap()
+        .image
+}
+
+#[test]
+fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
+    let library = build_example_plugin();
+    let builtin = lumis_cli::builtin_registry().unwrap();
+
+    // Without the plugin, the type is unknown.
+    let err = lumis_scene::load_str(&scene("", 1), "plugin.toml", "plugin", &scenes_dir(), &[], &builtin)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("unknown bsdf type \"phong\""), "{err}");
+
+    let plugins = format!("[plugins]\nload = [\"{}\"]\n", library.display());
+    let dynamic = render_with(&builtin, &scene(&plugins, 1));
+    assert!(dynamic.mean()[0] > 0.01, "the plugin's render is black");
+
+    let mut linked = lumis_cli::builtin_registry().unwrap();
+    example_bsdf::register(&mut linked).unwrap();
+    let reference = render_with(&linked, &scene("", 2));
+    let z = bonferroni_z(1e-3, 4 * 4 * 3);
+    assert_same_mean(&dynamic, &reference, 8, z, "dynamic vs linked phong");
+
+    // Loading it on top of the linked copy clashes, naming both sources.
+    let err = lumis_scene::load_str(&scene(&plugins, 1), "plugin.toml", "plugin", &scenes_dir(), &[], &linked)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("clashes") && err.contains("built-in") && err.contains(&library.display().to_string()), "{err}");
+}
+
+#[test]
+fn plugin_search_path_is_loaded_at_start_up() {
+    let library = build_example_plugin();
+    let dir = std::env::temp_dir().join(format!("lumis-plugin-path-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::copy(&library, dir.join(library.file_name().unwrap())).unwrap();
+    std::env::set_var(lumis_loader::PLUGIN_PATH_VAR, &dir);
+    let registry = lumis_cli::registry_with_search_path().unwrap();
+    std::env::remove_var(lumis_loader::PLUGIN_PATH_VAR);
+    let phong = registry.find(lumis_core::PluginKind::Bsdf, "phong").expect("phong registered");
+    assert!(phong.source.contains("lumis-plugin-path"), "{}", phong.source);
+    let listing = lumis_cli::plugin_listing(&registry);
+    assert!(listing.contains("type = \"phong\"") && listing.contains("exponent"), "{listing}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
