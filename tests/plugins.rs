@@ -10,15 +10,28 @@ use lumis_tests::{assert_same_mean, bonferroni_z, scenes_dir};
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
 fn build_example_plugin() -> PathBuf {
+    build_plugin("example-bsdf", "example_bsdf")
+}
+
+/// `cargo build -p PACKAGE`, returning the path of the cdylib `LIB` it wrote.
+fn build_plugin(package: &str, lib: &str) -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = Command::new(cargo)
-        .args(["build", "-p", "example-bsdf", "--message-format=json"])
+        .args(["build", "-p", package, "--message-format=json"])
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
         .expect("cargo runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8(out.stdout).unwrap();
-    let name = format!("{}example_bsdf.{}", std::env::consts::DLL_PREFIX, std::env::consts::DLL_EXTENSION);
+    let name = format!(
+        "{}{lib}.{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_EXTENSION
+    );
     stdout
         .split('"')
         .find(|s| s.ends_with(&name))
@@ -79,9 +92,15 @@ fn render_with(registry: &lumis_core::Registry, toml: &str) -> lumis_image::Imag
         threads: 0,
         progress: false,
     };
-    render(&loaded.camera, &loaded.scene, loaded.integrator.as_ref(), loaded.sampler.as_ref(), &settings)
-        .unwrap()
-        .image
+    render(
+        &loaded.camera,
+        &loaded.scene,
+        loaded.integrator.as_ref(),
+        loaded.sampler.as_ref(),
+        &settings,
+    )
+    .unwrap()
+    .image
 }
 
 #[test]
@@ -90,10 +109,17 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     let builtin = lumis_cli::builtin_registry().unwrap();
 
     // Without the plugin, the type is unknown.
-    let err = lumis_scene::load_str(&scene("", 1), "plugin.toml", "plugin", &scenes_dir(), &[], &builtin)
-        .err()
-        .unwrap()
-        .to_string();
+    let err = lumis_scene::load_str(
+        &scene("", 1),
+        "plugin.toml",
+        "plugin",
+        &scenes_dir(),
+        &[],
+        &builtin,
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(err.contains("unknown bsdf type \"phong\""), "{err}");
 
     let plugins = format!("[plugins]\nload = [\"{}\"]\n", library.display());
@@ -107,11 +133,23 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     assert_same_mean(&dynamic, &reference, 8, z, "dynamic vs linked phong");
 
     // Loading it on top of the linked copy clashes, naming both sources.
-    let err = lumis_scene::load_str(&scene(&plugins, 1), "plugin.toml", "plugin", &scenes_dir(), &[], &linked)
-        .err()
-        .unwrap()
-        .to_string();
-    assert!(err.contains("clashes") && err.contains("built-in") && err.contains(&library.display().to_string()), "{err}");
+    let err = lumis_scene::load_str(
+        &scene(&plugins, 1),
+        "plugin.toml",
+        "plugin",
+        &scenes_dir(),
+        &[],
+        &linked,
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(
+        err.contains("clashes")
+            && err.contains("built-in")
+            && err.contains(&library.display().to_string()),
+        "{err}"
+    );
 }
 
 #[test]
@@ -124,9 +162,37 @@ fn plugin_search_path_is_loaded_at_start_up() {
     std::env::set_var(lumis_loader::PLUGIN_PATH_VAR, &dir);
     let registry = lumis_cli::registry_with_search_path().unwrap();
     std::env::remove_var(lumis_loader::PLUGIN_PATH_VAR);
-    let phong = registry.find(lumis_core::PluginKind::Bsdf, "phong").expect("phong registered");
-    assert!(phong.source.contains("lumis-plugin-path"), "{}", phong.source);
+    let phong = registry
+        .find(lumis_core::PluginKind::Bsdf, "phong")
+        .expect("phong registered");
+    assert!(
+        phong.source.contains("lumis-plugin-path"),
+        "{}",
+        phong.source
+    );
     let listing = lumis_cli::plugin_listing(&registry);
-    assert!(listing.contains("type = \"phong\"") && listing.contains("exponent"), "{listing}");
+    assert!(
+        listing.contains("type = \"phong\"") && listing.contains("exponent"),
+        "{listing}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn library_from_another_lumis_core_is_refused_before_registering() {
+    let library = build_plugin("foreign-plugin", "foreign_plugin");
+    let mut registry = lumis_cli::builtin_registry().unwrap();
+    // Its register function panics: reaching it would fail differently.
+    let err = lumis_loader::load_library(&library, &mut registry)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("built against lumis-core 0.0.0-elsewhere")
+            && err.contains(lumis_core::plugin::CORE_VERSION)
+            && err.contains("rebuild"),
+        "{err}"
+    );
+    assert!(registry
+        .find(lumis_core::PluginKind::Bsdf, "phong")
+        .is_none());
 }

@@ -21,7 +21,14 @@ pub fn plugin_listing(registry: &Registry) -> String {
                     ParamDefault::Value(v) => format!("default {v}"),
                     ParamDefault::Absent => "optional".to_string(),
                 };
-                let _ = writeln!(out, "    {:<12} {:<12} {:<22} {}", param.name, param.ty.name(), default, param.doc);
+                let _ = writeln!(
+                    out,
+                    "    {:<12} {:<12} {:<22} {}",
+                    param.name,
+                    param.ty.name(),
+                    default,
+                    param.doc
+                );
             }
         }
         out.push('\n');
@@ -36,7 +43,15 @@ mod tests {
     #[test]
     fn lists_every_builtin_with_its_parameters() {
         let text = plugin_listing(&crate::builtin_registry().unwrap());
-        for needle in ["[sampler]", "type = \"independent\"  (built-in)", "[integrator]", "max_depth", "default 8", "reflectance", "required"] {
+        for needle in [
+            "[sampler]",
+            "type = \"independent\"  (built-in)",
+            "[integrator]",
+            "max_depth",
+            "default 8",
+            "reflectance",
+            "required",
+        ] {
             assert!(text.contains(needle), "listing lacks '{needle}':\n{text}");
         }
     }

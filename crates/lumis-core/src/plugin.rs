@@ -58,6 +58,23 @@ impl PluginDeclaration {
         }
     }
 
+    /// A declaration with explicit versions, for testing the loader's
+    /// checks against libraries built elsewhere.
+    #[doc(hidden)]
+    pub const fn with_versions(
+        abi_version: u32,
+        rustc_version: &str,
+        core_version: &str,
+        register: fn(&mut Registry) -> Result<()>,
+    ) -> Self {
+        Self {
+            abi_version,
+            rustc_version: text(rustc_version),
+            core_version: text(core_version),
+            register,
+        }
+    }
+
     pub fn rustc_version(&self) -> String {
         read_text(&self.rustc_version)
     }
@@ -85,7 +102,8 @@ macro_rules! lumis_plugin {
         #[allow(unsafe_code)]
         #[no_mangle]
         pub extern "C" fn lumis_plugin_declaration() -> *const $crate::plugin::PluginDeclaration {
-            static DECLARATION: $crate::plugin::PluginDeclaration = $crate::plugin::PluginDeclaration::new($register);
+            static DECLARATION: $crate::plugin::PluginDeclaration =
+                $crate::plugin::PluginDeclaration::new($register);
             &DECLARATION
         }
     };
@@ -99,7 +117,11 @@ mod tests {
     fn declaration_carries_versions() {
         let d = PluginDeclaration::new(|_| Ok(()));
         assert_eq!(d.abi_version, PLUGIN_ABI_VERSION);
-        assert!(d.rustc_version().starts_with("rustc "), "{}", d.rustc_version());
+        assert!(
+            d.rustc_version().starts_with("rustc "),
+            "{}",
+            d.rustc_version()
+        );
         assert_eq!(d.core_version(), CORE_VERSION);
         let mut r = Registry::new();
         (d.register)(&mut r).unwrap();

@@ -15,7 +15,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use libloading::{Library, Symbol};
-use lumis_core::plugin::{PluginDeclaration, CORE_VERSION, ENTRY_POINT, PLUGIN_ABI_VERSION, RUSTC_VERSION};
+use lumis_core::plugin::{
+    PluginDeclaration, CORE_VERSION, ENTRY_POINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
+};
 use lumis_core::{Error, Registry, Result};
 
 /// The environment variable listing directories whose plugin libraries are
@@ -37,14 +39,15 @@ fn describe_panic(payload: Box<dyn std::any::Any + Send>) -> String {
 pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
     let shown = path.display();
     if !path.exists() {
-        return Err(Error::msg(format!("plugin library '{shown}' does not exist")));
+        return Err(Error::msg(format!(
+            "plugin library '{shown}' does not exist"
+        )));
     }
     // SAFETY: loading runs the library's initialisers. This is the point
     // of a plugin system: the user asked for this library. Everything after
     // is guarded by the declaration check.
-    let library = unsafe { Library::new(path) }.map_err(|e| {
-        Error::msg(format!("'{shown}' is not a loadable shared library: {e}"))
-    })?;
+    let library = unsafe { Library::new(path) }
+        .map_err(|e| Error::msg(format!("'{shown}' is not a loadable shared library: {e}")))?;
     // SAFETY: the symbol, if present, was exported by `lumis_plugin!` with
     // exactly this signature; a library that exports the name with another
     // signature is not a lumis plugin and breaks the contract it claims.
@@ -54,10 +57,16 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
              (a plugin crate calls lumis_core::lumis_plugin!(register))"
         ))
     })?;
-    let declaration = catch_unwind(|| entry())
-        .map_err(|p| Error::msg(format!("'{shown}': entry point panicked: {}", describe_panic(p))))?;
+    let declaration = catch_unwind(|| entry()).map_err(|p| {
+        Error::msg(format!(
+            "'{shown}': entry point panicked: {}",
+            describe_panic(p)
+        ))
+    })?;
     if declaration.is_null() {
-        return Err(Error::msg(format!("'{shown}': entry point returned no declaration")));
+        return Err(Error::msg(format!(
+            "'{shown}': entry point returned no declaration"
+        )));
     }
     // SAFETY: non-null, points at the plugin's static declaration, which
     // lives as long as the library (forever: it is never unloaded). Only the
@@ -113,7 +122,10 @@ pub fn libraries_on_search_path() -> Result<Vec<PathBuf>> {
     let mut found = Vec::new();
     for dir in std::env::split_paths(&value).filter(|d| !d.as_os_str().is_empty()) {
         let entries = std::fs::read_dir(&dir).map_err(|e| {
-            Error::msg(format!("{PLUGIN_PATH_VAR} names '{}', which cannot be read: {e}", dir.display()))
+            Error::msg(format!(
+                "{PLUGIN_PATH_VAR} names '{}', which cannot be read: {e}",
+                dir.display()
+            ))
         })?;
         let mut libs: Vec<PathBuf> = entries
             .filter_map(|e| e.ok().map(|e| e.path()))
@@ -141,21 +153,34 @@ mod tests {
         std::fs::write(&text, b"not an ELF file").unwrap();
         let err = load_library(&text, &mut r).unwrap_err();
         std::fs::remove_file(&text).unwrap();
-        assert!(err.message.contains("not a loadable shared library"), "{err}");
+        assert!(
+            err.message.contains("not a loadable shared library"),
+            "{err}"
+        );
     }
 
     #[test]
     fn library_without_entry_point_is_refused() {
         // libm is a real shared library that is not a lumis plugin.
-        let libm = ["/lib/x86_64-linux-gnu/libm.so.6", "/usr/lib/x86_64-linux-gnu/libm.so.6", "/lib64/libm.so.6"]
-            .into_iter()
-            .map(Path::new)
-            .find(|p| p.exists());
+        let libm = [
+            "/lib/x86_64-linux-gnu/libm.so.6",
+            "/usr/lib/x86_64-linux-gnu/libm.so.6",
+            "/lib64/libm.so.6",
+        ]
+        .into_iter()
+        .map(Path::new)
+        .find(|p| p.exists());
         let Some(libm) = libm else {
-            eprintln!("no libm found at the usual paths; entry-point test covered by tests/plugins.rs");
+            eprintln!(
+                "no libm found at the usual paths; entry-point test covered by tests/plugins.rs"
+            );
             return;
         };
         let err = load_library(libm, &mut Registry::new()).unwrap_err();
-        assert!(err.message.contains("no lumis_plugin_declaration entry point"), "{err}");
+        assert!(
+            err.message
+                .contains("no lumis_plugin_declaration entry point"),
+            "{err}"
+        );
     }
 }

@@ -158,13 +158,20 @@ pub fn load_str(
         None => registry,
         Some(node) => {
             let table = as_table(node, "plugins")?;
-            let params = Params::new("[plugins]", table, node.location.clone(), PLUGINS_PARAMS, &[])?;
+            let params = Params::new(
+                "[plugins]",
+                table,
+                node.location.clone(),
+                PLUGINS_PARAMS,
+                &[],
+            )?;
             let libraries: Vec<String> = params.get("load")?;
             params.finish()?;
             let mut extended = registry.clone();
             for library in libraries {
-                lumis_loader::load_library(&dir.join(&library), &mut extended)
-                    .map_err(|e| Error::at(&node.location, format!("[plugins] load: {}", e.message)))?;
+                lumis_loader::load_library(&dir.join(&library), &mut extended).map_err(|e| {
+                    Error::at(&node.location, format!("[plugins] load: {}", e.message))
+                })?;
             }
             with_scene_plugins = extended;
             &with_scene_plugins

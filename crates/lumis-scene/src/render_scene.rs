@@ -104,7 +104,10 @@ fn to_embree(ray: &Ray) -> lumis_embree::Ray {
 impl Scene for RenderScene {
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
-        debug_assert!((ray.d.length() - 1.0).abs() < 1e-3, "intersect expects a unit direction");
+        debug_assert!(
+            (ray.d.length() - 1.0).abs() < 1e-3,
+            "intersect expects a unit direction"
+        );
         let hit = self.embree.intersect1(&to_embree(ray))?;
         let wo = -ray.d;
         match &self.geometries[hit.geom_id as usize] {

@@ -17,8 +17,8 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use std::sync::Arc;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Registry,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, ParamSpec, ParamType, Params, PluginKind,
+    PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -70,7 +70,10 @@ impl Phong {
         if (diffuse + specular).max_component() > 1.0 {
             return Err(params.error(
                 "specular",
-                format!("diffuse + specular must be <= 1 per channel to conserve energy, got {:?}", diffuse + specular),
+                format!(
+                    "diffuse + specular must be <= 1 per channel to conserve energy, got {:?}",
+                    diffuse + specular
+                ),
             ));
         }
         let exponent = params.get_in_range("exponent", 0.0, 1e6)?;
@@ -143,7 +146,8 @@ impl Bsdf for Phong {
             return 0.0;
         }
         let glossy = (self.exponent + 1.0) * 0.5 * FRAC_1_PI * self.lobe(wo, wi);
-        (1.0 - self.glossy_probability) * warp::cosine_hemisphere_pdf(wi.z) + self.glossy_probability * glossy
+        (1.0 - self.glossy_probability) * warp::cosine_hemisphere_pdf(wi.z)
+            + self.glossy_probability * glossy
     }
 }
 
@@ -172,7 +176,10 @@ mod tests {
                 let wo = dir(cos_o, 0.4);
                 let wi = dir(0.7, 2.0);
                 let (a, b) = (bsdf.f(&ctx, wo, wi), bsdf.f(&ctx, wi, wo));
-                assert!((a - b).max_component().abs() <= 1e-5 * a.max_component().max(1.0), "reciprocity");
+                assert!(
+                    (a - b).max_component().abs() <= 1e-5 * a.max_component().max(1.0),
+                    "reciprocity"
+                );
                 // White furnace per direction: albedo <= 1 when rho_d + rho_s = 1.
                 let samples = 100_000;
                 let mut albedo = 0.0f64;
@@ -185,7 +192,10 @@ mod tests {
                     }
                 }
                 albedo /= samples as f64;
-                assert!(albedo <= 1.0 + 5e-3, "n {n}, cos_o {cos_o}: albedo {albedo}");
+                assert!(
+                    albedo <= 1.0 + 5e-3,
+                    "n {n}, cos_o {cos_o}: albedo {albedo}"
+                );
             }
         }
     }
