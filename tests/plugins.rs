@@ -5,8 +5,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use lumis_render::{render, RenderSettings};
-use lumis_tests::{assert_same_mean, bonferroni_z, scenes_dir};
+use lumis_tests::{assert_same_mean, bonferroni_z, render_toml_with, scenes_dir};
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
 fn build_example_plugin() -> PathBuf {
@@ -83,26 +82,6 @@ emission = {{ radiance = [18.387, 13.9873, 6.75357] }}
     )
 }
 
-fn render_with(registry: &lumis_core::Registry, toml: &str) -> lumis_image::Image {
-    let loaded = lumis_scene::load_str(toml, "plugin.toml", "plugin", &scenes_dir(), &[], registry)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let settings = RenderSettings {
-        spp: loaded.sampler.samples_per_pixel(),
-        seed: loaded.seed,
-        threads: 0,
-        progress: false,
-    };
-    render(
-        &loaded.camera,
-        &loaded.scene,
-        loaded.integrator.as_ref(),
-        loaded.sampler.as_ref(),
-        &settings,
-    )
-    .unwrap()
-    .image
-}
-
 #[test]
 fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     let library = build_example_plugin();
@@ -123,12 +102,12 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     assert!(err.contains("unknown bsdf type \"phong\""), "{err}");
 
     let plugins = format!("[plugins]\nload = [\"{}\"]\n", library.display());
-    let dynamic = render_with(&builtin, &scene(&plugins, 1));
+    let dynamic = render_toml_with(&builtin, &scene(&plugins, 1), &[], 0).image;
     assert!(dynamic.mean()[0] > 0.01, "the plugin's render is black");
 
     let mut linked = lumis_cli::builtin_registry().unwrap();
     example_bsdf::register(&mut linked).unwrap();
-    let reference = render_with(&linked, &scene("", 2));
+    let reference = render_toml_with(&linked, &scene("", 2), &[], 0).image;
     let z = bonferroni_z(1e-3, 4 * 4 * 3);
     assert_same_mean(&dynamic, &reference, 8, z, "dynamic vs linked phong");
 

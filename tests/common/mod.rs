@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use lumis_core::Registry;
 use lumis_image::Image;
 use lumis_render::{render, RenderOutput, RenderSettings};
 
@@ -10,6 +11,16 @@ use lumis_render::{render, RenderOutput, RenderSettings};
 /// and renders it with the scene's own spp and seed.
 pub fn render_toml(toml: &str, overrides: &[&str], threads: usize) -> RenderOutput {
     let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    render_toml_with(&registry, toml, overrides, threads)
+}
+
+/// [`render_toml`] with a given plugin registry.
+pub fn render_toml_with(
+    registry: &Registry,
+    toml: &str,
+    overrides: &[&str],
+    threads: usize,
+) -> RenderOutput {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     let loaded = lumis_scene::load_str(
         toml,
@@ -17,7 +28,7 @@ pub fn render_toml(toml: &str, overrides: &[&str], threads: usize) -> RenderOutp
         "test",
         &scenes_dir(),
         &overrides,
-        &registry,
+        registry,
     )
     .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
     let settings = RenderSettings {

@@ -4,7 +4,7 @@
 
 use embree4_sys as sys;
 
-use crate::scene::Scene;
+use crate::scene::{empty_hit, raw_ray, Ray, Scene};
 
 /// A recorded query: a closest-hit ray or a shadow ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,20 +21,12 @@ pub fn trace(scene: &Scene, rays: &[BareRay]) -> u64 {
     let raw = scene.raw();
     let mut hits = 0;
     for r in rays {
-        let ray = sys::RTCRay {
-            org_x: r.org[0],
-            org_y: r.org[1],
-            org_z: r.org[2],
+        let ray = raw_ray(&Ray {
+            org: r.org,
+            dir: r.dir,
             tnear: 0.0,
-            dir_x: r.dir[0],
-            dir_y: r.dir[1],
-            dir_z: r.dir[2],
-            time: 0.0,
             tfar: r.tfar,
-            mask: u32::MAX,
-            id: 0,
-            flags: 0,
-        };
+        });
         if r.shadow {
             let mut ray = ray;
             // SAFETY: committed, live scene; valid RTCRay; default arguments.
@@ -43,7 +35,7 @@ pub fn trace(scene: &Scene, rays: &[BareRay]) -> u64 {
         } else {
             let mut rayhit = sys::RTCRayHit {
                 ray,
-                hit: crate::scene::empty_hit(),
+                hit: empty_hit(),
             };
             // SAFETY: as above, with a properly aligned RTCRayHit.
             unsafe { sys::rtcIntersect1(raw, &mut rayhit, std::ptr::null_mut()) };

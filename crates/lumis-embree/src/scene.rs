@@ -251,7 +251,8 @@ impl Drop for Scene {
     }
 }
 
-fn raw_ray(ray: &Ray) -> sys::RTCRay {
+#[inline]
+pub(crate) fn raw_ray(ray: &Ray) -> sys::RTCRay {
     sys::RTCRay {
         org_x: ray.org[0],
         org_y: ray.org[1],
@@ -268,6 +269,7 @@ fn raw_ray(ray: &Ray) -> sys::RTCRay {
     }
 }
 
+#[inline]
 pub(crate) fn empty_hit() -> sys::RTCHit {
     sys::RTCHit {
         Ng_x: 0.0,

@@ -211,20 +211,8 @@ pub fn load_str(
     }
 
     for (i, (table, location)) in tables_in(&root, "light")?.into_iter().enumerate() {
-        let owner = format!("[[light]] #{}", i + 1);
-        let (kind, kind_location) = type_of(table, &location, &owner)?;
-        let light = registry.create_light(
-            &TableRef {
-                owner: &owner,
-                table,
-                location: &location,
-                type_name: kind,
-                type_location: &kind_location,
-                structural: &["type"],
-            },
-            &LightShape::None,
-        )?;
-        lights.push(light);
+        let light = PluginTable::new(format!("[[light]] #{}", i + 1), table, location)?;
+        lights.push(registry.create_light(&light.as_ref(), &LightShape::None)?);
     }
 
     let embree = builder.commit().map_err(embree_error)?;
@@ -265,30 +253,10 @@ pub fn load_str(
         )?
     };
 
-    let sampler = {
-        let (table, location) = required_table(&root, "sampler", &file_location)?;
-        let (kind, kind_location) = type_of(table, &location, "sampler")?;
-        registry.create_sampler(&TableRef {
-            owner: "sampler",
-            table,
-            location: &location,
-            type_name: kind,
-            type_location: &kind_location,
-            structural: &["type"],
-        })?
-    };
-    let integrator = {
-        let (table, location) = required_table(&root, "integrator", &file_location)?;
-        let (kind, kind_location) = type_of(table, &location, "integrator")?;
-        registry.create_integrator(&TableRef {
-            owner: "integrator",
-            table,
-            location: &location,
-            type_name: kind,
-            type_location: &kind_location,
-            structural: &["type"],
-        })?
-    };
+    let sampler = registry
+        .create_sampler(&PluginTable::required(&root, "sampler", &file_location)?.as_ref())?;
+    let integrator = registry
+        .create_integrator(&PluginTable::required(&root, "integrator", &file_location)?.as_ref())?;
 
     let scene = RenderScene {
         embree,
@@ -308,6 +276,45 @@ pub fn load_str(
         seed,
         output,
     })
+}
+
+/// A plugin table of the scene with its `type` resolved.
+struct PluginTable<'a> {
+    owner: String,
+    table: &'a Table,
+    location: Location,
+    kind: &'a str,
+    kind_location: Location,
+}
+
+impl<'a> PluginTable<'a> {
+    fn new(owner: String, table: &'a Table, location: Location) -> Result<Self> {
+        let (kind, kind_location) = type_of(table, &location, &owner)?;
+        Ok(Self {
+            owner,
+            table,
+            location,
+            kind,
+            kind_location,
+        })
+    }
+
+    /// The top-level table `key`, which the scene must have.
+    fn required(root: &'a Table, key: &str, file: &Location) -> Result<Self> {
+        let (table, location) = required_table(root, key, file)?;
+        Self::new(key.to_string(), table, location)
+    }
+
+    fn as_ref(&self) -> TableRef<'_> {
+        TableRef {
+            owner: &self.owner,
+            table: self.table,
+            location: &self.location,
+            type_name: self.kind,
+            type_location: &self.kind_location,
+            structural: &["type"],
+        }
+    }
 }
 
 fn device() -> Result<Device> {
