@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+use lumis_check::bsdf_suite::{check_bsdf, format_results, BsdfCheckConfig};
 use lumis_tests::{assert_same_mean, bonferroni_z, render_toml_with, scenes_dir};
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
@@ -110,6 +111,16 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     let reference = render_toml_with(&linked, &scene("", 2), &[], 0).image;
     let z = bonferroni_z(1e-3, 4 * 4 * 3);
     assert_same_mean(&dynamic, &reference, 8, z, "dynamic vs linked phong");
+
+    // The loaded BSDF passes the same statistical checks as the built-in ones.
+    let mut loaded = lumis_cli::builtin_registry().unwrap();
+    lumis_loader::load_library(&library, &mut loaded).unwrap();
+    let results = check_bsdf(&loaded, "phong", &BsdfCheckConfig::default()).unwrap();
+    assert!(
+        results.iter().all(|r| r.passed()),
+        "{}",
+        format_results(&results)
+    );
 
     // Loading it on top of the linked copy clashes, naming both sources.
     let err = lumis_scene::load_str(

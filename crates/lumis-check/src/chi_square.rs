@@ -58,6 +58,10 @@ pub struct ChiSquareReport {
     /// out-of-support samples, a pdf that integrates above 1).
     pub defect: Option<String>,
     pub passed: bool,
+    /// Samples per bin, row-major over (z, phi), for failure pictures.
+    pub observed: Vec<f64>,
+    /// Expected samples per bin.
+    pub expected: Vec<f64>,
 }
 
 fn bin_of(d: Vec3, cfg: &ChiSquareConfig) -> usize {
@@ -205,7 +209,7 @@ pub fn chi_square(
     let mut order: Vec<usize> = (0..expected.len()).collect();
     order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
     let (mut pool_obs, mut pool_exp, mut statistic, mut dof) = (0.0, 0.0, 0.0, 0usize);
-    for &i in &order {
+    for &i in order.iter() {
         let (o, e) = (observed[i] as f64, expected[i]);
         if e <= 0.0 && o > 0.0 {
             defect.get_or_insert(format!(
@@ -247,6 +251,8 @@ pub fn chi_square(
         sampled_fraction,
         passed: defect.is_none() && p_value >= cfg.significance,
         defect,
+        observed: observed.iter().map(|&o| o as f64).collect(),
+        expected,
     }
 }
 

@@ -7,6 +7,7 @@
 //! `sample_li`/`pdf_li` into such a pair.
 
 pub mod adapters;
+pub mod bsdf_suite;
 pub mod chi_square;
 
 pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};

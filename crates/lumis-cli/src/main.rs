@@ -4,7 +4,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
 use lumis_cli::{plugin_listing, registry_with_search_path, render_scene_file, RenderArgs};
+use lumis_core::{Error, PluginKind, Result};
 
 #[derive(Parser)]
 #[command(
@@ -55,6 +57,27 @@ enum Command {
         #[arg(long, value_name = "LIB.so")]
         load: Vec<PathBuf>,
     },
+    /// Statistically check BSDF plugins: chi-square of sample_f against pdf,
+    /// pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
+    /// reciprocity and finiteness, over a sweep of the plugin's parameters
+    /// and of incident angles down to cos theta = 1e-4. Exits non-zero on
+    /// any failure and writes observed-vs-expected PNGs for failed cases.
+    CheckPlugin {
+        /// A plugin library: checks every BSDF it registers.
+        library: Option<PathBuf>,
+        /// Check this BSDF (built-in or from the library); repeatable.
+        #[arg(long)]
+        bsdf: Vec<String>,
+        /// Samples per chi-square test.
+        #[arg(long, default_value_t = 1_000_000)]
+        samples: usize,
+        /// Bins per axis (cos theta and phi) of the chi-square histogram.
+        #[arg(long, default_value_t = 100)]
+        bins: usize,
+        /// Where failure pictures go.
+        #[arg(long, default_value = ".")]
+        out: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -80,21 +103,82 @@ fn main() -> ExitCode {
                 progress: !quiet,
                 verbose,
             };
-            render_scene_file(&args, &registry).map(|report| println!("{}", report.summary()))
+            render_scene_file(&args, &registry).map(|report| {
+                println!("{}", report.summary());
+                true
+            })
         }),
         Command::Plugins { load } => registry_with_search_path().and_then(|mut registry| {
             for library in &load {
                 lumis_loader::load_library(library, &mut registry)?;
             }
             print!("{}", plugin_listing(&registry));
-            Ok(())
+            Ok(true)
         }),
+        Command::CheckPlugin {
+            library,
+            bsdf,
+            samples,
+            bins,
+            out,
+        } => check_plugin(library, bsdf, samples, bins, &out),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
         Err(e) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// `lumis check-plugin`: returns whether every case passed.
+fn check_plugin(
+    library: Option<PathBuf>,
+    mut names: Vec<String>,
+    samples: usize,
+    bins: usize,
+    out: &std::path::Path,
+) -> Result<bool> {
+    let mut registry = registry_with_search_path()?;
+    if let Some(library) = &library {
+        lumis_loader::load_library(library, &mut registry)?;
+        let source = library.display().to_string();
+        names.extend(
+            registry
+                .plugins()
+                .into_iter()
+                .filter(|p| p.spec.kind == PluginKind::Bsdf && *p.source == *source)
+                .map(|p| p.spec.name.to_string()),
+        );
+    }
+    if names.is_empty() {
+        return Err(Error::msg(
+            "nothing to check: give a plugin library that registers BSDFs, or --bsdf NAME",
+        ));
+    }
+    let mut cfg = BsdfCheckConfig::default();
+    cfg.chi_square.samples = samples;
+    cfg.chi_square.z_bins = bins;
+    cfg.chi_square.phi_bins = bins;
+    let mut all_passed = true;
+    for name in &names {
+        let results = check_bsdf(&registry, name, &cfg)?;
+        print!("{}", format_results(&results));
+        for (i, r) in results
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| !r.chi_square.passed)
+        {
+            let path = out.join(format!("check-{name}-{i}.png"));
+            write_histogram_png(&r.chi_square, &cfg.chi_square, &path)?;
+            println!(
+                "observed | expected histograms of failed case {i}: {}",
+                path.display()
+            );
+        }
+        all_passed &= results.iter().all(|r| r.passed());
+    }
+    Ok(all_passed)
 }

@@ -121,3 +121,31 @@ fn scene_errors_exit_nonzero_with_the_location() {
         "{stderr}"
     );
 }
+
+#[test]
+fn check_plugin_checks_a_builtin_bsdf_and_reports_a_table() {
+    let result = lumis(&[
+        "check-plugin",
+        "--bsdf",
+        "diffuse",
+        "--samples",
+        "20000",
+        "--bins",
+        "20",
+    ]);
+    let stdout = String::from_utf8(result.stdout).unwrap();
+    assert!(
+        result.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(
+        stdout.contains("p-value") && stdout.contains("passed, 0 failed"),
+        "{stdout}"
+    );
+    let missing = lumis(&["check-plugin", "--bsdf", "no-such-bsdf"]);
+    assert!(!missing.status.success());
+    assert!(
+        String::from_utf8_lossy(&missing.stderr).contains("no bsdf plugin named \"no-such-bsdf\"")
+    );
+}

@@ -66,12 +66,17 @@ pub enum ParamDefault {
 }
 
 /// One declared parameter of a plugin.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {
     pub name: &'static str,
     pub ty: ParamType,
     pub default: ParamDefault,
     pub doc: &'static str,
+    /// The valid range of a number, `[min, max]`: documents it, and tells
+    /// `lumis check-plugin` which extremes to sweep.
+    pub range: Option<(f64, f64)>,
+    /// The valid values of a string, for the same two purposes.
+    pub choices: &'static [&'static str],
 }
 
 impl ParamSpec {
@@ -81,6 +86,8 @@ impl ParamSpec {
             ty,
             default: ParamDefault::Required,
             doc,
+            range: None,
+            choices: &[],
         }
     }
 
@@ -95,6 +102,8 @@ impl ParamSpec {
             ty,
             default: ParamDefault::Value(default),
             doc,
+            range: None,
+            choices: &[],
         }
     }
 
@@ -104,7 +113,21 @@ impl ParamSpec {
             ty,
             default: ParamDefault::Absent,
             doc,
+            range: None,
+            choices: &[],
         }
+    }
+
+    /// Declares the valid range of a number parameter.
+    pub const fn in_range(mut self, min: f64, max: f64) -> Self {
+        self.range = Some((min, max));
+        self
+    }
+
+    /// Declares the valid values of a string parameter.
+    pub const fn one_of(mut self, choices: &'static [&'static str]) -> Self {
+        self.choices = choices;
+        self
     }
 
     /// The default as a document node, if it has one.
@@ -421,10 +444,13 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A float that must lie in `[min, max]`.
-    pub fn get_in_range(&self, name: &str, min: f32, max: f32) -> Result<f32> {
+    /// A number within the range the spec declares (`ParamSpec::in_range`).
+    pub fn get_in_range(&self, name: &str) -> Result<f32> {
         let v: f32 = self.get(name)?;
-        if !(v >= min && v <= max) {
+        let (min, max) = self.spec[self.spec_index(name)]
+            .range
+            .unwrap_or_else(|| panic!("plugin bug: '{name}' of {} declares no range", self.owner));
+        if !(v as f64 >= min && v as f64 <= max) {
             return Err(self.error(name, format!("must be in [{min}, {max}], got {v}")));
         }
         Ok(v)
@@ -439,9 +465,10 @@ impl<'a> Params<'a> {
         Ok(v)
     }
 
-    /// One of the listed strings.
-    pub fn get_choice(&self, name: &str, choices: &[&str]) -> Result<String> {
+    /// One of the strings the spec declares (`ParamSpec::one_of`).
+    pub fn get_choice(&self, name: &str) -> Result<String> {
         let v: String = self.get(name)?;
+        let choices = self.spec[self.spec_index(name)].choices;
         if !choices.contains(&v.as_str()) {
             return Err(self.error(
                 name,
@@ -511,7 +538,8 @@ mod tests {
     const SPEC: &[ParamSpec] = &[
         ParamSpec::required("reflectance", ParamType::Rgb, "albedo"),
         ParamSpec::with_default("max_depth", ParamType::Int, "8", "path segments"),
-        ParamSpec::with_default("heuristic", ParamType::String, "\"power\"", "MIS heuristic"),
+        ParamSpec::with_default("heuristic", ParamType::String, "\"power\"", "MIS heuristic")
+            .one_of(&["balance", "power"]),
         ParamSpec::optional("beta", ParamType::Float, "power heuristic exponent"),
     ];
 
@@ -585,10 +613,7 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("positive"));
-        let err = p
-            .get_choice("heuristic", &["balance", "power"])
-            .unwrap_err()
-            .to_string();
+        let err = p.get_choice("heuristic").unwrap_err().to_string();
         assert!(err.contains("\"balance\", \"power\""), "{err}");
     }
 }

@@ -25,7 +25,8 @@ pub const SPEC: PluginSpec = PluginSpec {
             ParamType::String,
             "\"cosine\"",
             "\"cosine\" (Malley: pdf cos/pi, zero variance for f cos) or \"uniform\" (pdf 1/(2 pi), for comparison)",
-        ),
+        )
+        .one_of(&["cosine", "uniform"]),
     ],
 };
 
@@ -61,10 +62,7 @@ impl Diffuse {
                 ),
             ));
         }
-        let sampling = match params
-            .get_choice("sampling", &["cosine", "uniform"])?
-            .as_str()
-        {
+        let sampling = match params.get_choice("sampling")?.as_str() {
             "uniform" => DiffuseSampling::Uniform,
             _ => DiffuseSampling::Cosine,
         };
@@ -119,10 +117,12 @@ impl Bsdf for Diffuse {
             DiffuseSampling::Cosine => warp::square_to_cosine_hemisphere(u2),
             DiffuseSampling::Uniform => warp::square_to_uniform_hemisphere(u2),
         };
-        let pdf = self.pdf_upper(local.z);
-        if pdf == 0.0 {
+        // A direction on the horizon (z = 0 exactly, reachable with u = 0)
+        // has no reflection: f() is zero there, so no sample either.
+        if local.z <= 0.0 {
             return None;
         }
+        let pdf = self.pdf_upper(local.z);
         Some(BsdfSample {
             f: self.reflectance * FRAC_1_PI,
             wi: Vec3::new(local.x, local.y, local.z * flip),

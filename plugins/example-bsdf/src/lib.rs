@@ -29,7 +29,8 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: &[
         ParamSpec::with_default("diffuse", ParamType::Rgb, "0.5", "diffuse albedo rho_d"),
         ParamSpec::with_default("specular", ParamType::Rgb, "0.2", "glossy albedo rho_s; rho_d + rho_s <= 1 per channel"),
-        ParamSpec::with_default("exponent", ParamType::Float, "30.0", "Phong exponent n in [0, 1e6]; larger = sharper"),
+        ParamSpec::with_default("exponent", ParamType::Float, "30.0", "Phong exponent n in [0, 1e4]; larger = sharper")
+            .in_range(0.0, 1e4),
     ],
 };
 
@@ -76,7 +77,7 @@ impl Phong {
                 ),
             ));
         }
-        let exponent = params.get_in_range("exponent", 0.0, 1e6)?;
+        let exponent = params.get_in_range("exponent")?;
         Ok(Self::new(diffuse, specular, exponent))
     }
 

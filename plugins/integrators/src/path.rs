@@ -31,13 +31,15 @@ pub const SPEC: PluginSpec = PluginSpec {
             ParamType::String,
             "\"mis\"",
             "\"bsdf\" (emission found by BSDF sampling only), \"light\" (next-event estimation only) or \"mis\" (both, weighted)",
-        ),
+        )
+        .one_of(&["bsdf", "light", "mis"]),
         ParamSpec::with_default(
             "heuristic",
             ParamType::String,
             "\"power\"",
             "MIS weights with strategy = \"mis\": \"balance\" or \"power\"",
-        ),
+        )
+        .one_of(&["balance", "power"]),
         ParamSpec::with_default("beta", ParamType::Float, "2.0", "exponent of the power heuristic"),
     ],
 };
@@ -94,10 +96,7 @@ impl PathIntegrator {
             ));
         }
         let rr_depth: u32 = params.get("rr_depth")?;
-        let strategy = match params
-            .get_choice("strategy", &["bsdf", "light", "mis"])?
-            .as_str()
-        {
+        let strategy = match params.get_choice("strategy")?.as_str() {
             "bsdf" => Strategy::Bsdf,
             "light" => Strategy::Light,
             _ => Strategy::Mis,
@@ -105,10 +104,7 @@ impl PathIntegrator {
         // Heuristic and beta are validated whatever the strategy, so that
         // `--set integrator.strategy=bsdf` works on a scene that sets them;
         // they only change the estimate when strategy = "mis".
-        let heuristic = match params
-            .get_choice("heuristic", &["balance", "power"])?
-            .as_str()
-        {
+        let heuristic = match params.get_choice("heuristic")?.as_str() {
             "balance" => Heuristic::Balance,
             _ => Heuristic::Power {
                 beta: params.get_positive("beta")?,

@@ -1,0 +1,405 @@
+//! The full check of a BSDF plugin, as `lumis check-plugin` and the test
+//! suite run it: over a sweep of the plugin's own parameters (both ends of
+//! every declared range, every declared choice, both values of every
+//! boolean) and of incident directions down to cos theta = 1e-4, check
+//!
+//! - chi-square goodness of fit of `sample_f` against `pdf`;
+//! - `pdf` integrates to at most 1 (and to the fraction of samples returned);
+//! - `sample_f` returns the `f` and `pdf` that `f()` and `pdf()` give;
+//! - energy: the directional albedo is at most 1 (a white furnace per lobe);
+//! - reciprocity `f(wo, wi) = f(wi, wo)` for reflection-only models;
+//! - no NaN, infinite or negative value anywhere.
+
+use std::fmt::Write;
+use std::path::Path;
+use std::sync::Arc;
+
+use lumis_core::doc::{self, Table};
+use lumis_core::params::ParamDefault;
+use lumis_core::registry::TableRef;
+use lumis_core::{
+    Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginKind, PluginSpec, Registry,
+    Result, Vec2, Vec3,
+};
+use lumis_sampling::{warp, Pcg32};
+
+use crate::adapters::bsdf_pair;
+use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+use crate::corrected_significance;
+
+/// How thoroughly to check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BsdfCheckConfig {
+    /// Bins, samples and quadrature of each chi-square test; its
+    /// significance is replaced by the Sidak-corrected one for the sweep.
+    pub chi_square: ChiSquareConfig,
+    /// Overall false-alarm rate of the whole sweep.
+    pub alpha: f64,
+    /// Incident cos theta values (negative ones probe the back side).
+    pub cos_theta_o: Vec<f32>,
+    /// Samples for the albedo, consistency and reciprocity checks.
+    pub samples: usize,
+}
+
+impl Default for BsdfCheckConfig {
+    fn default() -> Self {
+        Self {
+            chi_square: ChiSquareConfig {
+                z_bins: 100,
+                phi_bins: 100,
+                samples: 1_000_000,
+                ..Default::default()
+            },
+            alpha: 0.01,
+            cos_theta_o: vec![1e-4, 0.01, 0.1, 0.5, 1.0, -1e-4, -0.5, -1.0],
+            samples: 100_000,
+        }
+    }
+}
+
+/// One parameter setting of the sweep.
+#[derive(Debug, Clone)]
+pub struct Variant {
+    /// E.g. `base` or `exponent = 1000000`.
+    pub label: String,
+    pub table: Table,
+}
+
+/// The outcome of one (variant, incident direction) case.
+#[derive(Debug, Clone)]
+pub struct CaseResult {
+    pub bsdf: String,
+    pub variant: String,
+    pub cos_theta_o: f32,
+    pub chi_square: ChiSquareReport,
+    /// Directional albedo estimate and its standard error.
+    pub albedo: f64,
+    pub albedo_se: f64,
+    /// Everything that failed besides the chi-square statistic itself.
+    pub problems: Vec<String>,
+}
+
+impl CaseResult {
+    pub fn passed(&self) -> bool {
+        self.chi_square.passed && self.problems.is_empty()
+    }
+}
+
+/// A value to use for a required parameter with no default.
+fn stand_in(
+    name: &str,
+    ty: ParamType,
+    range: Option<(f64, f64)>,
+    choices: &[&str],
+) -> Result<String> {
+    Ok(match ty {
+        ParamType::Rgb => "0.5".into(),
+        ParamType::Float => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
+        ParamType::Int => range.map_or("1".into(), |(a, _)| format!("{}", a as i64)),
+        ParamType::Bool => "false".into(),
+        ParamType::String if !choices.is_empty() => format!("\"{}\"", choices[0]),
+        _ => {
+            return Err(Error::msg(format!(
+                "parameter '{name}' is required and of type {}: declare a default, a range or choices so it can be swept",
+                ty.name()
+            )))
+        }
+    })
+}
+
+/// The parameter settings to check: the defaults (with stand-ins for
+/// required parameters), then one parameter at a time at each end of its
+/// range, at each declared choice and at each boolean value.
+pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
+    let mut base: Vec<(String, String)> = Vec::new();
+    for p in spec.params {
+        if p.default == ParamDefault::Required {
+            base.push((
+                p.name.to_string(),
+                stand_in(p.name, p.ty, p.range, p.choices)?,
+            ));
+        }
+    }
+    let mut settings: Vec<(String, Vec<(String, String)>)> = vec![("base".into(), base.clone())];
+    for p in spec.params {
+        let mut values: Vec<String> = Vec::new();
+        match p.ty {
+            ParamType::Float | ParamType::Int => {
+                if let Some((a, b)) = p.range {
+                    let fmt = |v: f64| {
+                        if p.ty == ParamType::Int {
+                            format!("{}", v as i64)
+                        } else {
+                            format!("{v:?}")
+                        }
+                    };
+                    values.extend([fmt(a), fmt(b)]);
+                }
+            }
+            ParamType::Bool => values.extend(["true".to_string(), "false".to_string()]),
+            ParamType::String => values.extend(p.choices.iter().map(|c| format!("\"{c}\""))),
+            _ => {}
+        }
+        for v in values {
+            let mut s: Vec<(String, String)> =
+                base.iter().filter(|(k, _)| k != p.name).cloned().collect();
+            s.push((p.name.to_string(), v.clone()));
+            settings.push((format!("{} = {v}", p.name), s));
+        }
+    }
+    settings
+        .into_iter()
+        .map(|(label, kv)| {
+            let text: String = kv.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
+            let table = doc::parse(&text, "<sweep>")?;
+            Ok(Variant { label, table })
+        })
+        .collect()
+}
+
+fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
+    let owner = format!("bsdf \"{name}\" [{}]", variant.label);
+    registry.create_bsdf(&TableRef {
+        owner: &owner,
+        table: &variant.table,
+        location: &Location::Builtin,
+        type_name: name,
+        type_location: &Location::Builtin,
+        structural: &[],
+    })
+}
+
+fn direction(cos_theta: f32, phi: f32) -> Vec3 {
+    let s = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    Vec3::new(s * phi.cos(), s * phi.sin(), cos_theta)
+}
+
+/// Albedo, consistency, reciprocity and finiteness for one incident direction.
+fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f64, Vec<String>) {
+    let ctx = BsdfContext::default();
+    let mut rng = Pcg32::new(seed, 0xa1be);
+    let mut problems = Vec::new();
+    let mut note = |p: String| {
+        if problems.len() < 5 {
+            problems.push(p);
+        }
+    };
+    let reciprocal = !bsdf.flags().contains(BsdfFlags::TRANSMISSION);
+    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    for _ in 0..samples {
+        let u1 = rng.next_f32();
+        let u2 = Vec2::new(rng.next_f32(), rng.next_f32());
+        if let Some(s) = bsdf.sample_f(&ctx, wo, u1, u2) {
+            let bad = |v: f32| !v.is_finite() || v < 0.0;
+            if bad(s.pdf) || bad(s.f.r) || bad(s.f.g) || bad(s.f.b) || !s.wi.is_finite() {
+                note(format!(
+                    "sample_f returned f = {:?}, pdf = {}, wi = {:?}",
+                    s.f, s.pdf, s.wi
+                ));
+                continue;
+            }
+            if s.pdf == 0.0 {
+                continue;
+            }
+            let weight = (s.f.max_component() * s.wi.z.abs() / s.pdf) as f64;
+            sum += weight;
+            sum2 += weight * weight;
+            if !s.flags.is_specular() {
+                let (pdf, f) = (bsdf.pdf(&ctx, wo, s.wi), bsdf.f(&ctx, wo, s.wi));
+                if (pdf - s.pdf).abs() > 1e-3 * s.pdf.max(pdf) {
+                    note(format!(
+                        "sample_f pdf {} but pdf() = {pdf} at wi = {:?}",
+                        s.pdf, s.wi
+                    ));
+                }
+                if (f - s.f)
+                    .max_component()
+                    .abs()
+                    .max((s.f - f).max_component().abs())
+                    > 1e-3 * f.max_component().max(s.f.max_component())
+                {
+                    note(format!(
+                        "sample_f f {:?} but f() = {f:?} at wi = {:?}",
+                        s.f, s.wi
+                    ));
+                }
+                if reciprocal {
+                    let back = bsdf.f(&ctx, s.wi, wo);
+                    let scale = f.max_component().max(back.max_component());
+                    if (f - back).map(f32::abs).max_component() > 1e-3 * scale {
+                        note(format!(
+                            "not reciprocal: f(wo, wi) = {f:?}, f(wi, wo) = {back:?}, wi = {:?}",
+                            s.wi
+                        ));
+                    }
+                }
+            }
+        }
+        // Evaluation anywhere on the sphere must be finite and non-negative.
+        let wi = warp::square_to_uniform_sphere(u2);
+        let (f, pdf) = (bsdf.f(&ctx, wo, wi), bsdf.pdf(&ctx, wo, wi));
+        if !f.is_finite() || f.min_component() < 0.0 || !pdf.is_finite() || pdf < 0.0 {
+            note(format!("f() = {f:?}, pdf() = {pdf} at wi = {wi:?}"));
+        }
+    }
+    let n = samples as f64;
+    let albedo = sum / n;
+    let se = ((sum2 / n - albedo * albedo).max(0.0) / n).sqrt();
+    if albedo > 1.0 + 4.0 * se + 1e-3 {
+        problems.push(format!(
+            "directional albedo {albedo:.5} > 1 (standard error {se:.5}): creates energy"
+        ));
+    }
+    (albedo, se, problems)
+}
+
+/// Runs every check over the sweep for the BSDF plugin `name`.
+pub fn check_bsdf(
+    registry: &Registry,
+    name: &str,
+    cfg: &BsdfCheckConfig,
+) -> Result<Vec<CaseResult>> {
+    let plugin = registry
+        .find(PluginKind::Bsdf, name)
+        .ok_or_else(|| Error::msg(format!("no bsdf plugin named \"{name}\"")))?;
+    let variants = parameter_sweep(&plugin.spec)?;
+    let cases = variants.len() * cfg.cos_theta_o.len();
+    let chi_cfg = ChiSquareConfig {
+        significance: corrected_significance(cfg.alpha, cases),
+        ..cfg.chi_square
+    };
+    let mut results = Vec::with_capacity(cases);
+    for variant in &variants {
+        let bsdf = instantiate(registry, name, variant)?;
+        for (i, &c) in cfg.cos_theta_o.iter().enumerate() {
+            let wo = direction(c, 0.3 + i as f32);
+            let (sample, pdf) = bsdf_pair(bsdf.as_ref(), wo);
+            let report = chi_square(sample, pdf, &chi_cfg);
+            let (albedo, albedo_se, problems) =
+                check_values(bsdf.as_ref(), wo, cfg.samples, i as u64);
+            results.push(CaseResult {
+                bsdf: name.to_string(),
+                variant: variant.label.clone(),
+                cos_theta_o: c,
+                chi_square: report,
+                albedo,
+                albedo_se,
+                problems,
+            });
+        }
+    }
+    Ok(results)
+}
+
+/// A readable table of results, one line per case, failures explained.
+pub fn format_results(results: &[CaseResult]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "{:<12} {:<28} {:>8} {:>10} {:>9} {:>9} {:>8}  result",
+        "bsdf", "parameters", "cos_o", "p-value", "pdf int", "sampled", "albedo"
+    );
+    for r in results {
+        let c = &r.chi_square;
+        let _ = writeln!(
+            out,
+            "{:<12} {:<28} {:>8} {:>10.3e} {:>9.5} {:>9.5} {:>8.4}  {}",
+            r.bsdf,
+            r.variant,
+            r.cos_theta_o,
+            c.p_value,
+            c.pdf_integral,
+            c.sampled_fraction,
+            r.albedo,
+            if r.passed() { "ok" } else { "FAILED" }
+        );
+        if let Some(d) = &c.defect {
+            let _ = writeln!(out, "    chi-square: {d}");
+        }
+        if !c.passed && c.defect.is_none() {
+            let _ = writeln!(
+                out,
+                "    chi-square: statistic {:.1} with {} degrees of freedom",
+                c.statistic, c.degrees_of_freedom
+            );
+        }
+        for p in &r.problems {
+            let _ = writeln!(out, "    {p}");
+        }
+    }
+    let failed = results.iter().filter(|r| !r.passed()).count();
+    let _ = writeln!(out, "{} passed, {} failed", results.len() - failed, failed);
+    out
+}
+
+/// Writes observed (left) and expected (right) histograms side by side as a
+/// PNG: rows are cos theta from -1 (top) to 1, columns phi.
+pub fn write_histogram_png(
+    report: &ChiSquareReport,
+    cfg: &ChiSquareConfig,
+    path: &Path,
+) -> Result<()> {
+    let (w, h) = (cfg.phi_bins, cfg.z_bins);
+    let gap = 2;
+    let mut image = lumis_image::Image::new(2 * w + gap, h);
+    let max = report
+        .observed
+        .iter()
+        .chain(&report.expected)
+        .fold(0.0f64, |m, &v| m.max(v))
+        .max(1.0);
+    for z in 0..h {
+        for phi in 0..w {
+            let i = z * w + phi;
+            let o = (report.observed[i] / max) as f32;
+            let e = (report.expected[i] / max) as f32;
+            image.set(phi, z, [o, o, o]);
+            image.set(w + gap + phi, z, [e, e, e]);
+        }
+        for x in w..w + gap {
+            image.set(x, z, [1.0, 0.0, 0.0]);
+        }
+    }
+    lumis_image::write_png(path, &image).map_err(|e| Error::msg(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lumis_core::ParamSpec;
+
+    const SPEC: PluginSpec = PluginSpec {
+        kind: PluginKind::Bsdf,
+        name: "t",
+        doc: "",
+        params: &[
+            ParamSpec::required("albedo", ParamType::Rgb, ""),
+            ParamSpec::with_default("roughness", ParamType::Float, "0.5", "").in_range(1e-4, 1.0),
+            ParamSpec::with_default("mode", ParamType::String, "\"a\"", "").one_of(&["a", "b"]),
+            ParamSpec::with_default("two_sided", ParamType::Bool, "false", ""),
+        ],
+    };
+
+    #[test]
+    fn sweep_covers_range_ends_choices_and_booleans() {
+        let labels: Vec<String> = parameter_sweep(&SPEC)
+            .unwrap()
+            .into_iter()
+            .map(|v| v.label)
+            .collect();
+        for want in [
+            "base",
+            "roughness = 0.0001",
+            "roughness = 1.0",
+            "mode = \"a\"",
+            "mode = \"b\"",
+            "two_sided = true",
+            "two_sided = false",
+        ] {
+            assert!(
+                labels.iter().any(|l| l == want),
+                "missing {want} in {labels:?}"
+            );
+        }
+    }
+}
