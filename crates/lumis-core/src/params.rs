@@ -525,12 +525,6 @@ fn accepted(spec: &[ParamSpec], structural: &[&str]) -> String {
     }
 }
 
-/// A shorthand used by tests and programmatic scenes: parses `text` as a
-/// TOML table.
-pub fn table_from_toml(text: &str) -> Result<Table> {
-    crate::doc::parse(text, "<inline>")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

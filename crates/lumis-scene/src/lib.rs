@@ -14,8 +14,8 @@ use std::sync::Arc;
 use lumis_core::doc::{self, Node, Table, Value};
 use lumis_core::registry::TableRef;
 use lumis_core::{
-    Bsdf, Error, Integrator, Light, LightKind, LightShape, Location, ParamSpec, ParamType, Params,
-    Registry, Result, Sampler, UVec2, Vec3,
+    Bsdf, Error, Integrator, Light, LightKind, LightSampler, LightShape, Location, ParamSpec,
+    ParamType, Params, Registry, Result, Sampler, UVec2, Vec3,
 };
 use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
 use lumis_render::PerspectiveCamera;
@@ -126,57 +126,12 @@ pub fn load_str(
         line: 1,
         column: 1,
     };
-    for entry in &root.entries {
-        if !TOP_LEVEL_KEYS.contains(&entry.key.as_str()) {
-            return Err(Error::at(
-                &entry.key_location,
-                format!(
-                    "unknown top-level key '{}'; accepted: {}",
-                    entry.key,
-                    TOP_LEVEL_KEYS.join(", ")
-                ),
-            ));
-        }
-    }
-    let seed = match root.get("seed") {
-        None => 0,
-        Some(node) => match node.value {
-            Value::Int(s) if s >= 0 => s as u64,
-            _ => {
-                return Err(Error::at(
-                    &node.location,
-                    "seed: expected a non-negative integer",
-                ))
-            }
-        },
-    };
-
+    check_top_level_keys(&root)?;
+    let seed = seed_of(&root)?;
     // Plugins the scene loads go into a copy of the registry: the caller's
     // stays as it was, and nothing but what this scene names is registered.
-    let with_scene_plugins;
-    let registry = match root.get("plugins") {
-        None => registry,
-        Some(node) => {
-            let table = as_table(node, "plugins")?;
-            let params = Params::new(
-                "[plugins]",
-                table,
-                node.location.clone(),
-                PLUGINS_PARAMS,
-                &[],
-            )?;
-            let libraries: Vec<String> = params.get("load")?;
-            params.finish()?;
-            let mut extended = registry.clone();
-            for library in libraries {
-                lumis_loader::load_library(&dir.join(&library), &mut extended).map_err(|e| {
-                    Error::at(&node.location, format!("[plugins] load: {}", e.message))
-                })?;
-            }
-            with_scene_plugins = extended;
-            &with_scene_plugins
-        }
-    };
+    let scene_registry = with_scene_plugins(&root, registry, dir)?;
+    let registry = scene_registry.as_ref().unwrap_or(registry);
 
     let (camera, output) = film_and_camera(&root, &file_location, dir)?;
     let bsdfs = named_bsdfs(&root, registry)?;
@@ -217,42 +172,8 @@ pub fn load_str(
 
     let embree = builder.commit().map_err(embree_error)?;
     let (center, radius) = render_scene::bounding_sphere(&embree);
-    let mut infinite_lights = Vec::new();
-    for (i, light) in lights.iter_mut().enumerate() {
-        light.preprocess(center, radius);
-        match light.kind() {
-            LightKind::Infinite => {
-                infinite_lights.push(i as u32);
-                counts.infinite_lights += 1;
-            }
-            LightKind::DeltaPosition => counts.delta_lights += 1,
-            LightKind::Area => {}
-        }
-    }
-
-    let light_sampler = {
-        let default_table = Table::default();
-        let (table, location) = match root.get("light_sampler") {
-            Some(node) => (as_table(node, "light_sampler")?, node.location.clone()),
-            None => (&default_table, Location::Builtin),
-        };
-        let (kind, kind_location) = match table.get("type") {
-            Some(_) => type_of(table, &location, "light_sampler")?,
-            None => ("uniform", Location::Builtin),
-        };
-        registry.create_light_sampler(
-            &TableRef {
-                owner: "light_sampler",
-                table,
-                location: &location,
-                type_name: kind,
-                type_location: &kind_location,
-                structural: &["type"],
-            },
-            &lights,
-        )?
-    };
-
+    let infinite_lights = classify_lights(&mut lights, center, radius, &mut counts);
+    let light_sampler = light_sampler_of(&root, registry, &lights)?;
     let sampler = registry
         .create_sampler(&PluginTable::required(&root, "sampler", &file_location)?.as_ref())?;
     let integrator = registry
@@ -276,6 +197,112 @@ pub fn load_str(
         seed,
         output,
     })
+}
+
+fn check_top_level_keys(root: &Table) -> Result<()> {
+    match root
+        .entries
+        .iter()
+        .find(|e| !TOP_LEVEL_KEYS.contains(&e.key.as_str()))
+    {
+        Some(entry) => Err(Error::at(
+            &entry.key_location,
+            format!(
+                "unknown top-level key '{}'; accepted: {}",
+                entry.key,
+                TOP_LEVEL_KEYS.join(", ")
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+fn seed_of(root: &Table) -> Result<u64> {
+    match root.get("seed") {
+        None => Ok(0),
+        Some(node) => match node.value {
+            Value::Int(s) if s >= 0 => Ok(s as u64),
+            _ => Err(Error::at(
+                &node.location,
+                "seed: expected a non-negative integer",
+            )),
+        },
+    }
+}
+
+/// A copy of `registry` extended with the libraries of `[plugins] load`,
+/// or `None` when the scene loads none.
+fn with_scene_plugins(root: &Table, registry: &Registry, dir: &Path) -> Result<Option<Registry>> {
+    let Some(node) = root.get("plugins") else {
+        return Ok(None);
+    };
+    let table = as_table(node, "plugins")?;
+    let params = Params::new(
+        "[plugins]",
+        table,
+        node.location.clone(),
+        PLUGINS_PARAMS,
+        &[],
+    )?;
+    let libraries: Vec<String> = params.get("load")?;
+    let mut extended = registry.clone();
+    for library in libraries {
+        lumis_loader::load_library(&dir.join(&library), &mut extended)
+            .map_err(|e| params.error("load", e.message))?;
+    }
+    params.finish()?;
+    Ok(Some(extended))
+}
+
+/// Hands infinite lights the scene bounds, counts lights by kind and
+/// returns the indices of the infinite ones.
+fn classify_lights(
+    lights: &mut [Box<dyn Light>],
+    center: Vec3,
+    radius: f32,
+    counts: &mut SceneCounts,
+) -> Vec<u32> {
+    let mut infinite = Vec::new();
+    for (i, light) in lights.iter_mut().enumerate() {
+        light.preprocess(center, radius);
+        match light.kind() {
+            LightKind::Infinite => {
+                infinite.push(i as u32);
+                counts.infinite_lights += 1;
+            }
+            LightKind::DeltaPosition => counts.delta_lights += 1,
+            LightKind::Area => {}
+        }
+    }
+    infinite
+}
+
+/// The `[light_sampler]` table's plugin, `uniform` when absent.
+fn light_sampler_of(
+    root: &Table,
+    registry: &Registry,
+    lights: &[Box<dyn Light>],
+) -> Result<Box<dyn LightSampler>> {
+    let default_table = Table::default();
+    let (table, location) = match root.get("light_sampler") {
+        Some(node) => (as_table(node, "light_sampler")?, node.location.clone()),
+        None => (&default_table, Location::Builtin),
+    };
+    let (kind, kind_location) = match table.get("type") {
+        Some(_) => type_of(table, &location, "light_sampler")?,
+        None => ("uniform", Location::Builtin),
+    };
+    registry.create_light_sampler(
+        &TableRef {
+            owner: "light_sampler",
+            table,
+            location: &location,
+            type_name: kind,
+            type_location: &kind_location,
+            structural: &["type"],
+        },
+        lights,
+    )
 }
 
 /// A plugin table of the scene with its `type` resolved.
