@@ -3,7 +3,9 @@
 
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{LightSample, ParamSpec, ParamType, Params, Result, Rgb, Vec3};
+use lumis_core::{
+    Light, LightKind, LightSample, ParamSpec, ParamType, Params, Result, Rgb, Vec2, Vec3,
+};
 
 /// The keys of a shape's `emission = { ... }` table.
 pub const EMISSION_PARAMS: &[ParamSpec] = &[
@@ -102,5 +104,64 @@ pub fn area_pdf(t: f32, wi: Vec3, n: Vec3, area: f32, emission: &Emission) -> f3
         pdf
     } else {
         0.0
+    }
+}
+
+/// A flat shape that an area light can be attached to.
+pub trait PlanarShape: Send + Sync {
+    fn area(&self) -> f32;
+
+    /// Unit normal on the emitting (front) side.
+    fn normal(&self) -> Vec3;
+
+    /// A point distributed uniformly by area, with its error bound.
+    fn sample_point(&self, u: Vec2) -> SurfacePoint;
+
+    /// The `t > 0` at which `o + t w` (unit `w`) crosses the shape.
+    fn intersect(&self, o: Vec3, w: Vec3) -> Option<f32>;
+}
+
+/// Constant emission from a planar shape, sampled uniformly by area
+/// (pbrt-v4 `DiffuseAreaLight` without textures).
+#[derive(Debug, Clone)]
+pub struct AreaLight<S> {
+    pub(crate) shape: S,
+    pub(crate) emission: Emission,
+}
+
+impl<S: PlanarShape> Light for AreaLight<S> {
+    fn kind(&self) -> LightKind {
+        LightKind::Area
+    }
+
+    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
+        area_sample(
+            ctx,
+            self.shape.sample_point(u),
+            self.shape.area(),
+            &self.emission,
+        )
+    }
+
+    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
+        let wi = wi.normalize();
+        match self.shape.intersect(ctx.p(), wi) {
+            Some(t) => area_pdf(
+                t,
+                wi,
+                self.shape.normal(),
+                self.shape.area(),
+                &self.emission,
+            ),
+            None => 0.0,
+        }
+    }
+
+    fn l(&self, _p: Vec3, n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
+        self.emission.radiance_toward(n, w)
+    }
+
+    fn power(&self) -> Rgb {
+        self.emission.power(self.shape.area())
     }
 }

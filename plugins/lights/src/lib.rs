@@ -7,11 +7,11 @@ mod point;
 mod quad;
 mod triangle;
 
-pub use area::Emission;
+pub use area::{AreaLight, Emission, PlanarShape};
 pub use constant::ConstantLight;
 pub use point::PointLight;
-pub use quad::QuadLight;
-pub use triangle::TriangleLight;
+pub use quad::{Quad, QuadLight};
+pub use triangle::{Triangle, TriangleLight};
 
 use lumis_core::{Registry, Result};
 

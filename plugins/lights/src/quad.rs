@@ -1,14 +1,10 @@
 //! `quad`: a parallelogram emitter, sampled uniformly by area.
 
-use lumis_core::interaction::LightSampleContext;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb,
-    Vec2, Vec3,
-};
+use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
 
-use crate::area::{area_pdf, area_sample, Emission, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, PlanarShape, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -17,15 +13,18 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: EMISSION_PARAMS,
 };
 
+/// A parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`.
 #[derive(Debug, Clone)]
-pub struct QuadLight {
+pub struct Quad {
     corner: Vec3,
     edge_u: Vec3,
     edge_v: Vec3,
     normal: Vec3,
     area: f32,
-    emission: Emission,
 }
+
+/// The emission of a quad shape.
+pub type QuadLight = AreaLight<Quad>;
 
 impl QuadLight {
     pub fn new(corner: Vec3, edge_u: Vec3, edge_v: Vec3, emission: Emission) -> Result<Self> {
@@ -36,14 +35,14 @@ impl QuadLight {
                 "quad light: the edges are parallel or degenerate (zero area)",
             ));
         }
-        Ok(Self {
+        let shape = Quad {
             corner,
             edge_u,
             edge_v,
             normal: cross / area,
             area,
-            emission,
-        })
+        };
+        Ok(Self { shape, emission })
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
@@ -56,11 +55,29 @@ impl QuadLight {
             ))),
         }
     }
+}
 
-    /// Where the ray `o + t wi` crosses the quad, as `t`.
-    #[inline]
-    fn intersect(&self, o: Vec3, wi: Vec3) -> Option<f32> {
-        let denom = self.normal.dot(wi);
+impl PlanarShape for Quad {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    fn sample_point(&self, u: Vec2) -> SurfacePoint {
+        let su = self.edge_u * u.x;
+        let sv = self.edge_v * u.y;
+        SurfacePoint {
+            p: self.corner + su + sv,
+            p_error: gamma(6) * (self.corner.abs() + su.abs() + sv.abs()),
+            n: self.normal,
+        }
+    }
+
+    fn intersect(&self, o: Vec3, w: Vec3) -> Option<f32> {
+        let denom = self.normal.dot(w);
         if denom == 0.0 {
             return None;
         }
@@ -68,7 +85,7 @@ impl QuadLight {
         if t.is_nan() || t <= 0.0 {
             return None;
         }
-        let d = o + wi * t - self.corner;
+        let d = o + w * t - self.corner;
         // Coordinates along the (possibly non-orthogonal) edges.
         let uu = self.edge_u.length_squared();
         let vv = self.edge_v.length_squared();
@@ -82,47 +99,10 @@ impl QuadLight {
     }
 }
 
-impl Light for QuadLight {
-    fn kind(&self) -> LightKind {
-        LightKind::Area
-    }
-
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        let su = self.edge_u * u.x;
-        let sv = self.edge_v * u.y;
-        let point = SurfacePoint {
-            p: self.corner + su + sv,
-            p_error: gamma(6) * (self.corner.abs() + su.abs() + sv.abs()),
-            n: self.normal,
-        };
-        area_sample(ctx, point, self.area, &self.emission)
-    }
-
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
-        match self.intersect(ctx.p(), wi) {
-            Some(t) => area_pdf(
-                t * wi.length(),
-                wi.normalize(),
-                self.normal,
-                self.area,
-                &self.emission,
-            ),
-            None => 0.0,
-        }
-    }
-
-    fn l(&self, _p: Vec3, n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        self.emission.radiance_toward(n, w)
-    }
-
-    fn power(&self) -> Rgb {
-        self.emission.power(self.area)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lumis_core::{Light, LightSampleContext, Rgb};
     use lumis_sampling::Pcg32;
 
     fn light() -> QuadLight {

@@ -1,15 +1,11 @@
 //! `triangle`: one emissive triangle of a mesh, sampled uniformly by area.
 
-use lumis_core::interaction::LightSampleContext;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginSpec, Result, Rgb,
-    Vec2, Vec3,
-};
+use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
 use lumis_sampling::warp;
 
-use crate::area::{area_pdf, area_sample, Emission, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, PlanarShape, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -18,13 +14,16 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: EMISSION_PARAMS,
 };
 
+/// A triangle; its front faces `(p1 - p0) x (p2 - p0)`.
 #[derive(Debug, Clone)]
-pub struct TriangleLight {
+pub struct Triangle {
     p: [Vec3; 3],
     normal: Vec3,
     area: f32,
-    emission: Emission,
 }
+
+/// The emission of one mesh triangle.
+pub type TriangleLight = AreaLight<Triangle>;
 
 impl TriangleLight {
     pub fn new(p: [Vec3; 3], emission: Emission) -> Result<Self> {
@@ -35,12 +34,12 @@ impl TriangleLight {
                 "triangle light: degenerate triangle (zero area)",
             ));
         }
-        Ok(Self {
+        let shape = Triangle {
             p,
             normal: cross / len,
             area: 0.5 * len,
-            emission,
-        })
+        };
+        Ok(Self { shape, emission })
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
@@ -53,9 +52,30 @@ impl TriangleLight {
             ))),
         }
     }
+}
 
-    /// Möller-Trumbore ray/triangle test, returning `t` (1997, JGT 2(1)).
-    #[inline]
+impl PlanarShape for Triangle {
+    fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn normal(&self) -> Vec3 {
+        self.normal
+    }
+
+    fn sample_point(&self, u: Vec2) -> SurfacePoint {
+        let b = warp::square_to_uniform_triangle(u);
+        let (b0, b1, b2) = (b.x, b.y, 1.0 - b.x - b.y);
+        let (q0, q1, q2) = (self.p[0] * b0, self.p[1] * b1, self.p[2] * b2);
+        SurfacePoint {
+            p: q0 + q1 + q2,
+            // pbrt-v4 Triangle::Sample: gamma(6) (|b0 p0| + |b1 p1| + |b2 p2|).
+            p_error: gamma(6) * (q0.abs() + q1.abs() + q2.abs()),
+            n: self.normal,
+        }
+    }
+
+    /// Moller-Trumbore ray/triangle test (1997, JGT 2(1)).
     fn intersect(&self, o: Vec3, d: Vec3) -> Option<f32> {
         let e1 = self.p[1] - self.p[0];
         let e2 = self.p[2] - self.p[0];
@@ -80,44 +100,10 @@ impl TriangleLight {
     }
 }
 
-impl Light for TriangleLight {
-    fn kind(&self) -> LightKind {
-        LightKind::Area
-    }
-
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        let b = warp::square_to_uniform_triangle(u);
-        let (b0, b1, b2) = (b.x, b.y, 1.0 - b.x - b.y);
-        let (q0, q1, q2) = (self.p[0] * b0, self.p[1] * b1, self.p[2] * b2);
-        let point = SurfacePoint {
-            p: q0 + q1 + q2,
-            // pbrt-v4 Triangle::Sample: gamma(6) (|b0 p0| + |b1 p1| + |b2 p2|).
-            p_error: gamma(6) * (q0.abs() + q1.abs() + q2.abs()),
-            n: self.normal,
-        };
-        area_sample(ctx, point, self.area, &self.emission)
-    }
-
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
-        let wi = wi.normalize();
-        match self.intersect(ctx.p(), wi) {
-            Some(t) => area_pdf(t, wi, self.normal, self.area, &self.emission),
-            None => 0.0,
-        }
-    }
-
-    fn l(&self, _p: Vec3, n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {
-        self.emission.radiance_toward(n, w)
-    }
-
-    fn power(&self) -> Rgb {
-        self.emission.power(self.area)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lumis_core::{Light, LightSampleContext, Rgb};
     use lumis_sampling::Pcg32;
 
     #[test]
