@@ -164,6 +164,24 @@ mod tests {
     }
 
     #[test]
+    fn far_and_tiny_stays_consistent() {
+        // 1e4 units below a unit quad: the solid angle is ~1e-8 sr, far too
+        // small for a chi-square histogram; sample_li and pdf_li must still
+        // agree and stay finite.
+        let l = light();
+        let ctx = LightSampleContext::at(Vec3::new(0.1, -1e4, 0.2));
+        let mut rng = Pcg32::new(7, 8);
+        for _ in 0..1000 {
+            let s = l
+                .sample_li(&ctx, Vec2::new(rng.next_f32(), rng.next_f32()))
+                .unwrap();
+            let pdf = l.pdf_li(&ctx, s.wi);
+            assert!(s.pdf.is_finite() && s.pdf > 1e7, "{}", s.pdf);
+            assert!((s.pdf - pdf).abs() < 1e-2 * pdf, "{} vs {pdf}", s.pdf);
+        }
+    }
+
+    #[test]
     fn back_side_does_not_emit() {
         let l = light();
         let ctx = LightSampleContext::at(Vec3::new(0.0, 2.0, 0.0));
