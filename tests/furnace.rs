@@ -9,9 +9,9 @@
 
 use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 
-/// 3 strategies x 3 scenes x 3 channels, overall false-alarm rate 1e-3.
+/// 3 strategies x 6 scenes x 3 channels, overall false-alarm rate 1e-3.
 fn z_limit() -> f64 {
-    bonferroni_z(1e-3, 27)
+    bonferroni_z(1e-3, 54)
 }
 
 fn check_uniform_image(toml: &str, strategy: &str, expected: [f64; 3]) {
@@ -63,8 +63,9 @@ fn albedo_one_sphere_in_constant_light_is_invisible() {
     }
 }
 
-/// Six outward-facing quads flipped to face the inside of [-1, 1]^3.
-fn emissive_cube(albedo: f64, max_depth: u32) -> String {
+/// Six outward-facing quads flipped to face the inside of [-s, s]^3,
+/// offset by `shift` (to put the box far from the origin).
+fn emissive_cube(albedo: f64, max_depth: u32, scale: f64, shift: f64) -> String {
     let faces = [
         ([1, -1, -1], [0, 2, 0], [0, 0, 2]),
         ([-1, -1, -1], [0, 0, 2], [0, 2, 0]),
@@ -79,8 +80,8 @@ fn emissive_cube(albedo: f64, max_depth: u32) -> String {
 resolution = [16, 16]
 [camera]
 type = "perspective"
-origin = [0.1, -0.2, 0.05]
-target = [0.3, 0.1, 1.0]
+origin = [{cx}, {cy}, {cz}]
+target = [{tx}, {ty}, {tz}]
 fov = 100.0
 [sampler]
 type = "independent"
@@ -93,15 +94,22 @@ rr_depth = 100000
 name = "grey"
 type = "diffuse"
 reflectance = {albedo}
-"#
+"#,
+        cx = shift + 0.1 * scale,
+        cy = shift - 0.2 * scale,
+        cz = shift + 0.05 * scale,
+        tx = shift + 0.3 * scale,
+        ty = shift + 0.1 * scale,
+        tz = shift + scale,
     );
-    let v = |a: [i32; 3]| format!("[{}.0, {}.0, {}.0]", a[0], a[1], a[2]);
+    let point = |a: [i32; 3]| format!("{:?}", a.map(|c| shift + c as f64 * scale));
+    let edge = |a: [i32; 3]| format!("{:?}", a.map(|c| c as f64 * scale));
     for (corner, u, w) in faces {
         toml += &format!(
             "[[shape]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nbsdf = \"grey\"\nflip_normals = true\nemission = {{ radiance = [1.0, 0.5, 0.25] }}\n",
-            v(corner),
-            v(u),
-            v(w)
+            point(corner),
+            edge(u),
+            edge(w)
         );
     }
     toml
@@ -111,7 +119,24 @@ reflectance = {albedo}
 fn closed_emissive_box_reproduces_the_neumann_series() {
     for (albedo, depth) in [(0.5f64, 8u32), (0.9, 60)] {
         let series: f64 = (0..depth).map(|k| albedo.powi(k as i32)).sum();
-        let toml = emissive_cube(albedo, depth);
+        let toml = emissive_cube(albedo, depth, 1.0, 0.0);
+        for strategy in ["bsdf", "light", "mis"] {
+            check_uniform_image(&toml, strategy, [series, 0.5 * series, 0.25 * series]);
+        }
+    }
+}
+
+/// The same closed box at 1e-4 and 1e5 units, and 100 units wide 1e4 units
+/// from the origin:
+/// self-intersection (acne) would lose energy and leaks would let paths
+/// escape, both of which change the series. Ray origins are offset by
+/// rounding-error bounds, not by a fixed epsilon, so every scale works.
+#[test]
+fn tiny_huge_and_far_scenes_have_no_acne_or_leaks() {
+    let (albedo, depth) = (0.8f64, 12u32);
+    let series: f64 = (0..depth).map(|k| albedo.powi(k as i32)).sum();
+    for (scale, shift) in [(1e-4, 0.0), (1e5, 0.0), (100.0, 1e4)] {
+        let toml = emissive_cube(albedo, depth, scale, shift);
         for strategy in ["bsdf", "light", "mis"] {
             check_uniform_image(&toml, strategy, [series, 0.5 * series, 0.25 * series]);
         }
