@@ -101,9 +101,9 @@ fn describe(loaded: &LoadedScene) -> String {
         c.infinite_lights,
         if c.shading_normals { "interpolated" } else { "flat (none stored)" },
         if c.area_lights + c.infinite_lights > 0 {
-            "used where the integrator's strategy asks for it"
+            "can matter (lights that BSDF rays can hit)"
         } else {
-            "never needed (only delta lights)"
+            "cannot matter (only delta lights: light sampling gets weight 1)"
         },
     )
 }
