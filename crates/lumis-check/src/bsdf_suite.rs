@@ -351,8 +351,9 @@ pub fn write_histogram_png(
     for z in 0..h {
         for phi in 0..w {
             let i = z * w + phi;
-            let o = (report.observed[i] / max) as f32;
-            let e = (report.expected[i] / max) as f32;
+            // Square root so that low-count bins stay visible beside a peak.
+            let o = (report.observed[i] / max).sqrt() as f32;
+            let e = (report.expected[i] / max).sqrt() as f32;
             image.set(phi, z, [o, o, o]);
             image.set(w + gap + phi, z, [e, e, e]);
         }
