@@ -7,7 +7,9 @@
 //!
 //! The ratio lumis/bare of rays per second says how much throughput
 //! everything that is not traversal (sampling, shading, light sampling, MIS,
-//! film) costs: 0.5 means as much time outside Embree as inside it.
+//! film) costs: 0.5 means as much time outside Embree as inside it. A second
+//! bare loop makes each ray wait for the previous one, as a path tracer's
+//! rays do, to show how much of the gap is lost overlap rather than work.
 //!
 //! `cargo bench -p lumis-cli --bench embree_overhead [-- SCENE.toml SPP]`
 
@@ -98,6 +100,7 @@ fn main() {
     let repeats = 5;
     let mut lumis_best = f64::INFINITY;
     let mut bare_best = f64::INFINITY;
+    let mut dependent_best = f64::INFINITY;
     let mut stats = None;
     for _ in 0..repeats {
         let out = run(&loaded.scene);
@@ -106,6 +109,10 @@ fn main() {
         let start = Instant::now();
         let hits = bare::trace(loaded.scene.embree(), &rays);
         bare_best = bare_best.min(start.elapsed().as_secs_f64());
+        std::hint::black_box(hits);
+        let start = Instant::now();
+        let hits = bare::trace_dependent(loaded.scene.embree(), &rays);
+        dependent_best = dependent_best.min(start.elapsed().as_secs_f64());
         std::hint::black_box(hits);
     }
     let stats = stats.unwrap();
@@ -136,7 +143,16 @@ fn main() {
         bare_rate * 1e-6
     );
     println!(
+        "bare Embree loop, each ray waiting for the previous one: {:.3} s, {:.2} Mrays/s",
+        dependent_best,
+        n / dependent_best * 1e-6
+    );
+    println!(
         "ratio lumis/bare rays per second: {:.3}",
         lumis_rate / bare_rate
+    );
+    println!(
+        "ratio lumis/dependent bare rays per second: {:.3}",
+        lumis_rate / (n / dependent_best)
     );
 }

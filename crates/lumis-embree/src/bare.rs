@@ -18,11 +18,29 @@ pub struct BareRay {
 /// Traces every ray through `embree4-sys` directly; returns how many hit
 /// (or were occluded), so the work cannot be optimised away.
 pub fn trace(scene: &Scene, rays: &[BareRay]) -> u64 {
+    trace_impl(scene, rays, false)
+}
+
+/// As [`trace`], but each ray's origin is made to depend (through an
+/// opaque zero mask) on the previous ray's result, as in a path tracer
+/// where the next ray starts where the last one hit. The rays are the same;
+/// only the CPU's freedom to overlap consecutive queries is taken away.
+pub fn trace_dependent(scene: &Scene, rays: &[BareRay]) -> u64 {
+    trace_impl(scene, rays, true)
+}
+
+fn trace_impl(scene: &Scene, rays: &[BareRay], dependent: bool) -> u64 {
     let raw = scene.raw();
+    let mask = std::hint::black_box(0u32);
+    let mut previous = 0u32;
     let mut hits = 0;
     for r in rays {
+        let mut org = r.org;
+        if dependent {
+            org[0] = f32::from_bits(org[0].to_bits() ^ (previous & mask));
+        }
         let ray = raw_ray(&Ray {
-            org: r.org,
+            org,
             dir: r.dir,
             tnear: 0.0,
             tfar: r.tfar,
@@ -32,6 +50,7 @@ pub fn trace(scene: &Scene, rays: &[BareRay]) -> u64 {
             // SAFETY: committed, live scene; valid RTCRay; default arguments.
             unsafe { sys::rtcOccluded1(raw, &mut ray, std::ptr::null_mut()) };
             hits += u64::from(ray.tfar == f32::NEG_INFINITY);
+            previous = ray.tfar.to_bits();
         } else {
             let mut rayhit = sys::RTCRayHit {
                 ray,
@@ -40,6 +59,7 @@ pub fn trace(scene: &Scene, rays: &[BareRay]) -> u64 {
             // SAFETY: as above, with a properly aligned RTCRayHit.
             unsafe { sys::rtcIntersect1(raw, &mut rayhit, std::ptr::null_mut()) };
             hits += u64::from(rayhit.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID);
+            previous = rayhit.ray.tfar.to_bits();
         }
     }
     hits
