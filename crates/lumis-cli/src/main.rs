@@ -22,34 +22,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a TOML scene to PATH.exr (linear float RGB) and PATH.png (sRGB).
-    Render {
-        /// The scene file.
-        scene: PathBuf,
-        /// Samples per pixel (overrides sampler.spp).
-        #[arg(long)]
-        spp: Option<u32>,
-        /// Random seed (overrides the scene's top-level seed).
-        #[arg(long)]
-        seed: Option<u64>,
-        /// Worker threads; 0 or absent means one per core.
-        #[arg(long, default_value_t = 0)]
-        threads: usize,
-        /// Output path: writes PATH.exr and PATH.png [default: the scene's
-        /// film.output, else SCENE-NAME.exr in the current directory].
-        #[arg(long, short)]
-        output: Option<PathBuf>,
-        /// Override any scene value, e.g. --set integrator.max_depth=3,
-        /// --set bsdf.white.reflectance=[0.5,0.5,0.5], --set sampler.type=independent.
-        /// Arrays of tables are addressed by name or index (shape.0.file).
-        #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
-        set: Vec<String>,
-        /// No progress bar.
-        #[arg(long, short)]
-        quiet: bool,
-        /// Print what the loader decided the scene needs.
-        #[arg(long, short)]
-        verbose: bool,
-    },
+    Render(RenderArgs),
     /// List every plugin (built-in, and libraries on LUMIS_PLUGIN_PATH or
     /// given with --load) with its parameters: name, type, default, meaning.
     Plugins {
@@ -83,26 +56,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render {
-            scene,
-            spp,
-            seed,
-            threads,
-            output,
-            set,
-            quiet,
-            verbose,
-        } => registry_with_search_path().and_then(|registry| {
-            let args = RenderArgs {
-                scene,
-                spp,
-                seed,
-                threads,
-                output,
-                set,
-                progress: !quiet,
-                verbose,
-            };
+        Command::Render(args) => registry_with_search_path().and_then(|registry| {
             render_scene_file(&args, &registry).map(|report| {
                 println!("{}", report.summary());
                 true

@@ -7,18 +7,34 @@ use lumis_image::Image;
 use lumis_render::{render, RenderSettings};
 use lumis_scene::LoadedScene;
 
-/// What `lumis render` was asked to do.
-#[derive(Debug, Clone, Default)]
+/// What `lumis render` was asked to do; also its command-line flags.
+#[derive(Debug, Clone, Default, clap::Args)]
 pub struct RenderArgs {
+    /// The scene file.
     pub scene: PathBuf,
+    /// Samples per pixel (overrides sampler.spp).
+    #[arg(long)]
     pub spp: Option<u32>,
+    /// Random seed (overrides the scene's top-level seed).
+    #[arg(long)]
     pub seed: Option<u64>,
-    /// 0 = one thread per core.
+    /// Worker threads; 0 or absent means one per core.
+    #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Output path: writes PATH.exr and PATH.png [default: the scene's
+    /// film.output, else SCENE-NAME.exr in the current directory].
+    #[arg(long, short)]
     pub output: Option<PathBuf>,
-    /// `key.path=value` overrides, applied in order.
+    /// Override any scene value, e.g. --set integrator.max_depth=3,
+    /// --set bsdf.white.reflectance=[0.5,0.5,0.5], --set sampler.type=independent.
+    /// Arrays of tables are addressed by name or index (shape.0.file).
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     pub set: Vec<String>,
-    pub progress: bool,
+    /// No progress bar.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Print what the loader decided the scene needs.
+    #[arg(long, short)]
     pub verbose: bool,
 }
 
@@ -137,7 +153,7 @@ pub fn render_scene_file(
         spp: loaded.sampler.samples_per_pixel(),
         seed: loaded.seed,
         threads: args.threads,
-        progress: args.progress,
+        progress: !args.quiet,
     };
     let out = render(
         &loaded.camera,
