@@ -6,6 +6,7 @@
 //! read: [`Params::finish`] rejects keys that were given but not used, so a
 //! typo or a setting that does not apply never falls back silently.
 
+use std::borrow::Cow;
 use std::cell::RefCell;
 
 use glam::{UVec2, Vec2, Vec3};
@@ -368,11 +369,13 @@ impl<'a> Params<'a> {
     }
 
     /// The node for `name` (given, or its default), marking it read.
-    fn node(&self, name: &str) -> Result<Option<(Node, bool)>> {
+    /// Borrowed when the table has it, so large values (mesh positions) are
+    /// not copied before conversion; defaults are parsed on demand.
+    fn node(&self, name: &str) -> Result<Option<Cow<'a, Node>>> {
         let i = self.spec_index(name);
         self.read.borrow_mut()[i] = true;
         if let Some(node) = self.table.get(name) {
-            return Ok(Some((node.clone(), true)));
+            return Ok(Some(Cow::Borrowed(node)));
         }
         match self.spec[i].default {
             ParamDefault::Required => Err(Error::at(
@@ -385,7 +388,7 @@ impl<'a> Params<'a> {
                 ),
             )),
             ParamDefault::Absent => Ok(None),
-            ParamDefault::Value(_) => Ok(self.spec[i].default_node()?.map(|n| (n, false))),
+            ParamDefault::Value(_) => Ok(self.spec[i].default_node()?.map(Cow::Owned)),
         }
     }
 
@@ -397,7 +400,7 @@ impl<'a> Params<'a> {
     /// The value of `name`, or its declared default.
     pub fn get<T: FromParam>(&self, name: &str) -> Result<T> {
         match self.node(name)? {
-            Some((node, _)) => self.convert(name, &node),
+            Some(node) => self.convert(name, &node),
             None => Err(Error::at(
                 &self.location,
                 format!(
@@ -411,7 +414,7 @@ impl<'a> Params<'a> {
     /// The value of `name` if given (or defaulted), `None` if absent.
     pub fn get_opt<T: FromParam>(&self, name: &str) -> Result<Option<T>> {
         match self.node(name)? {
-            Some((node, _)) => self.convert(name, &node).map(Some),
+            Some(node) => self.convert(name, &node).map(Some),
             None => Ok(None),
         }
     }
