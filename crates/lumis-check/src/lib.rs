@@ -4,13 +4,16 @@
 //! exactly as the pdf it claims, with Pearson's chi-square test over a grid
 //! of equal-solid-angle bins (the approach of Mitsuba's and pbrt's sampling
 //! tests). [`adapters`] turn a BSDF's `sample_f`/`pdf` or a light's
-//! `sample_li`/`pdf_li` into such a pair.
+//! `sample_li`/`pdf_li` into such a pair. [`uniformity_2d`] tests that
+//! randomised sample points are uniform.
 
 pub mod adapters;
 pub mod bsdf_suite;
 pub mod chi_square;
+pub mod uniformity;
 
 pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+pub use uniformity::{uniformity_2d, UniformityReport};
 
 /// The per-test significance level that keeps the chance of any false
 /// alarm among `tests` tests at `alpha` (Šidák correction).

@@ -1,10 +1,24 @@
 //! Sampling building blocks: warps from the unit square to shapes and
-//! directions, each with its density; random number generation; and the
-//! multiple importance sampling heuristics.
+//! directions, each with its density; random number generation; the
+//! low-discrepancy sequences and their randomisations; and the multiple
+//! importance sampling heuristics.
 
 pub mod mis;
+pub mod permutation;
+pub mod poisson_disk;
+pub mod primes;
+pub mod radical_inverse;
 pub mod rng;
+pub mod scramble;
+pub mod sobol;
 pub mod warp;
 
 pub use mis::{balance_heuristic, power_heuristic};
-pub use rng::{hash_u64, Pcg32};
+pub use permutation::permutation_element;
+pub use radical_inverse::{
+    inverse_radical_inverse, radical_inverse, scrambled_radical_inverse, DigitScramble,
+    ONE_MINUS_EPSILON,
+};
+pub use rng::{hash_u64, pixel_key, Pcg32};
+pub use scramble::{fixed_to_unit_f32, owen_scramble, xor_scramble};
+pub use sobol::{sobol_u32, SOBOL_DIMENSIONS};

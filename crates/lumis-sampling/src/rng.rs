@@ -72,6 +72,13 @@ pub fn hash_u64(mut x: u64) -> u64 {
     x ^ (x >> 31)
 }
 
+/// One key per (pixel, seed): the root from which samplers derive the
+/// per-pixel streams, permutations and scrambles.
+#[inline]
+pub fn pixel_key(x: u32, y: u32, seed: u64) -> u64 {
+    hash_u64((((x as u64) << 32) | y as u64) ^ hash_u64(seed))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,15 +1,15 @@
 //! `independent`: uniform random numbers, no stratification.
 
-use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
-};
-use lumis_sampling::{hash_u64, Pcg32};
+use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
+use lumis_sampling::{hash_u64, pixel_key, Pcg32};
+
+use crate::spp::{read_spp, SPP_PARAM};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "independent",
     doc: "uniform random samples (PCG32, one stream per pixel); the baseline every other sampler is measured against",
-    params: &[ParamSpec::with_default("spp", ParamType::Int, "16", "samples per pixel")],
+    params: &[SPP_PARAM],
 };
 
 /// Uniform random samples from PCG32. Each (pixel, sample index, seed)
@@ -33,11 +33,7 @@ impl IndependentSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let spp: u32 = params.get("spp")?;
-        if spp == 0 {
-            return Err(params.error("spp", "must be at least 1"));
-        }
-        Ok(Self::new(spp))
+        Ok(Self::new(read_spp(params)?))
     }
 }
 
@@ -47,8 +43,7 @@ impl Sampler for IndependentSampler {
     }
 
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
-        let pixel_key = ((pixel.x as u64) << 32) | pixel.y as u64;
-        let stream = hash_u64(pixel_key ^ hash_u64(seed));
+        let stream = pixel_key(pixel.x, pixel.y, seed);
         self.rng = Pcg32::new(hash_u64(stream ^ hash_u64(index as u64)), stream);
     }
 

@@ -1,8 +1,19 @@
 //! Standard sample generators.
 
+mod halton;
+mod hammersley;
 mod independent;
+mod poisson_disk;
+mod sobol;
+mod spp;
+mod stratified;
 
+pub use halton::HaltonSampler;
+pub use hammersley::HammersleySampler;
 pub use independent::IndependentSampler;
+pub use poisson_disk::PoissonDiskSampler;
+pub use sobol::{Dimensions as SobolDimensions, Randomize as SobolRandomize, SobolSampler};
+pub use stratified::{strata_grid, StratifiedSampler};
 
 use lumis_core::{Registry, Result};
 
@@ -10,5 +21,18 @@ use lumis_core::{Registry, Result};
 pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_sampler(independent::SPEC, |p| {
         Ok(Box::new(IndependentSampler::from_params(p)?))
+    })?;
+    registry.add_sampler(stratified::SPEC, |p| {
+        Ok(Box::new(StratifiedSampler::from_params(p)?))
+    })?;
+    registry.add_sampler(halton::SPEC, |p| {
+        Ok(Box::new(HaltonSampler::from_params(p)?))
+    })?;
+    registry.add_sampler(hammersley::SPEC, |p| {
+        Ok(Box::new(HammersleySampler::from_params(p)?))
+    })?;
+    registry.add_sampler(sobol::SPEC, |p| Ok(Box::new(SobolSampler::from_params(p)?)))?;
+    registry.add_sampler(poisson_disk::SPEC, |p| {
+        Ok(Box::new(PoissonDiskSampler::from_params(p)?))
     })
 }

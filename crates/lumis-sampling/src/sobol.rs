@@ -1,0 +1,100 @@
+//! Sobol' sequence points from the Joe-Kuo generator matrices.
+
+include!(concat!(env!("OUT_DIR"), "/sobol_matrices.rs"));
+
+/// Dimensions with their own generator matrix.
+pub const SOBOL_DIMENSIONS: usize = 1024;
+
+/// Coordinate `dim` of Sobol' point `index` as a 32-bit fixed-point
+/// fraction: the XOR of the matrix columns selected by the set bits of the
+/// index (a matrix-vector product over GF(2)). Dimensions 0 and 1 together
+/// are a (0,2)-sequence: every aligned block of 2^m points is a (0,m,2)-net.
+#[inline]
+pub fn sobol_u32(mut index: u32, dim: usize) -> u32 {
+    let columns = &SOBOL_MATRICES[dim];
+    let mut x = 0;
+    while index != 0 {
+        let bit = index.trailing_zeros();
+        x ^= columns[bit as usize];
+        index &= index - 1;
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scramble::{owen_scramble, xor_scramble};
+
+    #[test]
+    fn first_points_match_the_published_sequence() {
+        // Joe-Kuo dimension 3 (our index 2) starts 0, 1/2, 3/4, 1/4, 3/8, 7/8.
+        let x: Vec<f64> = (0..6)
+            .map(|i| sobol_u32(i, 2) as f64 / 4_294_967_296.0)
+            .collect();
+        assert_eq!(x, [0.0, 0.5, 0.75, 0.25, 0.375, 0.875]);
+        // Dimension 1 (polynomial x + 1): 0, 1/2, 3/4, 1/4, 5/8, 1/8.
+        let y: Vec<f64> = (0..6)
+            .map(|i| sobol_u32(i, 1) as f64 / 4_294_967_296.0)
+            .collect();
+        assert_eq!(y, [0.0, 0.5, 0.75, 0.25, 0.625, 0.125]);
+    }
+
+    /// Every elementary interval of volume 2^-m (2^a by 2^b cells,
+    /// a + b = m) holds exactly one of the first 2^m points.
+    fn assert_02_net(points: &[(u32, u32)], m: u32, label: &str) {
+        for a in 0..=m {
+            let b = m - a;
+            let mut seen = vec![false; 1 << m];
+            for &(x, y) in points {
+                let cx = if a == 0 { 0 } else { x >> (32 - a) };
+                let cy = if b == 0 { 0 } else { y >> (32 - b) };
+                let cell = ((cx << b) | cy) as usize;
+                assert!(
+                    !seen[cell],
+                    "{label}: m {m}, {a}x{b} split, cell {cell} twice"
+                );
+                seen[cell] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn first_two_dimensions_form_02_nets_before_and_after_scrambling() {
+        for m in 0..=14u32 {
+            let n = 1u32 << m;
+            // Aligned blocks, not only the prefix: the second block of 2^m.
+            for block in [0u32, 1] {
+                let points: Vec<(u32, u32)> = (block * n..(block + 1) * n)
+                    .map(|i| (sobol_u32(i, 0), sobol_u32(i, 1)))
+                    .collect();
+                assert_02_net(&points, m, "plain");
+                let owen: Vec<(u32, u32)> = points
+                    .iter()
+                    .map(|&(x, y)| (owen_scramble(x, 0x9e37_79b9), owen_scramble(y, 0x7f4a_7c15)))
+                    .collect();
+                assert_02_net(&owen, m, "owen");
+                let xor: Vec<(u32, u32)> = points
+                    .iter()
+                    .map(|&(x, y)| (xor_scramble(x, 0xdead_beef), xor_scramble(y, 0x1234_5678)))
+                    .collect();
+                assert_02_net(&xor, m, "xor");
+            }
+        }
+    }
+
+    #[test]
+    fn every_dimension_is_a_01_sequence() {
+        // Each one-dimensional projection: the first 2^m points fill the
+        // 2^m intervals of width 2^-m once each.
+        let m = 10;
+        for dim in [0, 1, 2, 5, 100, 500, SOBOL_DIMENSIONS - 1] {
+            let mut seen = vec![false; 1 << m];
+            for i in 0..1u32 << m {
+                let cell = (sobol_u32(i, dim) >> (32 - m)) as usize;
+                assert!(!seen[cell], "dim {dim}");
+                seen[cell] = true;
+            }
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! `hammersley`: the finite Hammersley point set of the pixel's samples,
+//! Owen-scrambled per pixel.
+
+use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
+use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
+use lumis_sampling::{
+    fixed_to_unit_f32, hash_u64, owen_scramble, pixel_key, scrambled_radical_inverse, DigitScramble,
+};
+
+use crate::spp::{read_spp, SPP_PARAM};
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Sampler,
+    name: "hammersley",
+    doc: "the Hammersley set (i/spp, radical inverses in 2, 3, 5, ...) of each pixel, Owen-scrambled per pixel; a (0,m,2)-net in the pixel when spp = 2^m",
+    params: &[SPP_PARAM],
+};
+
+/// Sample `i` of `N = spp` is `(i/N, phi_2(i), phi_3(i), phi_5(i), ...)`
+/// (Hammersley 1960): dimension 0 is the regular grid `i/N`, dimension
+/// `d >= 1` the radical inverse in the `d`-th prime. Unlike Halton it is a
+/// finite set: it needs N in advance and has no good prefixes, but its first
+/// two dimensions have lower discrepancy. Each pixel scrambles every
+/// dimension with its own Owen scramble, so pixels get independent,
+/// unbiased copies. Base-2 Owen scrambling of `i/N` keeps the net structure
+/// when `N` is a power of two; for other `N` the set is still a scrambled
+/// low-discrepancy set, but no longer one point per `1/N` stratum.
+#[derive(Debug, Clone)]
+pub struct HammersleySampler {
+    spp: u32,
+    key: u64,
+    index: u32,
+    dimension: u32,
+}
+
+impl HammersleySampler {
+    pub fn new(spp: u32) -> Self {
+        Self {
+            spp,
+            key: 0,
+            index: 0,
+            dimension: 0,
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        Ok(Self::new(read_spp(params)?))
+    }
+
+    fn dimension_seed(&self, dimension: u32) -> u64 {
+        hash_u64(self.key ^ hash_u64(dimension as u64))
+    }
+
+    fn sample_dimension(&self, dimension: u32) -> f32 {
+        let seed = self.dimension_seed(dimension);
+        match dimension {
+            // i / N as a 32-bit binary fraction, scrambled like the rest.
+            0 => {
+                let fixed = ((self.index as u64) << 32) / self.spp as u64;
+                fixed_to_unit_f32(owen_scramble(fixed as u32, seed as u32))
+            }
+            1 => fixed_to_unit_f32(owen_scramble(self.index.reverse_bits(), seed as u32)),
+            d => {
+                let prime = PRIMES[1 + (d as usize - 2) % (PRIME_TABLE_SIZE - 1)];
+                scrambled_radical_inverse(prime, self.index as u64, seed, DigitScramble::Owen)
+            }
+        }
+    }
+}
+
+impl Sampler for HammersleySampler {
+    fn samples_per_pixel(&self) -> u32 {
+        self.spp
+    }
+
+    fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
+        self.key = pixel_key(pixel.x, pixel.y, seed);
+        self.index = index % self.spp;
+        self.dimension = 2;
+    }
+
+    fn get_1d(&mut self) -> f32 {
+        let d = self.dimension;
+        self.dimension += 1;
+        self.sample_dimension(d)
+    }
+
+    fn get_2d(&mut self) -> Vec2 {
+        let d = self.dimension;
+        self.dimension += 2;
+        Vec2::new(self.sample_dimension(d), self.sample_dimension(d + 1))
+    }
+
+    fn get_pixel_2d(&mut self) -> Vec2 {
+        Vec2::new(self.sample_dimension(0), self.sample_dimension(1))
+    }
+
+    fn clone_sampler(&self) -> Box<dyn Sampler> {
+        Box::new(self.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For N = 2^m the scrambled first two dimensions are a (0,m,2)-net:
+    /// each 2^a x 2^(m-a) cell holds one point.
+    #[test]
+    fn pixel_dimensions_form_a_net_for_powers_of_two() {
+        for m in [0u32, 3, 6, 10] {
+            let n = 1u32 << m;
+            let mut s = HammersleySampler::new(n);
+            let points: Vec<Vec2> = (0..n)
+                .map(|i| {
+                    s.start_pixel_sample(UVec2::new(3, 4), i, 11);
+                    s.get_pixel_2d()
+                })
+                .collect();
+            for a in 0..=m {
+                let mut seen = vec![false; n as usize];
+                for p in &points {
+                    let cx = (p.x * (1u32 << a) as f32) as u32;
+                    let cy = (p.y * (1u32 << (m - a)) as f32) as u32;
+                    let cell = (cx << (m - a)) | cy;
+                    assert!(!seen[cell as usize], "m {m} a {a}");
+                    seen[cell as usize] = true;
+                }
+            }
+        }
+    }
+}
