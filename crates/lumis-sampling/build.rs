@@ -32,12 +32,14 @@ fn main() {
         matrices.push(direction_vectors(s, a, m));
     }
 
-    let mut out = String::from("/// Generator matrices of Sobol' dimensions 0..1024, one `u32` column per\n/// index bit (bit k of the index selects column k).\npub static SOBOL_MATRICES: [[u32; 32]; ");
+    // Stored bit-reversed (first digit in the lowest bit): Owen scrambling
+    // works on reversed values, so this saves one reversal per sample.
+    let mut out = String::from("/// Generator matrices of Sobol' dimensions 0..1024, one `u32` column per\n/// index bit (bit k of the index selects column k), each column bit-reversed.\npub static SOBOL_MATRICES_REVERSED: [[u32; 32]; ");
     writeln!(out, "{}] = [", matrices.len()).unwrap();
     for m in &matrices {
         out.push_str("    [");
         for v in m {
-            write!(out, "{v:#010x}, ").unwrap();
+            write!(out, "{:#010x}, ", v.reverse_bits()).unwrap();
         }
         out.push_str("],\n");
     }

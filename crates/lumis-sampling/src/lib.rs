@@ -19,6 +19,6 @@ pub use radical_inverse::{
     inverse_radical_inverse, radical_inverse, scrambled_radical_inverse, DigitScramble,
     ONE_MINUS_EPSILON,
 };
-pub use rng::{hash_u64, pixel_key, Pcg32};
-pub use scramble::{fixed_to_unit_f32, owen_scramble, xor_scramble};
-pub use sobol::{sobol_u32, SOBOL_DIMENSIONS};
+pub use rng::{hash_u64, hash_with, pixel_key, Pcg32};
+pub use scramble::{fixed_to_unit_f32, owen_scramble, owen_scramble_reversed, xor_scramble};
+pub use sobol::{sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};

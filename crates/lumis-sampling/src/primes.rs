@@ -14,7 +14,7 @@ const fn first_primes<const N: usize>() -> [u32; N] {
         let mut is_prime = true;
         let mut k = 0;
         while k < count && primes[k] * primes[k] <= candidate {
-            if candidate % primes[k] == 0 {
+            if candidate.is_multiple_of(primes[k]) {
                 is_prime = false;
                 break;
             }

@@ -72,6 +72,14 @@ pub fn hash_u64(mut x: u64) -> u64 {
     x ^ (x >> 31)
 }
 
+/// Output `counter` of the splitmix64 stream with state `key`: a cheap
+/// family of independent hashes, one per counter value (per dimension, per
+/// sample index...), each costing a single mix.
+#[inline]
+pub fn hash_with(key: u64, counter: u64) -> u64 {
+    hash_u64(key.wrapping_add(counter.wrapping_mul(0x9e37_79b9_7f4a_7c15)))
+}
+
 /// One key per (pixel, seed): the root from which samplers derive the
 /// per-pixel streams, permutations and scrambles.
 #[inline]

@@ -10,8 +10,15 @@ pub const SOBOL_DIMENSIONS: usize = 1024;
 /// index (a matrix-vector product over GF(2)). Dimensions 0 and 1 together
 /// are a (0,2)-sequence: every aligned block of 2^m points is a (0,m,2)-net.
 #[inline]
-pub fn sobol_u32(mut index: u32, dim: usize) -> u32 {
-    let columns = &SOBOL_MATRICES[dim];
+pub fn sobol_u32(index: u32, dim: usize) -> u32 {
+    sobol_reversed_u32(index, dim).reverse_bits()
+}
+
+/// [`sobol_u32`] with its bits reversed (first digit in bit 0), the form
+/// [`crate::scramble::owen_scramble_reversed`] takes.
+#[inline]
+pub fn sobol_reversed_u32(mut index: u32, dim: usize) -> u32 {
+    let columns = &SOBOL_MATRICES_REVERSED[dim];
     let mut x = 0;
     while index != 0 {
         let bit = index.trailing_zeros();

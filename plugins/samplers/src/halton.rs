@@ -4,7 +4,9 @@ use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
-use lumis_sampling::{hash_u64, inverse_radical_inverse, scrambled_radical_inverse, DigitScramble};
+use lumis_sampling::{
+    hash_u64, hash_with, inverse_radical_inverse, scrambled_radical_inverse, DigitScramble,
+};
 
 use crate::spp::{read_spp, SPP_PARAM};
 
@@ -92,7 +94,7 @@ impl HaltonSampler {
 
     fn sample_dimension(&self, dimension: u32) -> f32 {
         let wrapped = 2 + (dimension as usize - 2) % (PRIME_TABLE_SIZE - 2);
-        let seed = hash_u64(self.seed_key ^ hash_u64(dimension as u64));
+        let seed = hash_with(self.seed_key, dimension as u64);
         scrambled_radical_inverse(PRIMES[wrapped], self.halton_index, seed, self.scramble)
     }
 }
@@ -131,7 +133,7 @@ impl Sampler for HaltonSampler {
     /// The position inside the pixel: the digits of the index past those
     /// that chose the pixel.
     fn get_pixel_2d(&mut self) -> Vec2 {
-        let s = |d: u64| hash_u64(self.seed_key ^ hash_u64(d));
+        let s = |d: u64| hash_with(self.seed_key, d);
         Vec2::new(
             scrambled_radical_inverse(
                 2,

@@ -4,7 +4,8 @@
 use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
-    fixed_to_unit_f32, hash_u64, owen_scramble, pixel_key, scrambled_radical_inverse, DigitScramble,
+    fixed_to_unit_f32, hash_with, owen_scramble, pixel_key, scrambled_radical_inverse,
+    DigitScramble,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -48,7 +49,7 @@ impl HammersleySampler {
     }
 
     fn dimension_seed(&self, dimension: u32) -> u64 {
-        hash_u64(self.key ^ hash_u64(dimension as u64))
+        hash_with(self.key, dimension as u64)
     }
 
     fn sample_dimension(&self, dimension: u32) -> f32 {

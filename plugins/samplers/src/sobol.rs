@@ -4,8 +4,8 @@ use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
 use lumis_sampling::{
-    fixed_to_unit_f32, hash_u64, owen_scramble, pixel_key, sobol_u32, xor_scramble,
-    SOBOL_DIMENSIONS,
+    fixed_to_unit_f32, hash_with, owen_scramble, owen_scramble_reversed, pixel_key,
+    sobol_reversed_u32, xor_scramble, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -67,6 +67,10 @@ pub struct SobolSampler {
     key: u64,
     index: u32,
     dimension: u32,
+    /// Scramble seeds of the current pixel, per dimension, filled lazily:
+    /// a pixel's samples are drawn one after another, so each seed is
+    /// hashed once per pixel rather than once per sample.
+    seeds: Vec<u32>,
 }
 
 impl SobolSampler {
@@ -78,6 +82,7 @@ impl SobolSampler {
             key: 0,
             index: 0,
             dimension: 0,
+            seeds: Vec::new(),
         }
     }
 
@@ -94,17 +99,19 @@ impl SobolSampler {
         Ok(Self::new(read_spp(params)?, randomize, dimensions))
     }
 
+    /// The scramble seed of a dimension (salt 0) or of its index shuffle
+    /// (salt 1).
     fn seed(&self, dimension: u32, salt: u64) -> u32 {
-        hash_u64(self.key ^ hash_u64(((dimension as u64) << 2) | salt)) as u32
+        hash_with(self.key, ((dimension as u64) << 2) | salt) as u32
     }
 
-    fn randomized(&self, x: u32, dimension: u32) -> f32 {
-        let seed = self.seed(dimension, 0);
-        fixed_to_unit_f32(match self.randomize {
-            Randomize::Owen => owen_scramble(x, seed),
-            Randomize::Xor => xor_scramble(x, seed),
-            Randomize::None => x,
-        })
+    fn scramble_seed(&mut self, dimension: u32) -> u32 {
+        let d = dimension as usize;
+        while self.seeds.len() <= d {
+            let seed = self.seed(self.seeds.len() as u32, 0);
+            self.seeds.push(seed);
+        }
+        self.seeds[d]
     }
 
     /// The sample index a request starting at `dimension` uses: shuffled per
@@ -128,10 +135,15 @@ impl SobolSampler {
         }
     }
 
-    fn sample(&self, start: u32, component: u32) -> f32 {
+    fn sample(&mut self, start: u32, component: u32) -> f32 {
         let index = self.index_for(start);
-        let x = sobol_u32(index, self.sobol_dimension(start, component));
-        self.randomized(x, start + component)
+        let reversed = sobol_reversed_u32(index, self.sobol_dimension(start, component));
+        let seed = self.scramble_seed(start + component);
+        fixed_to_unit_f32(match self.randomize {
+            Randomize::Owen => owen_scramble_reversed(reversed, seed),
+            Randomize::Xor => xor_scramble(reversed.reverse_bits(), seed),
+            Randomize::None => reversed.reverse_bits(),
+        })
     }
 }
 
@@ -141,7 +153,11 @@ impl Sampler for SobolSampler {
     }
 
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
-        self.key = pixel_key(pixel.x, pixel.y, seed);
+        let key = pixel_key(pixel.x, pixel.y, seed);
+        if key != self.key || self.seeds.is_empty() {
+            self.key = key;
+            self.seeds.clear();
+        }
         self.index = index;
         self.dimension = 2;
     }

@@ -4,7 +4,9 @@
 use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
-use lumis_sampling::{hash_u64, permutation_element, pixel_key, Pcg32, ONE_MINUS_EPSILON};
+use lumis_sampling::{
+    hash_u64, hash_with, permutation_element, pixel_key, Pcg32, ONE_MINUS_EPSILON,
+};
 
 use crate::spp::{read_spp, SPP_PARAM};
 
@@ -50,7 +52,7 @@ pub struct StratifiedSampler {
 /// The factorisation `spp = nx * ny` with `nx <= ny` closest to square.
 pub fn strata_grid(spp: u32) -> (u32, u32) {
     let mut nx = (spp as f64).sqrt() as u32;
-    while nx > 1 && spp % nx != 0 {
+    while nx > 1 && !spp.is_multiple_of(nx) {
         nx -= 1;
     }
     let nx = nx.max(1);
@@ -78,7 +80,7 @@ impl StratifiedSampler {
 
     /// The stratum sample `index` takes in `dimension`.
     fn stratum(&self, dimension: u32) -> u32 {
-        let seed = hash_u64(self.key ^ hash_u64(dimension as u64)) as u32;
+        let seed = hash_with(self.key, dimension as u64) as u32;
         permutation_element(self.index % self.spp, self.spp, seed)
     }
 
