@@ -7,6 +7,7 @@ mod poisson_disk;
 mod sobol;
 mod spp;
 mod stratified;
+mod zsobol;
 
 pub use halton::HaltonSampler;
 pub use hammersley::HammersleySampler;
@@ -14,6 +15,7 @@ pub use independent::IndependentSampler;
 pub use poisson_disk::PoissonDiskSampler;
 pub use sobol::{Dimensions as SobolDimensions, Randomize as SobolRandomize, SobolSampler};
 pub use stratified::{strata_grid, StratifiedSampler};
+pub use zsobol::ZSobolSampler;
 
 use lumis_core::{Registry, Result};
 
@@ -32,6 +34,9 @@ pub fn register(registry: &mut Registry) -> Result<()> {
         Ok(Box::new(HammersleySampler::from_params(p)?))
     })?;
     registry.add_sampler(sobol::SPEC, |p| Ok(Box::new(SobolSampler::from_params(p)?)))?;
+    registry.add_sampler(zsobol::SPEC, |p| {
+        Ok(Box::new(ZSobolSampler::from_params(p)?))
+    })?;
     registry.add_sampler(poisson_disk::SPEC, |p| {
         Ok(Box::new(PoissonDiskSampler::from_params(p)?))
     })

@@ -4,7 +4,7 @@
 use lumis_core::{Sampler, UVec2, Vec2};
 use lumis_samplers::{
     HaltonSampler, HammersleySampler, IndependentSampler, PoissonDiskSampler, SobolDimensions,
-    SobolRandomize, SobolSampler, StratifiedSampler,
+    SobolRandomize, SobolSampler, StratifiedSampler, ZSobolSampler,
 };
 use lumis_sampling::{poisson_disk::max_packing_distance, DigitScramble};
 
@@ -47,6 +47,7 @@ fn samplers() -> Vec<(&'static str, Box<dyn Sampler>)> {
                 SobolDimensions::Padded,
             )),
         ),
+        ("zsobol", Box::new(ZSobolSampler::new(SPP, true))),
         (
             "poisson-disk",
             Box::new(
