@@ -135,7 +135,9 @@ mod tests {
     fn parallelograms_and_coplanar_points_are_refused() {
         let skew = SphericalRectangle::new(Vec3::Z, Vec3::X, Vec3::new(0.5, 1.0, 0.0), Vec3::ZERO);
         assert!(skew.is_none());
-        assert!(SphericalRectangle::new(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(5.0, 1.0, 0.0))
-            .is_none());
+        assert!(
+            SphericalRectangle::new(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(5.0, 1.0, 0.0))
+                .is_none()
+        );
     }
 }

@@ -112,7 +112,10 @@ mod tests {
     fn octant_is_an_eighth_of_the_sphere() {
         let t = SphericalTriangle::new([Vec3::X, Vec3::Y, Vec3::Z], Vec3::ZERO).unwrap();
         let omega = t.solid_angle();
-        assert!((omega - std::f64::consts::PI / 2.0).abs() < 1e-12, "{omega}");
+        assert!(
+            (omega - std::f64::consts::PI / 2.0).abs() < 1e-12,
+            "{omega}"
+        );
         let b = t.sample(Vec2::new(0.3, 0.7)).unwrap();
         assert!(b.iter().all(|&x| (0.0..=1.0).contains(&x)));
         assert!((b.iter().sum::<f32>() - 1.0).abs() < 1e-6);
@@ -125,9 +128,7 @@ mod tests {
             Vec3::new(1e-3, 0.0, 1e4),
             Vec3::new(0.0, 1e-3, 1e4),
         ];
-        let omega = SphericalTriangle::new(v, Vec3::ZERO)
-            .unwrap()
-            .solid_angle();
+        let omega = SphericalTriangle::new(v, Vec3::ZERO).unwrap().solid_angle();
         let expected = 0.5e-6 / 1e8;
         assert!((omega / expected - 1.0).abs() < 1e-4, "{omega}");
     }
