@@ -177,20 +177,27 @@ impl SphereLight {
         }
         let dist = dist2.sqrt();
         let wi = to_light / dist;
-        // The cosine at the sampled point from the triangle p, c, q alone:
-        // n_out . (q - p) = (|q - p|^2 - (d^2 - r^2)) / (2 r), law of
-        // cosines. Unlike n_out . wi it keeps its precision on short chords
-        // from a point on the sphere, where both vectors are nearly
-        // perpendicular. Negative: q faces p (the visible cap from outside).
-        let (c0, _, _) = self.power_of(ctx.p());
-        let k = dist2 - c0;
+        // The cosine at q, n_out . (q - p) / |q - p|, from quantities that
+        // keep their precision: n_out . (q - p) = r - n_out . (p - c), whose
+        // terms are exact to the scale of |p - c| (not of |q|, which may be
+        // 1e8 times the radius); and, on the sphere's own surface where that
+        // cancels for short chords, the law of cosines
+        // n_out . (q - p) = (|q - p|^2 - (d^2 - r^2)) / (2 r).
+        // Positive: q faces away from p.
+        let inside = self.inside_or_on(ctx.p());
+        let k = if inside {
+            let (c0, _, _) = self.power_of(ctx.p());
+            (dist2 - c0) / (2.0 * self.radius)
+        } else {
+            self.radius - n_out.dot(ctx.p() - self.center)
+        };
         // From outside, only the cap facing the point is seen first; the far
         // side is hidden behind it (its direction belongs to the near point).
-        if !self.inside_or_on(ctx.p()) && k >= 0.0 {
+        if !inside && k >= 0.0 {
             return None;
         }
         let l = self.emission.radiance_toward(point.n, -wi);
-        let cos_light = k.abs() / (2.0 * self.radius * dist);
+        let cos_light = k.abs() / dist;
         let pdf = dist2 / (cos_light * self.area());
         if l.is_black() || !(pdf.is_finite() && pdf > 0.0) {
             return None;
