@@ -4,9 +4,7 @@
 //! most samples on the dim ones. It ignores position: a light far from the
 //! shading point still gets its share.
 
-use lumis_core::{
-    Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight,
-};
+use lumis_core::{Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
@@ -33,7 +31,13 @@ impl PowerLightSampler {
     pub fn from_weights(weights: impl IntoIterator<Item = f32>) -> Self {
         let mut w: Vec<f64> = weights
             .into_iter()
-            .map(|x| if x.is_finite() && x > 0.0 { f64::from(x) } else { 0.0 })
+            .map(|x| {
+                if x.is_finite() && x > 0.0 {
+                    f64::from(x)
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let mut total: f64 = w.iter().sum();
         if total == 0.0 {
@@ -109,7 +113,9 @@ mod tests {
         let ctx = LightSampleContext::at(Vec3::ZERO);
         let zero = PowerLightSampler::from_weights([0.0, 0.0]);
         assert_eq!(zero.pmf(&ctx, 1), 0.5);
-        assert!(PowerLightSampler::from_weights([]).sample(&ctx, 0.5).is_none());
+        assert!(PowerLightSampler::from_weights([])
+            .sample(&ctx, 0.5)
+            .is_none());
         let odd = PowerLightSampler::from_weights([f32::NAN, 2.0, -1.0]);
         assert_eq!(odd.sample(&ctx, 0.1).unwrap().index, 1);
         assert_eq!(odd.sample(&ctx, 0.99).unwrap().index, 1);

@@ -25,7 +25,11 @@ fn samples(light: &dyn Light, ctx: &LightSampleContext, n: usize) -> Vec<lumis_c
         if let Some(s) = light.sample_li(ctx, u) {
             assert!(s.pdf.is_finite() && s.pdf > 0.0, "pdf {}", s.pdf);
             assert!(s.l.is_finite() && s.l.min_component() >= 0.0, "{:?}", s.l);
-            assert!(s.wi.is_finite() && (s.wi.length() - 1.0).abs() < 1e-5, "{}", s.wi);
+            assert!(
+                s.wi.is_finite() && (s.wi.length() - 1.0).abs() < 1e-5,
+                "{}",
+                s.wi
+            );
             assert!(s.p.p.is_finite() && s.p.p_error.is_finite());
             out.push(s);
         }
@@ -67,15 +71,24 @@ fn tiny_sphere_very_far_away() {
 fn quad_seen_edge_on() {
     for sampling in [Sampling::Area, Sampling::SolidAngle] {
         for two_sided in [false, true] {
-            let light = QuadLight::new(Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, emission(two_sided))
-                .unwrap()
-                .with_sampling(sampling);
+            let light = QuadLight::new(
+                Vec3::new(-0.5, 1.0, -0.5),
+                Vec3::X,
+                Vec3::Z,
+                emission(two_sided),
+            )
+            .unwrap()
+            .with_sampling(sampling);
             // In the quad's plane, beside it: zero solid angle.
             let ctx = LightSampleContext::at(Vec3::new(3.0, 1.0, 0.0));
             assert!(!light.samples_solid_angle_from(ctx.p()));
             let drawn = samples(&light, &ctx, 1000);
             assert!(drawn.len() < 10, "{sampling:?}: {}", drawn.len());
-            for w in [Vec3::new(-1.0, 0.0, 0.0), Vec3::new(-1.0, 1e-7, 0.0), Vec3::Y] {
+            for w in [
+                Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(-1.0, 1e-7, 0.0),
+                Vec3::Y,
+            ] {
                 let pdf = light.pdf_li(&ctx, w);
                 assert!(pdf.is_finite() && pdf >= 0.0, "{sampling:?} {w}: {pdf}");
             }
@@ -92,17 +105,34 @@ fn quad_seen_edge_on() {
 
 #[test]
 fn shading_point_on_the_light() {
-    let quad = QuadLight::new(Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, emission(true)).unwrap();
+    let quad =
+        QuadLight::new(Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, emission(true)).unwrap();
     let tri = TriangleLight::new(
-        [Vec3::new(0.0, 1.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0)],
+        [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ],
         emission(true),
     )
     .unwrap();
     for sampling in [Sampling::Area, Sampling::SolidAngle] {
         let lights: [(&str, Box<dyn Light>, Vec3); 3] = [
-            ("quad centre", Box::new(quad.clone().with_sampling(sampling)), Vec3::new(0.0, 1.0, 0.0)),
-            ("triangle vertex", Box::new(tri.clone().with_sampling(sampling)), Vec3::new(0.0, 1.0, 0.0)),
-            ("triangle inside", Box::new(tri.clone().with_sampling(sampling)), Vec3::new(0.2, 1.0, 0.2)),
+            (
+                "quad centre",
+                Box::new(quad.clone().with_sampling(sampling)),
+                Vec3::new(0.0, 1.0, 0.0),
+            ),
+            (
+                "triangle vertex",
+                Box::new(tri.clone().with_sampling(sampling)),
+                Vec3::new(0.0, 1.0, 0.0),
+            ),
+            (
+                "triangle inside",
+                Box::new(tri.clone().with_sampling(sampling)),
+                Vec3::new(0.2, 1.0, 0.2),
+            ),
         ];
         for (name, light, p) in &lights {
             let ctx = LightSampleContext::at(*p);
@@ -131,7 +161,11 @@ fn shading_point_on_the_light() {
         // From a point on a sphere, area sampling has density cos / pi
         // (Shirley et al. 1996): at most 1/pi.
         assert!(s.pdf <= 1.001 / std::f32::consts::PI, "{}", s.pdf);
-        assert!((pdf - s.pdf).abs() <= 1e-2 * s.pdf + 1e-6, "{} vs {pdf}", s.pdf);
+        assert!(
+            (pdf - s.pdf).abs() <= 1e-2 * s.pdf + 1e-6,
+            "{} vs {pdf}",
+            s.pdf
+        );
     }
 }
 
@@ -145,7 +179,10 @@ fn solid_angle_estimate(light: &dyn Light, ctx: &LightSampleContext, n: usize) -
         sum2 += w * w;
     }
     let mean = sum / n as f64;
-    (mean, ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt())
+    (
+        mean,
+        ((sum2 / n as f64 - mean * mean).max(0.0) / n as f64).sqrt(),
+    )
 }
 
 #[test]
@@ -184,7 +221,11 @@ fn triangle_switches_to_area_sampling_below_the_threshold() {
         assert_eq!(drawn.len(), n, "{side}");
         for s in drawn.iter().take(2000) {
             let pdf = light.pdf_li(&ctx, s.wi);
-            assert!((pdf - s.pdf).abs() <= 1e-3 * s.pdf, "{side}: {} vs {pdf}", s.pdf);
+            assert!(
+                (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
+                "{side}: {} vs {pdf}",
+                s.pdf
+            );
             if spherical {
                 assert_eq!(s.pdf, (1.0 / omega) as f32, "{side}: uniform density");
             }
