@@ -281,7 +281,7 @@ impl Light for SphereLight {
         } else {
             return 0.0;
         };
-        if !(t > 0.0) {
+        if t.is_nan() || t <= 0.0 {
             return 0.0;
         }
         // From inside the ray leaves through the inner side, from outside it

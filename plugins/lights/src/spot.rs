@@ -58,7 +58,7 @@ impl SpotLight {
         let axis = (target - position)
             .try_normalize()
             .ok_or_else(|| Error::msg("spot light: target must differ from position"))?;
-        if !(0.0..=cutoff).contains(&falloff_start) || !(cutoff <= 90.0) {
+        if !(0.0..=cutoff).contains(&falloff_start) || !(0.0..=90.0).contains(&cutoff) {
             return Err(Error::msg(format!(
                 "spot light: need 0 <= falloff_start ({falloff_start}) <= cutoff ({cutoff}) <= 90"
             )));
