@@ -53,7 +53,7 @@ impl RenderReport {
     pub fn summary(&self) -> String {
         let secs = self.seconds.max(1e-9);
         format!(
-            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} shadow), {} NaN/Inf samples -> {}",
+            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} shadow), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
             self.image.width,
             self.image.height,
             self.spp,
@@ -63,6 +63,8 @@ impl RenderReport {
             self.stats.rays,
             self.stats.shadow_rays,
             self.stats.nonfinite,
+            self.stats.bsdf_light_hits,
+            self.stats.light_samples,
             self.exr.display(),
         )
     }

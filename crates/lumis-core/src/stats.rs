@@ -13,9 +13,11 @@ pub struct RenderStats {
     pub samples: u64,
     /// Samples whose radiance was NaN or infinite, counted and dropped.
     pub nonfinite: u64,
-    /// Emission contributions found by BSDF sampling (emitter hit by a bounce).
+    /// Emission contributions found by BSDF sampling (an emitter hit by a
+    /// bounce with a non-zero MIS weight), strategy f.
     pub bsdf_light_hits: u64,
-    /// Emission contributions found by light sampling (unoccluded shadow rays).
+    /// Emission contributions found by light sampling (unoccluded shadow
+    /// rays toward a non-black light sample), strategy g.
     pub light_samples: u64,
 }
 

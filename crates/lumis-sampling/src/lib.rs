@@ -11,6 +11,8 @@ pub mod radical_inverse;
 pub mod rng;
 pub mod scramble;
 pub mod sobol;
+pub mod spherical_rectangle;
+pub mod spherical_triangle;
 pub mod warp;
 
 pub use mis::{balance_heuristic, power_heuristic};
@@ -22,3 +24,7 @@ pub use radical_inverse::{
 pub use rng::{hash_u64, hash_with, pixel_key, Pcg32};
 pub use scramble::{fixed_to_unit_f32, owen_scramble, owen_scramble_reversed, xor_scramble};
 pub use sobol::{sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};
+pub use spherical_rectangle::SphericalRectangle;
+pub use spherical_triangle::{
+    SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
+};

@@ -156,3 +156,54 @@ mod tests {
         assert!((frac - 0.25).abs() < 0.01, "{frac}");
     }
 }
+
+/// `1 - cos theta` from `sin^2 theta` for `theta` in `[0, pi/2]`, without the
+/// cancellation of `1 - sqrt(1 - s)`: by the half-angle identity
+/// `1 - cos theta = sin^2 theta / (1 + cos theta)`. Exact to a few ulps even
+/// for `s = 1e-16` (a sphere of radius 1e-4 at distance 1e4), where
+/// `1 - sqrt(1 - s)` is 0 in `f32`.
+#[inline]
+pub fn one_minus_cos_from_sin2(sin2: f32) -> f32 {
+    sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
+}
+
+/// A direction uniform in the cone of half-angle `theta_max` around `+z`,
+/// given `h_max = 1 - cos theta_max` (pbrt-v4 `SampleUniformCone`, written in
+/// `h = 1 - cos theta` so that narrow cones keep their precision:
+/// `sin theta = sqrt(h (2 - h))`). Density [`uniform_cone_pdf`].
+#[inline]
+pub fn square_to_uniform_cone(u: Vec2, h_max: f32) -> Vec3 {
+    let h = u.x * h_max;
+    let sin_theta = (h * (2.0 - h)).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), 1.0 - h)
+}
+
+/// `1 / (2 pi (1 - cos theta_max))`, the solid angle of the cone inverted.
+#[inline]
+pub fn uniform_cone_pdf(h_max: f32) -> f32 {
+    1.0 / (2.0 * PI * h_max)
+}
+
+#[cfg(test)]
+mod cone_tests {
+    use super::*;
+
+    #[test]
+    fn half_angle_form_survives_tiny_cones() {
+        let s = 1e-16f32;
+        let h = one_minus_cos_from_sin2(s);
+        assert!((h / 5e-17 - 1.0).abs() < 1e-6, "{h}");
+        assert_eq!(1.0 - (1.0 - s).sqrt(), 0.0, "the naive form cancels");
+        let d = square_to_uniform_cone(Vec2::new(1.0, 0.25), h);
+        assert!((d.y - 1e-8).abs() < 1e-13 && d.z == 1.0, "{d}");
+        assert!(uniform_cone_pdf(h).is_finite());
+    }
+
+    #[test]
+    fn full_hemisphere_cone() {
+        let h = one_minus_cos_from_sin2(1.0);
+        assert_eq!(h, 1.0);
+        assert!((uniform_cone_pdf(h) - 0.5 * FRAC_1_PI).abs() < 1e-7);
+    }
+}

@@ -1,8 +1,13 @@
-//! Standard integrators.
+//! Standard integrators: `path` (unidirectional path tracing) and `direct`
+//! (direct lighting only), sharing one direct-lighting estimator.
 
+mod direct;
+mod estimator;
 mod path;
 
-pub use path::{Heuristic, PathIntegrator, Strategy};
+pub use direct::DirectIntegrator;
+pub use estimator::{Estimator, Heuristic, MisEstimator, Strategy, VertexPlan};
+pub use path::PathIntegrator;
 
 use lumis_core::{Registry, Result};
 
@@ -10,5 +15,8 @@ use lumis_core::{Registry, Result};
 pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_integrator(path::SPEC, |p| {
         Ok(Box::new(PathIntegrator::from_params(p)?))
+    })?;
+    registry.add_integrator(direct::SPEC, |p| {
+        Ok(Box::new(DirectIntegrator::from_params(p)?))
     })
 }

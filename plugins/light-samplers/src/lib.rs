@@ -1,7 +1,9 @@
 //! Standard light-selection strategies.
 
+mod power;
 mod uniform;
 
+pub use power::PowerLightSampler;
 pub use uniform::UniformLightSampler;
 
 use lumis_core::{Registry, Result};
@@ -10,5 +12,8 @@ use lumis_core::{Registry, Result};
 pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_light_sampler(uniform::SPEC, |_p, lights| {
         Ok(Box::new(UniformLightSampler::new(lights.len())))
+    })?;
+    registry.add_light_sampler(power::SPEC, |_p, lights| {
+        Ok(Box::new(PowerLightSampler::new(lights)))
     })
 }

@@ -7,16 +7,54 @@ use lumis_core::{
     Light, LightKind, LightSample, ParamSpec, ParamType, Params, Result, Rgb, Vec2, Vec3,
 };
 
-/// The keys of a shape's `emission = { ... }` table.
-pub const EMISSION_PARAMS: &[ParamSpec] = &[
-    ParamSpec::required("radiance", ParamType::Rgb, "emitted radiance in linear RGB"),
+/// `radiance`, a key of every `emission = { ... }` table.
+pub const RADIANCE: ParamSpec =
+    ParamSpec::required("radiance", ParamType::Rgb, "emitted radiance in linear RGB");
+
+/// `two_sided`, a key of every `emission = { ... }` table.
+pub const TWO_SIDED: ParamSpec = ParamSpec::with_default(
+    "two_sided",
+    ParamType::Bool,
+    "false",
+    "emit from the back side too",
+);
+
+/// `sampling`: how `sample_li` picks points on a quad, triangle or sphere.
+/// Quads and triangles default to `"area"` so that scenes written before the
+/// switch existed render bit-identically; spheres default to
+/// `"solid-angle"`.
+pub const fn sampling_param(default: &'static str) -> ParamSpec {
     ParamSpec::with_default(
-        "two_sided",
-        ParamType::Bool,
-        "false",
-        "emit from the back side too",
-    ),
-];
+        "sampling",
+        ParamType::String,
+        default,
+        "\"solid-angle\": uniform over the solid angle the shape subtends (area sampling where that is unstable), \"area\": uniform over the surface, converted to solid angle",
+    )
+    .one_of(&["solid-angle", "area"])
+}
+
+/// The keys of a quad's or mesh's `emission = { ... }` table.
+pub const EMISSION_PARAMS: &[ParamSpec] = &[RADIANCE, TWO_SIDED, sampling_param("\"area\"")];
+
+/// How an area light chooses points for next-event estimation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sampling {
+    /// Uniform by area; the density in solid angle is `d^2 / (|cos| A)`,
+    /// which peaks at grazing angles and near the light.
+    Area,
+    /// Uniform over the solid angle subtended from the shading point:
+    /// density `1 / Omega`, no `1/d^2` or `1/cos` spikes.
+    SolidAngle,
+}
+
+impl Sampling {
+    pub fn from_params(params: &Params) -> Result<Self> {
+        Ok(match params.get_choice("sampling")?.as_str() {
+            "area" => Sampling::Area,
+            _ => Sampling::SolidAngle,
+        })
+    }
+}
 
 /// Constant radiance leaving a surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +145,29 @@ pub fn area_pdf(t: f32, wi: Vec3, n: Vec3, area: f32, emission: &Emission) -> f3
     }
 }
 
+/// Turns a point sampled uniformly over the solid angle `omega` subtended
+/// from `ctx` into a light sample of density `1 / omega`.
+#[inline]
+pub fn solid_angle_sample(
+    ctx: &LightSampleContext,
+    point: SurfacePoint,
+    omega: f32,
+    emission: &Emission,
+) -> Option<LightSample> {
+    let wi = (point.p - ctx.p()).try_normalize()?;
+    let l = emission.radiance_toward(point.n, -wi);
+    let pdf = 1.0 / omega;
+    if l.is_black() || !pdf.is_finite() || pdf <= 0.0 {
+        return None;
+    }
+    Some(LightSample {
+        l,
+        wi,
+        pdf,
+        p: point,
+    })
+}
+
 /// A flat shape that an area light can be attached to.
 pub trait PlanarShape: Send + Sync {
     fn area(&self) -> f32;
@@ -119,14 +180,55 @@ pub trait PlanarShape: Send + Sync {
 
     /// The `t > 0` at which `o + t w` (unit `w`) crosses the shape.
     fn intersect(&self, o: Vec3, w: Vec3) -> Option<f32>;
+
+    /// The solid angle (sr) the shape subtends from `p`, when it samples
+    /// that solid angle uniformly from there; `None` where it falls back to
+    /// area sampling. Depends on `p` only, so `sample_li` and `pdf_li` make
+    /// the same choice.
+    fn solid_angle(&self, _p: Vec3) -> Option<f32> {
+        None
+    }
+
+    /// A point whose direction from `p` is uniform in the solid angle; only
+    /// called where [`PlanarShape::solid_angle`] is `Some`.
+    fn sample_solid_angle(&self, _p: Vec3, _u: Vec2) -> Option<SurfacePoint> {
+        None
+    }
 }
 
-/// Constant emission from a planar shape, sampled uniformly by area
-/// (pbrt-v4 `DiffuseAreaLight` without textures).
+/// Constant emission from a planar shape, sampled uniformly by area or by
+/// solid angle (pbrt-v4 `DiffuseAreaLight` without textures).
 #[derive(Debug, Clone)]
 pub struct AreaLight<S> {
     pub(crate) shape: S,
     pub(crate) emission: Emission,
+    pub(crate) sampling: Sampling,
+}
+
+impl<S: PlanarShape> AreaLight<S> {
+    /// The same light with another sampling strategy.
+    pub fn with_sampling(mut self, sampling: Sampling) -> Self {
+        self.sampling = sampling;
+        self
+    }
+
+    pub fn sampling(&self) -> Sampling {
+        self.sampling
+    }
+
+    /// The solid angle used from `p`, or `None` for area sampling.
+    #[inline]
+    fn spherical(&self, p: Vec3) -> Option<f32> {
+        match self.sampling {
+            Sampling::SolidAngle => self.shape.solid_angle(p),
+            Sampling::Area => None,
+        }
+    }
+
+    /// Whether `sample_li` from `p` samples the solid angle (else area).
+    pub fn samples_solid_angle_from(&self, p: Vec3) -> bool {
+        self.spherical(p).is_some()
+    }
 }
 
 impl<S: PlanarShape> Light for AreaLight<S> {
@@ -135,6 +237,10 @@ impl<S: PlanarShape> Light for AreaLight<S> {
     }
 
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
+        if let Some(omega) = self.spherical(ctx.p()) {
+            let point = self.shape.sample_solid_angle(ctx.p(), u)?;
+            return solid_angle_sample(ctx, point, omega, &self.emission);
+        }
         area_sample(
             ctx,
             self.shape.sample_point(u),
@@ -145,15 +251,23 @@ impl<S: PlanarShape> Light for AreaLight<S> {
 
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
         let wi = wi.normalize();
-        match self.shape.intersect(ctx.p(), wi) {
-            Some(t) => area_pdf(
-                t,
-                wi,
-                self.shape.normal(),
-                self.shape.area(),
-                &self.emission,
-            ),
-            None => 0.0,
+        let Some(t) = self.shape.intersect(ctx.p(), wi) else {
+            return 0.0;
+        };
+        let normal = self.shape.normal();
+        match self.spherical(ctx.p()) {
+            Some(omega) => {
+                if !self.emission.two_sided && normal.dot(-wi) <= 0.0 {
+                    return 0.0;
+                }
+                let pdf = 1.0 / omega;
+                if pdf.is_finite() {
+                    pdf
+                } else {
+                    0.0
+                }
+            }
+            None => area_pdf(t, wi, normal, self.shape.area(), &self.emission),
         }
     }
 

@@ -1,16 +1,21 @@
-//! Standard lights: a point light, area lights for quads and triangles, and
-//! a constant environment.
+//! Standard lights: point and spot lights, area lights for quads, triangles
+//! and spheres (each sampled by area or by solid angle), and a constant
+//! environment.
 
 mod area;
 mod constant;
 mod point;
 mod quad;
+mod sphere;
+mod spot;
 mod triangle;
 
-pub use area::{AreaLight, Emission, PlanarShape};
+pub use area::{AreaLight, Emission, PlanarShape, Sampling};
 pub use constant::ConstantLight;
 pub use point::PointLight;
 pub use quad::{Quad, QuadLight};
+pub use sphere::SphereLight;
+pub use spot::SpotLight;
 pub use triangle::{Triangle, TriangleLight};
 
 use lumis_core::{Registry, Result};
@@ -25,6 +30,12 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     })?;
     registry.add_light(triangle::SPEC, |p, shape| {
         Ok(Box::new(TriangleLight::from_params(p, shape)?))
+    })?;
+    registry.add_light(sphere::SPEC, |p, shape| {
+        Ok(Box::new(SphereLight::from_params(p, shape)?))
+    })?;
+    registry.add_light(spot::SPEC, |p, shape| {
+        Ok(Box::new(SpotLight::from_params(p, shape)?))
     })?;
     registry.add_light(constant::SPEC, |p, shape| {
         Ok(Box::new(ConstantLight::from_params(p, shape)?))

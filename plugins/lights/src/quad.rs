@@ -1,15 +1,19 @@
-//! `quad`: a parallelogram emitter, sampled uniformly by area.
+//! `quad`: a parallelogram emitter, sampled uniformly by area or, for
+//! rectangles, uniformly over the spherical rectangle it subtends (Urena et
+//! al. 2013).
 
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
 
-use crate::area::{AreaLight, Emission, PlanarShape, EMISSION_PARAMS};
+use lumis_sampling::{SphericalRectangle, MIN_SPHERICAL_SAMPLE_AREA};
+
+use crate::area::{AreaLight, Emission, PlanarShape, Sampling, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "quad",
-    doc: "emission of a quad shape: uniform area sampling converted to solid angle",
+    doc: "emission of a quad shape: uniform area sampling converted to solid angle, or spherical-rectangle sampling (Urena et al. 2013) for rectangles subtending at least 3e-4 sr",
     params: EMISSION_PARAMS,
 };
 
@@ -42,13 +46,18 @@ impl QuadLight {
             normal: cross / area,
             area,
         };
-        Ok(Self { shape, emission })
+        Ok(Self {
+            shape,
+            emission,
+            sampling: Sampling::Area,
+        })
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
         let emission = Emission::from_params(params)?;
         match *shape {
-            LightShape::Quad { corner, edge_u, edge_v } => Self::new(corner, edge_u, edge_v, emission),
+            LightShape::Quad { corner, edge_u, edge_v } => Ok(Self::new(corner, edge_u, edge_v, emission)?
+                .with_sampling(Sampling::from_params(params)?)),
             _ => Err(Error::msg(format!(
                 "{}: the quad light is the emission of a quad shape; use [[shape]] type = \"quad\" with emission = {{ ... }}",
                 params.owner()
@@ -96,6 +105,22 @@ impl PlanarShape for Quad {
         let s = (du * vv - dv * uv) / det;
         let r = (dv * uu - du * uv) / det;
         ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t)
+    }
+
+    /// The spherical rectangle's area (Urena et al. 2013, eq. 1), when the
+    /// quad is a rectangle and subtends at least
+    /// [`MIN_SPHERICAL_SAMPLE_AREA`]: below that the angle sum cancels and
+    /// area sampling is nearly as good. Skewed parallelograms always sample
+    /// by area.
+    fn solid_angle(&self, p: Vec3) -> Option<f32> {
+        let omega =
+            SphericalRectangle::new(self.corner, self.edge_u, self.edge_v, p)?.solid_angle();
+        (omega >= f64::from(MIN_SPHERICAL_SAMPLE_AREA)).then_some(omega as f32)
+    }
+
+    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> Option<SurfacePoint> {
+        let st = SphericalRectangle::new(self.corner, self.edge_u, self.edge_v, p)?.sample(u);
+        Some(self.sample_point(st))
     }
 }
 

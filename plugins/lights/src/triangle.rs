@@ -1,16 +1,19 @@
-//! `triangle`: one emissive triangle of a mesh, sampled uniformly by area.
+//! `triangle`: one emissive triangle of a mesh, sampled uniformly by area or
+//! uniformly over the spherical triangle it subtends (Arvo 1995).
 
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
-use lumis_sampling::warp;
+use lumis_sampling::{
+    warp, SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
+};
 
-use crate::area::{AreaLight, Emission, PlanarShape, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, PlanarShape, Sampling, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "triangle",
-    doc: "emission of one mesh triangle: uniform area sampling converted to solid angle",
+    doc: "emission of one mesh triangle: uniform area sampling converted to solid angle, or spherical-triangle sampling (Arvo 1995) where it subtends 3e-4 to 6.22 sr",
     params: EMISSION_PARAMS,
 };
 
@@ -39,17 +42,36 @@ impl TriangleLight {
             normal: cross / len,
             area: 0.5 * len,
         };
-        Ok(Self { shape, emission })
+        Ok(Self {
+            shape,
+            emission,
+            sampling: Sampling::Area,
+        })
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
         let emission = Emission::from_params(params)?;
         match *shape {
-            LightShape::Triangle { p } => Self::new(p, emission),
+            LightShape::Triangle { p } => {
+                Ok(Self::new(p, emission)?.with_sampling(Sampling::from_params(params)?))
+            }
             _ => Err(Error::msg(format!(
                 "{}: the triangle light is the emission of a mesh shape; give the mesh an emission = {{ ... }}",
                 params.owner()
             ))),
+        }
+    }
+}
+
+impl Triangle {
+    /// The point with barycentrics `b`, with its error bound.
+    fn point_at(&self, b: [f32; 3]) -> SurfacePoint {
+        let (q0, q1, q2) = (self.p[0] * b[0], self.p[1] * b[1], self.p[2] * b[2]);
+        SurfacePoint {
+            p: q0 + q1 + q2,
+            // pbrt-v4 Triangle::Sample: gamma(6) (|b0 p0| + |b1 p1| + |b2 p2|).
+            p_error: gamma(6) * (q0.abs() + q1.abs() + q2.abs()),
+            n: self.normal,
         }
     }
 }
@@ -65,14 +87,26 @@ impl PlanarShape for Triangle {
 
     fn sample_point(&self, u: Vec2) -> SurfacePoint {
         let b = warp::square_to_uniform_triangle(u);
-        let (b0, b1, b2) = (b.x, b.y, 1.0 - b.x - b.y);
-        let (q0, q1, q2) = (self.p[0] * b0, self.p[1] * b1, self.p[2] * b2);
-        SurfacePoint {
-            p: q0 + q1 + q2,
-            // pbrt-v4 Triangle::Sample: gamma(6) (|b0 p0| + |b1 p1| + |b2 p2|).
-            p_error: gamma(6) * (q0.abs() + q1.abs() + q2.abs()),
-            n: self.normal,
-        }
+        self.point_at([b.x, b.y, 1.0 - b.x - b.y])
+    }
+
+    /// Arvo's spherical triangle, used where it subtends between
+    /// [`MIN_SPHERICAL_SAMPLE_AREA`] (3e-4 sr: below it the spherical excess
+    /// cancels; a triangle of area `A` at distance `d` subtends about
+    /// `A / d^2`, so a unit triangle beyond ~40 units) and
+    /// [`MAX_SPHERICAL_SAMPLE_AREA`] (6.22 sr: a shading point almost in a
+    /// huge triangle's plane close to it, where the arcs degenerate).
+    /// Elsewhere the light samples by area (pbrt-v4 `Triangle::Sample`).
+    fn solid_angle(&self, p: Vec3) -> Option<f32> {
+        let omega = SphericalTriangle::new(self.p, p)?.solid_angle() as f32;
+        (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA)
+            .contains(&omega)
+            .then_some(omega)
+    }
+
+    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> Option<SurfacePoint> {
+        let b = SphericalTriangle::new(self.p, p)?.sample(u)?;
+        Some(self.point_at(b))
     }
 
     /// Moller-Trumbore ray/triangle test (1997, JGT 2(1)).

@@ -1,0 +1,408 @@
+//! The direct-lighting estimator shared by `path` and `direct`: which
+//! strategies find emission, how many samples each takes at a vertex, and
+//! the multiple importance sampling weights that combine them (Veach 1997,
+//! chapter 9; Veach and Guibas 1995, "Optimally Combining Sampling
+//! Techniques for Monte Carlo Rendering").
+//!
+//! Strategy f samples the BSDF (`n_f` directions per vertex), strategy g
+//! samples the lights (`n_g` points per vertex). The multi-sample estimator
+//! (Veach eq. 9.3) is
+//!
+//! ```text
+//! F = sum_i 1/n_i sum_j w_i(X_ij) f(X_ij) / p_i(X_ij),   i in {f, g}
+//! ```
+//!
+//! with `w_i = n_i p_i / sum_k n_k p_k` (balance, eq. 9.4) or
+//! `(n_i p_i)^beta / sum_k (n_k p_k)^beta` (power, eq. 9.12). The one-sample
+//! estimator (section 9.2.4) draws a single sample from strategy i chosen
+//! with probability `c_i = n_i / (n_f + n_g)` and returns
+//! `w_i(X) f(X) / (c_i p_i(X))`; the balance heuristic is optimal for it
+//! (Theorem 9.4), the power heuristic stays unbiased.
+//!
+//! Delta lights (pdf_li = 0 for every BSDF direction) and specular BSDFs
+//! (no light sample can find their direction) take weight 1 by flags, never
+//! by infinite densities.
+
+use lumis_core::bsdf::BsdfContext;
+use lumis_core::{
+    LightKind, LightSampleContext, ParamSpec, ParamType, Params, RenderStats, Result, Rgb, Sampler,
+    Scene, SurfaceInteraction, Vec3,
+};
+use lumis_sampling::{balance_heuristic, power_heuristic};
+
+/// The parameters every integrator built on [`Estimator`] accepts.
+pub const PARAMS: [ParamSpec; 6] = [
+    ParamSpec::with_default(
+        "strategy",
+        ParamType::String,
+        "\"mis\"",
+        "\"bsdf\" (emission found by BSDF sampling only), \"light\" (next-event estimation only) or \"mis\" (both, weighted)",
+    )
+    .one_of(&["bsdf", "light", "mis"]),
+    ParamSpec::with_default(
+        "heuristic",
+        ParamType::String,
+        "\"power\"",
+        "MIS weights with strategy = \"mis\": \"balance\" or \"power\"",
+    )
+    .one_of(&["balance", "power"]),
+    ParamSpec::with_default("beta", ParamType::Float, "2.0", "exponent of the power heuristic"),
+    ParamSpec::with_default(
+        "n_f",
+        ParamType::Int,
+        "1",
+        "BSDF samples per vertex for direct lighting (the first also continues the path)",
+    )
+    .in_range(1.0, 64.0),
+    ParamSpec::with_default(
+        "n_g",
+        ParamType::Int,
+        "1",
+        "light samples per vertex (next-event estimation)",
+    )
+    .in_range(1.0, 64.0),
+    ParamSpec::with_default(
+        "estimator",
+        ParamType::String,
+        "\"multi-sample\"",
+        "with strategy = \"mis\": \"multi-sample\" takes n_f BSDF and n_g light samples per vertex (Veach eq. 9.3); \"one-sample\" takes one, from the BSDF or the lights with probability n_f : n_g (Veach section 9.2.4)",
+    )
+    .one_of(&["multi-sample", "one-sample"]),
+];
+
+/// Which estimator finds emission.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    Bsdf,
+    Light,
+    Mis,
+}
+
+/// How MIS weights the two strategies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Heuristic {
+    Balance,
+    Power { beta: f32 },
+}
+
+impl Heuristic {
+    /// The weight of a sample of a strategy taking `n_own` samples of
+    /// density `p_own`, against `n_other` samples of density `p_other`.
+    #[inline]
+    pub fn weight(self, n_own: u32, p_own: f32, n_other: u32, p_other: f32) -> f32 {
+        match self {
+            Heuristic::Balance => balance_heuristic(n_own, p_own, n_other, p_other),
+            Heuristic::Power { beta } => power_heuristic(n_own, p_own, n_other, p_other, beta),
+        }
+    }
+}
+
+/// Veach's two ways of combining the strategies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MisEstimator {
+    MultiSample,
+    OneSample,
+}
+
+/// What one vertex does for direct lighting, decided before sampling.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexPlan {
+    /// Light samples to take here.
+    pub light_samples: u32,
+    /// Extra BSDF samples to trace for emission only (beyond the one that
+    /// continues the path).
+    pub extra_bsdf_samples: u32,
+    /// Factor on every light sample's weighted contribution: `1 / n_g`, or
+    /// `1 / c_g` for the one-sample estimator.
+    pub light_scale: f32,
+    /// Factor on emission found by this vertex's BSDF samples: `1 / n_f`,
+    /// `1 / c_f`, 0 when the BSDF may not find emission, 1 after a
+    /// specular bounce.
+    pub bsdf_scale: f32,
+}
+
+impl VertexPlan {
+    /// What a camera ray or a specular bounce carries: emission counts fully.
+    pub const UNWEIGHTED: VertexPlan = VertexPlan {
+        light_samples: 0,
+        extra_bsdf_samples: 0,
+        light_scale: 0.0,
+        bsdf_scale: 1.0,
+    };
+}
+
+/// Strategy, heuristic and sample counts: the whole direct-lighting
+/// estimator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Estimator {
+    pub strategy: Strategy,
+    pub heuristic: Heuristic,
+    pub n_f: u32,
+    pub n_g: u32,
+    pub mode: MisEstimator,
+}
+
+impl Estimator {
+    /// One sample of each strategy per vertex: what the path tracer did
+    /// before sample counts existed.
+    pub fn new(strategy: Strategy, heuristic: Heuristic) -> Self {
+        Self {
+            strategy,
+            heuristic,
+            n_f: 1,
+            n_g: 1,
+            mode: MisEstimator::MultiSample,
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let strategy = match params.get_choice("strategy")?.as_str() {
+            "bsdf" => Strategy::Bsdf,
+            "light" => Strategy::Light,
+            _ => Strategy::Mis,
+        };
+        // Heuristic and beta are validated whatever the strategy, so that
+        // `--set integrator.strategy=bsdf` works on a scene that sets them;
+        // they only change the estimate when strategy = "mis".
+        let heuristic = match params.get_choice("heuristic")?.as_str() {
+            "balance" => Heuristic::Balance,
+            _ => Heuristic::Power {
+                beta: params.get_positive("beta")?,
+            },
+        };
+        if params.is_given("beta") && heuristic == Heuristic::Balance {
+            return Err(params.error("beta", "only applies to heuristic = \"power\""));
+        }
+        let n_f = params.get_in_range("n_f")?;
+        let n_g = params.get_in_range("n_g")?;
+        let mode = match params.get_choice("estimator")?.as_str() {
+            "one-sample" => MisEstimator::OneSample,
+            _ => MisEstimator::MultiSample,
+        };
+        Ok(Self {
+            strategy,
+            heuristic,
+            n_f: n_f as u32,
+            n_g: n_g as u32,
+            mode,
+        })
+    }
+
+    /// The plan at a vertex whose BSDF has a non-specular component; the
+    /// one-sample estimator draws its choice from `sampler` (only then).
+    pub fn plan(&self, sampler: &mut dyn Sampler) -> VertexPlan {
+        let (n_f, n_g) = (self.n_f, self.n_g);
+        match (self.strategy, self.mode) {
+            (Strategy::Bsdf, _) => VertexPlan {
+                light_samples: 0,
+                extra_bsdf_samples: n_f - 1,
+                light_scale: 0.0,
+                bsdf_scale: 1.0 / n_f as f32,
+            },
+            (Strategy::Light, _) => VertexPlan {
+                light_samples: n_g,
+                extra_bsdf_samples: 0,
+                light_scale: 1.0 / n_g as f32,
+                bsdf_scale: 0.0,
+            },
+            (Strategy::Mis, MisEstimator::MultiSample) => VertexPlan {
+                light_samples: n_g,
+                extra_bsdf_samples: n_f - 1,
+                light_scale: 1.0 / n_g as f32,
+                bsdf_scale: 1.0 / n_f as f32,
+            },
+            (Strategy::Mis, MisEstimator::OneSample) => {
+                let c_g = n_g as f32 / (n_f + n_g) as f32;
+                if sampler.get_1d() < c_g {
+                    VertexPlan {
+                        light_samples: 1,
+                        extra_bsdf_samples: 0,
+                        light_scale: 1.0 / c_g,
+                        bsdf_scale: 0.0,
+                    }
+                } else {
+                    VertexPlan {
+                        light_samples: 0,
+                        extra_bsdf_samples: 0,
+                        light_scale: 0.0,
+                        bsdf_scale: 1.0 / (1.0 - c_g),
+                    }
+                }
+            }
+        }
+    }
+
+    /// MIS weight of a light sample of density `p_light` (light pmf times
+    /// solid-angle pdf) whose direction the BSDF samples with `p_bsdf`.
+    #[inline]
+    pub fn light_weight(&self, p_light: f32, p_bsdf: f32, delta: bool) -> f32 {
+        if delta || self.strategy == Strategy::Light {
+            1.0
+        } else {
+            self.heuristic.weight(self.n_g, p_light, self.n_f, p_bsdf)
+        }
+    }
+
+    /// MIS weight of emission found by a BSDF sample of density `p_bsdf`
+    /// from `prev`, on light `index` that samples that direction with
+    /// `pdf_li`; the plan's scale is applied by the caller.
+    #[inline]
+    pub fn bsdf_weight(
+        &self,
+        scene: &dyn Scene,
+        index: u32,
+        prev: &LightSampleContext,
+        wi: Vec3,
+        p_bsdf: f32,
+        specular: bool,
+    ) -> f32 {
+        if specular || self.strategy == Strategy::Bsdf {
+            return 1.0;
+        }
+        if self.strategy == Strategy::Light {
+            return 0.0;
+        }
+        let light = &scene.lights()[index as usize];
+        let p_light = scene.light_sampler().pmf(prev, index) * light.pdf_li(prev, wi);
+        self.heuristic.weight(self.n_f, p_bsdf, self.n_g, p_light)
+    }
+
+    /// Next-event estimation at `hit`: `plan.light_samples` lights chosen
+    /// by the light sampler, one point on each, weighted and scaled.
+    pub fn sample_lights(
+        &self,
+        plan: &VertexPlan,
+        hit: &SurfaceInteraction,
+        wo: Vec3,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        let mut sum = Rgb::BLACK;
+        for _ in 0..plan.light_samples {
+            sum += self.sample_one_light(hit, wo, scene, sampler, stats);
+        }
+        sum * plan.light_scale
+    }
+
+    fn sample_one_light(
+        &self,
+        hit: &SurfaceInteraction,
+        wo: Vec3,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        let u_light = sampler.get_1d();
+        let u = sampler.get_2d();
+        let ctx = hit.light_context();
+        let Some(chosen) = scene.light_sampler().sample(&ctx, u_light) else {
+            return Rgb::BLACK;
+        };
+        let light = &scene.lights()[chosen.index as usize];
+        let Some(ls) = light.sample_li(&ctx, u) else {
+            return Rgb::BLACK;
+        };
+        let wi = hit.shading.to_local(ls.wi);
+        let bsdf_ctx = BsdfContext {
+            uv: hit.uv,
+            ..Default::default()
+        };
+        let f = hit.bsdf.f(&bsdf_ctx, wo, wi) * wi.z.abs();
+        if f.is_black() {
+            return Rgb::BLACK;
+        }
+        stats.shadow_rays += 1;
+        if scene.occluded(&hit.point.spawn_ray_to(&ls.p)) {
+            return Rgb::BLACK;
+        }
+        stats.light_samples += 1;
+        let p_light = chosen.pmf * ls.pdf;
+        let delta = light.kind() == LightKind::DeltaPosition;
+        let p_bsdf = if delta {
+            0.0
+        } else {
+            hit.bsdf.pdf(&bsdf_ctx, wo, wi)
+        };
+        f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
+    }
+
+    /// Emission found by `count` BSDF samples at `hit` that only look for
+    /// emitters (they do not continue the path), weighted and scaled by the
+    /// plan's `bsdf_scale`.
+    pub fn extra_bsdf_samples(
+        &self,
+        plan: &VertexPlan,
+        hit: &SurfaceInteraction,
+        wo: Vec3,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        let mut sum = Rgb::BLACK;
+        for _ in 0..plan.extra_bsdf_samples {
+            let u1 = sampler.get_1d();
+            let u2 = sampler.get_2d();
+            let bsdf_ctx = BsdfContext {
+                uv: hit.uv,
+                ..Default::default()
+            };
+            let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) else {
+                continue;
+            };
+            let wi = hit.shading.to_world(bs.wi);
+            if wi.dot(hit.n()) * bs.wi.z <= 0.0 {
+                continue;
+            }
+            let throughput = bs.f * (bs.wi.z.abs() / bs.pdf);
+            let prev = hit.light_context();
+            let ray = hit.spawn_ray(wi);
+            stats.rays += 1;
+            sum += throughput
+                * self.emission_along(scene, &ray, &prev, bs.pdf, bs.flags.is_specular(), stats);
+        }
+        sum * plan.bsdf_scale
+    }
+
+    /// Weighted emission seen along a BSDF-sampled `ray` from `prev`: the
+    /// emitter it hits, or the infinite lights if it escapes. The caller
+    /// counts the ray and applies the plan's scale.
+    pub fn emission_along(
+        &self,
+        scene: &dyn Scene,
+        ray: &lumis_core::Ray,
+        prev: &LightSampleContext,
+        p_bsdf: f32,
+        specular: bool,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        let mut sum = Rgb::BLACK;
+        match scene.intersect(ray) {
+            Some(hit) => {
+                if let Some(emitter) = hit.light {
+                    let le = emitter.light.l(hit.p(), hit.n(), hit.uv, hit.wo);
+                    if !le.is_black() {
+                        let w =
+                            self.bsdf_weight(scene, emitter.index, prev, ray.d, p_bsdf, specular);
+                        if w > 0.0 {
+                            sum += le * w;
+                            stats.bsdf_light_hits += 1;
+                        }
+                    }
+                }
+            }
+            None => {
+                for &index in scene.infinite_lights() {
+                    let light = &scene.lights()[index as usize];
+                    let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
+                    let w = self.bsdf_weight(scene, index, prev, ray.d, p_bsdf, specular);
+                    if w > 0.0 && !le.is_black() {
+                        sum += le * w;
+                        stats.bsdf_light_hits += 1;
+                    }
+                }
+            }
+        }
+        sum
+    }
+}
