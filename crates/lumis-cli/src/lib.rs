@@ -1,12 +1,14 @@
-//! The `lumis` command line: the built-in plugin set and the `render`
-//! command, as a library so end-to-end tests and benchmarks drive exactly
+//! The `lumis` command line: the built-in plugin set, the `render` and
+//! `samplers analyze` commands, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
 mod listing;
 mod render;
+mod samplers_analyze;
 
 pub use listing::plugin_listing;
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
+pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
 
 use lumis_core::{Registry, Result};
 

@@ -5,7 +5,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
-use lumis_cli::{plugin_listing, registry_with_search_path, render_scene_file, RenderArgs};
+use lumis_cli::{
+    analyze_samplers, plugin_listing, registry_with_search_path, render_scene_file, AnalyzeArgs,
+    RenderArgs,
+};
 use lumis_core::{Error, PluginKind, Result};
 
 #[derive(Parser)]
@@ -51,6 +54,17 @@ enum Command {
         #[arg(long, default_value = ".")]
         out: PathBuf,
     },
+    /// Sample generators: compare where they put their points.
+    #[command(subcommand)]
+    Samplers(SamplersCommand),
+}
+
+#[derive(Subcommand)]
+enum SamplersCommand {
+    /// Point-set pictures, power spectrum (2D and radially averaged),
+    /// L2-star discrepancy, raw points, and a convergence study on test
+    /// integrands against Simpson's rule, for one sampler or `all`.
+    Analyze(AnalyzeArgs),
 }
 
 fn main() -> ExitCode {
@@ -76,6 +90,13 @@ fn main() -> ExitCode {
             bins,
             out,
         } => check_plugin(library, bsdf, samples, bins, &out),
+        Command::Samplers(SamplersCommand::Analyze(args)) => registry_with_search_path()
+            .and_then(|registry| analyze_samplers(&args, &registry))
+            .map(|report| {
+                print!("{report}");
+                println!("pictures and CSV in {}", args.out.display());
+                true
+            }),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

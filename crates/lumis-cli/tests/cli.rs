@@ -149,3 +149,96 @@ fn check_plugin_checks_a_builtin_bsdf_and_reports_a_table() {
         String::from_utf8_lossy(&missing.stderr).contains("no bsdf plugin named \"no-such-bsdf\"")
     );
 }
+
+#[test]
+fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
+    let dir = scratch("analyze");
+    let out = dir.join("out");
+    let dump = dir.join("points.csv");
+    let run = lumis(&[
+        "samplers",
+        "analyze",
+        "--sampler",
+        "sobol",
+        "--count",
+        "64",
+        "--dims",
+        "5",
+        "--realizations",
+        "2",
+        "--spectrum-size",
+        "16",
+        "--max-count",
+        "64",
+        "--seeds",
+        "8",
+        "--out",
+        out.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for file in [
+        "sobol-points.png",
+        "sobol-points-d2-d3.png",
+        "sobol-psd.png",
+        "sobol-radial-psd.png",
+        "convergence.csv",
+        "convergence-gaussian.png",
+        "convergence-step-1d.png",
+    ] {
+        assert!(out.join(file).is_file(), "{file} missing");
+    }
+    // 64 rows of 5 columns, every value in [0, 1).
+    let csv = std::fs::read_to_string(&dump).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("d0,d1,d2,d3,d4"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 64);
+    assert!(rows
+        .iter()
+        .all(|r| r.len() == 5 && r.iter().all(|v| (0.0..1.0).contains(v))));
+    assert!(stdout.contains("L2-star discrepancy") && stdout.contains("simpson"));
+}
+
+#[test]
+fn samplers_analyze_rejects_unknown_sampler_and_bad_parameters() {
+    let dir = scratch("analyze-errors");
+    let run = lumis(&[
+        "samplers",
+        "analyze",
+        "--sampler",
+        "sobl",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("unknown sampler \"sobl\"") && stderr.contains("independent, poisson-disk"),
+        "{stderr}"
+    );
+    let run = lumis(&[
+        "samplers",
+        "analyze",
+        "--sampler",
+        "sobol",
+        "--set",
+        "randomize=fancy",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("randomize") && stderr.contains("owen"),
+        "{stderr}"
+    );
+}

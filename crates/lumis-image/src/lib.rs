@@ -7,7 +7,7 @@ mod png_io;
 
 pub use atomic::write_atomically;
 pub use exr_io::{read_exr, write_exr};
-pub use png_io::{linear_to_srgb8, write_png};
+pub use png_io::{linear_to_srgb8, write_png, write_rgb8_png};
 
 use std::path::PathBuf;
 

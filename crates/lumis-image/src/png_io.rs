@@ -25,13 +25,23 @@ pub fn write_png(path: &Path, image: &Image) -> Result<(), ImageError> {
         .iter()
         .flat_map(|p| p.map(linear_to_srgb8))
         .collect();
+    write_rgb8_png(path, image.width, image.height, &data)
+}
+
+/// Writes 8-bit sRGB RGB rows (e.g. a drawn plot) to a PNG, atomically.
+pub fn write_rgb8_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    data: &[u8],
+) -> Result<(), ImageError> {
     write_atomically(path, |w| {
-        let mut encoder = png::Encoder::new(&mut *w, image.width as u32, image.height as u32);
+        let mut encoder = png::Encoder::new(&mut *w, width as u32, height as u32);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(&data).map_err(|e| e.to_string())?;
+        writer.write_image_data(data).map_err(|e| e.to_string())?;
         writer.finish().map_err(|e| e.to_string())?;
         flush(w)
     })

@@ -1,0 +1,14 @@
+//! Sample-pattern analysis: where a sampler puts its points and what that
+//! buys. Discrepancy ([`discrepancy`]), power spectra ([`spectrum`]),
+//! convergence on integrands with known integrals against Simpson's rule
+//! ([`convergence`], [`integrands`]), and the PNG plots ([`plot`]).
+
+pub mod convergence;
+pub mod discrepancy;
+pub mod integrands;
+pub mod plot;
+pub mod points;
+pub mod spectrum;
+
+pub use discrepancy::l2_star_discrepancy;
+pub use points::{sample_points, sample_points_1d, PointSet};
