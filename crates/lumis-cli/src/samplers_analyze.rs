@@ -293,17 +293,16 @@ fn convergence_study(args: &AnalyzeArgs, registry: &Registry, names: &[String]) 
         write!(table, " {:>22}", g.name).unwrap();
     }
     table.push('\n');
-    // A rate, or where the error reached the rounding floor.
+    // The rate over the errors above the rounding floor, then the last
+    // error or where the floor was reached.
     let slope_text = |xs: &[f64], errors: &[f64]| {
         let last = *errors.last().unwrap();
-        if last <= EXACT {
-            let from = xs.iter().zip(errors).find(|(_, e)| **e <= EXACT).unwrap().0;
-            format!("exact from N={from}")
-        } else {
-            match loglog_slope(xs, errors) {
-                Some(s) => format!("{s:+.2} ({last:.1e})"),
-                None => format!("- ({last:.1e})"),
-            }
+        let floor = xs.iter().zip(errors).find(|(_, e)| **e <= EXACT).map(|p| *p.0);
+        match (loglog_slope(xs, errors), floor) {
+            (Some(s), None) => format!("{s:+.2} ({last:.1e})"),
+            (Some(s), Some(n)) => format!("{s:+.2} (exact N>={n})"),
+            (None, Some(n)) => format!("exact N>={n}"),
+            (None, None) => format!("- ({last:.1e})"),
         }
     };
     for r in &results {
