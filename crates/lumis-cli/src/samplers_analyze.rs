@@ -297,7 +297,11 @@ fn convergence_study(args: &AnalyzeArgs, registry: &Registry, names: &[String]) 
     // error or where the floor was reached.
     let slope_text = |xs: &[f64], errors: &[f64]| {
         let last = *errors.last().unwrap();
-        let floor = xs.iter().zip(errors).find(|(_, e)| **e <= EXACT).map(|p| *p.0);
+        let floor = xs
+            .iter()
+            .zip(errors)
+            .find(|(_, e)| **e <= EXACT)
+            .map(|p| *p.0);
         match (loglog_slope(xs, errors), floor) {
             (Some(s), None) => format!("{s:+.2} ({last:.1e})"),
             (Some(s), Some(n)) => format!("{s:+.2} (exact N>={n})"),

@@ -104,6 +104,7 @@ impl Sampler for HammersleySampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::net_check::is_02_net;
 
     /// For N = 2^m the scrambled first two dimensions are a (0,m,2)-net:
     /// each 2^a x 2^(m-a) cell holds one point.
@@ -118,16 +119,7 @@ mod tests {
                     s.get_pixel_2d()
                 })
                 .collect();
-            for a in 0..=m {
-                let mut seen = vec![false; n as usize];
-                for p in &points {
-                    let cx = (p.x * (1u32 << a) as f32) as u32;
-                    let cy = (p.y * (1u32 << (m - a)) as f32) as u32;
-                    let cell = (cx << (m - a)) | cy;
-                    assert!(!seen[cell as usize], "m {m} a {a}");
-                    seen[cell as usize] = true;
-                }
-            }
+            assert!(is_02_net(&points, m), "m {m}");
         }
     }
 }

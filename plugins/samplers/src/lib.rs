@@ -3,6 +3,8 @@
 mod halton;
 mod hammersley;
 mod independent;
+#[cfg(test)]
+mod net_check;
 mod poisson_disk;
 mod sobol;
 mod spp;

@@ -186,6 +186,7 @@ impl Sampler for SobolSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::net_check::is_02_net;
 
     fn pairs(s: &mut SobolSampler, n: u32, skip_pairs: usize, seed: u64) -> Vec<Vec2> {
         (0..n)
@@ -198,18 +199,6 @@ mod tests {
                 p
             })
             .collect()
-    }
-
-    fn is_02_net(points: &[Vec2], m: u32) -> bool {
-        (0..=m).all(|a| {
-            let mut seen = vec![false; 1 << m];
-            points.iter().all(|p| {
-                let cx = (p.x * (1u32 << a) as f32) as u32;
-                let cy = (p.y * (1u32 << (m - a)) as f32) as u32;
-                let cell = ((cx << (m - a)) | cy) as usize;
-                !std::mem::replace(&mut seen[cell], true)
-            })
-        })
     }
 
     /// The film-plane samples of every power-of-two prefix, up to 2^14,

@@ -223,18 +223,7 @@ impl Sampler for ZSobolSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn is_02_net(points: &[Vec2], m: u32) -> bool {
-        (0..=m).all(|a| {
-            let mut seen = vec![false; 1 << m];
-            points.iter().all(|p| {
-                let cx = (p.x * (1u32 << a) as f32) as u32;
-                let cy = (p.y * (1u32 << (m - a)) as f32) as u32;
-                let cell = ((cx << (m - a)) | cy) as usize;
-                !std::mem::replace(&mut seen[cell], true)
-            })
-        })
-    }
+    use crate::net_check::is_02_net;
 
     fn pixel_points(s: &mut ZSobolSampler, pixel: UVec2, pair: usize) -> Vec<Vec2> {
         (0..s.spp)
