@@ -1,10 +1,12 @@
 //! Sample-pattern analysis: where a sampler puts its points and what that
 //! buys. Discrepancy ([`discrepancy`]), power spectra ([`spectrum`]),
 //! convergence on integrands with known integrals against Simpson's rule
-//! ([`convergence`], [`integrands`]), and the PNG plots ([`plot`]).
+//! ([`convergence`], [`integrands`]), image error metrics against a
+//! reference ([`image_error`]), and the PNG plots ([`plot`]).
 
 pub mod convergence;
 pub mod discrepancy;
+pub mod image_error;
 pub mod integrands;
 pub mod plot;
 pub mod points;

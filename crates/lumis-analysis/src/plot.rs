@@ -93,14 +93,26 @@ fn viridis(t: f64) -> RGBColor {
     RGBColor(lerp(a.0, b.0), lerp(a.1, b.1), lerp(a.2, b.2))
 }
 
-/// A `size x size` array (row-major, row = y) as a log10 heat map over
-/// frequencies `[-size/2, size/2)`, with a colour bar. Values are clamped to
-/// `[min, max]` of the positive entries, or to `range` when given.
+/// Where a heat map's cells sit: a `width x height` grid whose cell
+/// `(0, 0)` (row 0 at the bottom) is at integer coordinate `origin`.
+pub struct Grid<'a> {
+    pub width: usize,
+    pub height: usize,
+    pub origin: (i64, i64),
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    /// What the colour bar measures, e.g. "log10 P".
+    pub value_label: &'a str,
+}
+
+/// A row-major array as a log10 heat map with a colour bar (viridis).
+/// Values are clamped to `[min, max]` of the positive entries, or to
+/// `range` when given.
 pub fn heat_map(
     path: &Path,
     title: &str,
     values: &[f64],
-    size: usize,
+    grid: &Grid,
     range: Option<(f64, f64)>,
 ) -> Result<()> {
     let positive = values.iter().copied().filter(|v| *v > 0.0);
@@ -111,29 +123,33 @@ pub fn heat_map(
         lo.max(1e-12).log10(),
         hi.max(1e-12).log10().max(lo.log10() + 1e-9),
     );
-    let half = (size / 2) as i64;
-    render(path, (760, 660), |root| {
-        let (map_area, bar_area) = root.split_horizontally(650);
+    let (w, h) = (grid.width, grid.height);
+    let (x0, y0) = grid.origin;
+    // Keep cells square: the plot area follows the grid's aspect ratio.
+    let map_width = 650u32;
+    let map_height = ((map_width - 60) as f64 * h as f64 / w as f64) as u32 + 80;
+    render(path, (map_width + 110, map_height.max(200)), |root| {
+        let (map_area, bar_area) = root.split_horizontally(map_width);
         let mut chart = ChartBuilder::on(&map_area)
             .caption(title, (FONT, 18))
             .margin(12)
             .x_label_area_size(30)
             .y_label_area_size(40)
-            .build_cartesian_2d(-half..half, -half..half)
+            .build_cartesian_2d(x0..x0 + w as i64, y0..y0 + h as i64)
             .map_err(text_error)?;
         chart
             .configure_mesh()
             .disable_mesh()
             .label_style((FONT, 12))
-            .x_desc("k_x")
-            .y_desc("k_y")
+            .x_desc(grid.x_label)
+            .y_desc(grid.y_label)
             .draw()
             .map_err(text_error)?;
         chart
-            .draw_series((0..size).flat_map(|y| {
-                (0..size).map(move |x| {
-                    let v = values[y * size + x].max(1e-12).log10();
-                    let (kx, ky) = (x as i64 - half, y as i64 - half);
+            .draw_series((0..h).flat_map(|y| {
+                (0..w).map(move |x| {
+                    let v = values[y * w + x].max(1e-12).log10();
+                    let (kx, ky) = (x as i64 + x0, y as i64 + y0);
                     Rectangle::new(
                         [(kx, ky), (kx + 1, ky + 1)],
                         viridis((v - lo) / (hi - lo)).filled(),
@@ -152,7 +168,7 @@ pub fn heat_map(
             .disable_mesh()
             .disable_x_axis()
             .label_style((FONT, 11))
-            .y_desc("log10 P")
+            .y_desc(grid.value_label)
             .draw()
             .map_err(text_error)?;
         let steps = 100;
@@ -323,7 +339,15 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         scatter(&dir.join("s.png"), "points", &[[0.1, 0.2], [0.7, 0.9]]).unwrap();
         let values: Vec<f64> = (0..64).map(|i| 1.0 + i as f64).collect();
-        heat_map(&dir.join("h.png"), "psd", &values, 8, None).unwrap();
+        let grid = Grid {
+            width: 8,
+            height: 8,
+            origin: (-4, -4),
+            x_label: "k_x",
+            y_label: "k_y",
+            value_label: "log10 P",
+        };
+        heat_map(&dir.join("h.png"), "psd", &values, &grid, None).unwrap();
         let series = [Series {
             name: "a".into(),
             points: vec![(1.0, 1.0), (10.0, 0.1)],

@@ -2,10 +2,12 @@
 //! `samplers analyze` commands, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
+mod diff;
 mod listing;
 mod render;
 mod samplers_analyze;
 
+pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};

@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
 use lumis_cli::{
-    analyze_samplers, plugin_listing, registry_with_search_path, render_scene_file, AnalyzeArgs,
-    RenderArgs,
+    analyze_samplers, diff_images, plugin_listing, registry_with_search_path, render_scene_file,
+    AnalyzeArgs, DiffArgs, RenderArgs,
 };
 use lumis_core::{Error, PluginKind, Result};
 
@@ -54,6 +54,10 @@ enum Command {
         #[arg(long, default_value = ".")]
         out: PathBuf,
     },
+    /// Error of an image against a reference: MSE, RMSE, relMSE, mean
+    /// absolute and signed relative error, PSNR, per named region, and an
+    /// optional false-colour error picture.
+    Diff(DiffArgs),
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
@@ -90,6 +94,10 @@ fn main() -> ExitCode {
             bins,
             out,
         } => check_plugin(library, bsdf, samples, bins, &out),
+        Command::Diff(args) => diff_images(&args).map(|report| {
+            print!("{report}");
+            true
+        }),
         Command::Samplers(SamplersCommand::Analyze(args)) => registry_with_search_path()
             .and_then(|registry| analyze_samplers(&args, &registry))
             .map(|report| {

@@ -210,11 +210,20 @@ pub fn analyze(args: &AnalyzeArgs, registry: &Registry) -> Result<String> {
             "{name}: power spectrum, {} points, {} scrambles",
             args.count, args.realizations
         );
+        let half = (size / 2) as i64;
+        let grid = plot::Grid {
+            width: size,
+            height: size,
+            origin: (-half, -half),
+            x_label: "k_x",
+            y_label: "k_y",
+            value_label: "log10 power",
+        };
         plot::heat_map(
             &args.out.join(format!("{name}-psd.png")),
             &title,
             &psd,
-            size,
+            &grid,
             None,
         )?;
         let (radial, _) = radial_average(&psd, size);

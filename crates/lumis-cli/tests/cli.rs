@@ -242,3 +242,67 @@ fn samplers_analyze_rejects_unknown_sampler_and_bad_parameters() {
         "{stderr}"
     );
 }
+
+fn write_exr(path: &Path, width: usize, height: usize, values: &[f32]) {
+    let mut image = lumis_image::Image::new(width, height);
+    for (p, v) in image.pixels.iter_mut().zip(values) {
+        *p = [*v; 3];
+    }
+    lumis_image::write_exr(path, &image).unwrap();
+}
+
+#[test]
+fn diff_prints_known_numbers_per_region_and_refuses_other_sizes() {
+    let dir = scratch("diff");
+    let (a, b, c) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("c.exr"));
+    // Reference (1, 0), image (1.5, 0.1): MSE 0.13, relMSE (0.25/1.01 + 1)/2.
+    write_exr(&a, 2, 1, &[1.5, 0.1]);
+    write_exr(&b, 2, 1, &[1.0, 0.0]);
+    write_exr(&c, 1, 2, &[1.0, 0.0]);
+    let mask = dir.join("regions.toml");
+    std::fs::write(
+        &mask,
+        "[[region]]\nname = \"left\"\nmin = [0, 0]\nmax = [1, 1]\n",
+    )
+    .unwrap();
+    let picture = dir.join("err.png");
+    let run = lumis(&[
+        "diff",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--mask",
+        mask.to_str().unwrap(),
+        "--error-image",
+        picture.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let image_row = stdout.lines().find(|l| l.starts_with("image")).unwrap();
+    let numbers: Vec<f64> = image_row
+        .split_whitespace()
+        .skip(1)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((numbers[0] - 0.13).abs() < 1e-6, "{image_row}");
+    assert!(
+        (numbers[2] - (0.25 / 1.01 + 1.0) / 2.0).abs() < 1e-4,
+        "{image_row}"
+    );
+    let left_row = stdout.lines().find(|l| l.starts_with("left")).unwrap();
+    let left: Vec<f64> = left_row
+        .split_whitespace()
+        .skip(1)
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert!((left[0] - 0.25).abs() < 1e-6, "{left_row}");
+    assert!(picture.is_file());
+
+    let run = lumis(&["diff", a.to_str().unwrap(), c.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(stderr.contains("differ in size: 2x1 vs 1x2"), "{stderr}");
+}
