@@ -2,11 +2,13 @@
 //! `samplers analyze` commands, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
+mod converge;
 mod diff;
 mod listing;
 mod render;
 mod samplers_analyze;
 
+pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};

@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
 use lumis_cli::{
-    analyze_samplers, diff_images, plugin_listing, registry_with_search_path, render_scene_file,
-    AnalyzeArgs, DiffArgs, RenderArgs,
+    analyze_samplers, converge, diff_images, plugin_listing, registry_with_search_path,
+    render_scene_file, AnalyzeArgs, ConvergeArgs, DiffArgs, RenderArgs,
 };
 use lumis_core::{Error, PluginKind, Result};
 
@@ -54,6 +54,10 @@ enum Command {
         #[arg(long, default_value = ".")]
         out: PathBuf,
     },
+    /// Error vs samples and vs time against a reference, for variants of a
+    /// scene (sampler, strategy, heuristic, BSDF sampling...) over seeds:
+    /// CSV, JSON, two log-log plots and a table ranked by efficiency.
+    Converge(ConvergeArgs),
     /// Error of an image against a reference: MSE, RMSE, relMSE, mean
     /// absolute and signed relative error, PSNR, per named region, and an
     /// optional false-colour error picture.
@@ -94,6 +98,13 @@ fn main() -> ExitCode {
             bins,
             out,
         } => check_plugin(library, bsdf, samples, bins, &out),
+        Command::Converge(args) => registry_with_search_path()
+            .and_then(|registry| converge(&args, &registry))
+            .map(|report| {
+                print!("{}", report.table);
+                println!("CSV, JSON and plots in {}", args.out.display());
+                true
+            }),
         Command::Diff(args) => diff_images(&args).map(|report| {
             print!("{report}");
             true

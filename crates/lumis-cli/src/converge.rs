@@ -1,0 +1,431 @@
+//! `lumis converge`: error against a reference vs samples and vs time, for
+//! several variants of one scene, over several seeds.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressStyle};
+use lumis_analysis::convergence::loglog_slope;
+use lumis_analysis::image_error::{check_same_size, error_metrics};
+use lumis_analysis::plot::{self, Axes, Series};
+use lumis_core::doc::{self, Value};
+use lumis_core::{Error, Registry, Result};
+use lumis_image::read_exr;
+use lumis_render::{render, RenderSettings};
+
+use crate::render::{load, RenderArgs};
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct ConvergeArgs {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// The converged reference image (EXR) of the same scene.
+    #[arg(long)]
+    pub reference: PathBuf,
+    /// Variants (TOML: `[[variant]] name = "...", set = ["sampler.type=sobol", ...]`).
+    #[arg(long, value_name = "variants.toml")]
+    pub variants: PathBuf,
+    /// Samples per pixel to measure, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1,2,4,8,16,32,64")]
+    pub spp: Vec<u32>,
+    /// Seeds per (variant, spp): the spread gives the standard errors.
+    #[arg(long, default_value_t = 4)]
+    pub seeds: u64,
+    /// Equal time instead of equal samples: each variant doubles its spp
+    /// from 1 while one render fits in this many seconds.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_budget: Option<f64>,
+    /// Overrides applied to every variant (like `lumis render --set`).
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    pub set: Vec<String>,
+    /// Worker threads; 0 means one per core.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Output directory for converge.csv, converge.json and the plots.
+    #[arg(long, default_value = "converge")]
+    pub out: PathBuf,
+}
+
+/// One variant: a name and its scene overrides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Variant {
+    pub name: String,
+    pub set: Vec<String>,
+}
+
+/// Reads `[[variant]]` tables, with located errors.
+pub fn parse_variants(text: &str, path: &str) -> Result<Vec<Variant>> {
+    let root = doc::parse(text, path)?;
+    let mut variants = Vec::new();
+    for entry in &root.entries {
+        let Value::Array(items) = &entry.node.value else {
+            return Err(Error::at(
+                &entry.key_location,
+                "expected [[variant]] tables only",
+            ));
+        };
+        if entry.key != "variant" {
+            return Err(Error::at(
+                &entry.key_location,
+                format!("unknown key '{}'; expected [[variant]]", entry.key),
+            ));
+        }
+        for item in items {
+            let Value::Table(table) = &item.value else {
+                return Err(Error::at(&item.location, "each variant must be a table"));
+            };
+            for key in table.keys() {
+                if key != "name" && key != "set" {
+                    return Err(Error::at(
+                        &table.entry(key).unwrap().key_location,
+                        format!("unknown variant key '{key}'; accepted: name, set"),
+                    ));
+                }
+            }
+            let Some(Value::String(name)) = table.get("name").map(|n| &n.value) else {
+                return Err(Error::at(&item.location, "variant needs name = \"...\""));
+            };
+            let mut set = Vec::new();
+            if let Some(node) = table.get("set") {
+                let bad = || {
+                    Error::at(
+                        &node.location,
+                        format!("variant \"{name}\": set must be an array of \"key.path=value\" strings"),
+                    )
+                };
+                let Value::Array(values) = &node.value else {
+                    return Err(bad());
+                };
+                for v in values {
+                    match &v.value {
+                        Value::String(s) if s.contains('=') => set.push(s.clone()),
+                        _ => return Err(bad()),
+                    }
+                }
+            }
+            variants.push(Variant {
+                name: name.clone(),
+                set,
+            });
+        }
+    }
+    if variants.is_empty() {
+        return Err(Error::msg(format!("{path}: no [[variant]] tables")));
+    }
+    Ok(variants)
+}
+
+/// One render: a variant at one spp and seed.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub variant: String,
+    pub spp: u32,
+    pub seed: u64,
+    pub seconds: f64,
+    pub samples_per_second: f64,
+    pub rays_per_second: f64,
+    pub mse: f64,
+    pub rel_mse: f64,
+}
+
+/// The seeds of one (variant, spp), summarised.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub variant: String,
+    pub spp: u32,
+    pub seconds: f64,
+    pub mse: f64,
+    pub mse_se: f64,
+    pub rel_mse: f64,
+    pub rel_mse_se: f64,
+    pub rel_mse_min: f64,
+    pub rel_mse_max: f64,
+    /// 1 / (relMSE x seconds).
+    pub efficiency: f64,
+}
+
+fn mean_se(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    if values.len() < 2 {
+        return (mean, f64::NAN);
+    }
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+fn summarise(runs: &[Run]) -> Point {
+    let rel: Vec<f64> = runs.iter().map(|r| r.rel_mse).collect();
+    let mse: Vec<f64> = runs.iter().map(|r| r.mse).collect();
+    let (rel_mse, rel_mse_se) = mean_se(&rel);
+    let (mse, mse_se) = mean_se(&mse);
+    let seconds = runs.iter().map(|r| r.seconds).sum::<f64>() / runs.len() as f64;
+    Point {
+        variant: runs[0].variant.clone(),
+        spp: runs[0].spp,
+        seconds,
+        mse,
+        mse_se,
+        rel_mse,
+        rel_mse_se,
+        rel_mse_min: rel.iter().cloned().fold(f64::INFINITY, f64::min),
+        rel_mse_max: rel.iter().cloned().fold(0.0, f64::max),
+        efficiency: 1.0 / (rel_mse * seconds),
+    }
+}
+
+/// What `converge` measured, and where it wrote it.
+pub struct ConvergeReport {
+    pub runs: Vec<Run>,
+    pub points: Vec<Point>,
+    /// Per variant: fitted log-log slope of relMSE vs spp.
+    pub slopes: Vec<(String, Option<f64>)>,
+    pub table: String,
+}
+
+/// Renders every variant at each spp and seed and measures its error.
+pub fn converge(args: &ConvergeArgs, registry: &Registry) -> Result<ConvergeReport> {
+    let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
+    let variants_path = args.variants.display().to_string();
+    let text = std::fs::read_to_string(&args.variants)
+        .map_err(|e| Error::msg(format!("{variants_path}: {e}")))?;
+    let variants = parse_variants(&text, &variants_path)?;
+    if args.seeds == 0 || args.spp.contains(&0) {
+        return Err(Error::msg(
+            "--seeds and every --spp value must be at least 1",
+        ));
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| Error::msg(format!("{}: {e}", args.out.display())))?;
+
+    let render_once = |variant: &Variant, spp: u32, seed: u64| -> Result<Run> {
+        let mut set = args.set.clone();
+        set.extend(variant.set.iter().cloned());
+        let render_args = RenderArgs {
+            scene: args.scene.clone(),
+            spp: Some(spp),
+            seed: Some(seed),
+            threads: args.threads,
+            set,
+            ..Default::default()
+        };
+        let loaded = load(&render_args, registry)
+            .map_err(|e| Error::msg(format!("variant \"{}\": {e}", variant.name)))?;
+        let settings = RenderSettings {
+            spp,
+            seed,
+            threads: args.threads,
+            progress: false,
+        };
+        let out = render(
+            &loaded.camera,
+            &loaded.scene,
+            loaded.integrator.as_ref(),
+            loaded.sampler.as_ref(),
+            &settings,
+        )?;
+        check_same_size(&out.image, &reference).map_err(|e| {
+            Error::msg(format!(
+                "variant \"{}\" vs {}: {e}",
+                variant.name,
+                args.reference.display()
+            ))
+        })?;
+        let m = error_metrics(&out.image, &reference, None);
+        Ok(Run {
+            variant: variant.name.clone(),
+            spp,
+            seed,
+            seconds: out.seconds,
+            samples_per_second: out.stats.samples as f64 / out.seconds,
+            rays_per_second: out.stats.total_rays() as f64 / out.seconds,
+            mse: m.mse,
+            rel_mse: m.rel_mse,
+        })
+    };
+
+    let total = match args.time_budget {
+        Some(_) => 0,
+        None => (variants.len() * args.spp.len()) as u64 * args.seeds,
+    };
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{msg:28} [{bar:40}] {pos}/{len} {elapsed}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let mut runs = Vec::new();
+    let mut points = Vec::new();
+    for variant in &variants {
+        let mut spp_list: Vec<u32> = args.spp.clone();
+        if args.time_budget.is_some() {
+            spp_list = vec![1];
+        }
+        let mut i = 0;
+        while i < spp_list.len() {
+            let spp = spp_list[i];
+            bar.set_message(format!("{} @ {spp} spp", variant.name));
+            let mut these = Vec::new();
+            for s in 0..args.seeds {
+                these.push(render_once(variant, spp, s)?);
+                bar.inc(1);
+            }
+            let point = summarise(&these);
+            runs.extend(these);
+            if let Some(budget) = args.time_budget {
+                // Keep doubling while the next render would still fit.
+                if point.seconds * 2.0 <= budget {
+                    spp_list.push(spp * 2);
+                }
+                if point.seconds > budget && !points.is_empty() {
+                    break;
+                }
+            }
+            points.push(point);
+            i += 1;
+        }
+    }
+    bar.finish_and_clear();
+
+    let slopes: Vec<(String, Option<f64>)> = variants
+        .iter()
+        .map(|v| {
+            let (xs, ys): (Vec<f64>, Vec<f64>) = points
+                .iter()
+                .filter(|p| p.variant == v.name)
+                .map(|p| (p.spp as f64, p.rel_mse))
+                .unzip();
+            (v.name.clone(), loglog_slope(&xs, &ys))
+        })
+        .collect();
+    write_outputs(args, &variants, &runs, &points)?;
+    let table = ranked_table(&variants, &points, &slopes, args.time_budget);
+    Ok(ConvergeReport {
+        runs,
+        points,
+        slopes,
+        table,
+    })
+}
+
+/// Ranks the variants by efficiency at their last (largest) spp.
+fn ranked_table(
+    variants: &[Variant],
+    points: &[Point],
+    slopes: &[(String, Option<f64>)],
+    budget: Option<f64>,
+) -> String {
+    let mut last: Vec<&Point> = variants
+        .iter()
+        .filter_map(|v| points.iter().rev().find(|p| p.variant == v.name))
+        .collect();
+    match budget {
+        Some(_) => last.sort_by(|a, b| a.rel_mse.total_cmp(&b.rel_mse)),
+        None => last.sort_by(|a, b| b.efficiency.total_cmp(&a.efficiency)),
+    }
+    let mut out = format!(
+        "{:20} {:>6} {:>9} {:>11} {:>10} {:>11} {:>8}\n",
+        "variant", "spp", "seconds", "relMSE", "+-se", "efficiency", "slope"
+    );
+    for p in last {
+        let slope = slopes
+            .iter()
+            .find(|s| s.0 == p.variant)
+            .and_then(|s| s.1)
+            .map_or("-".into(), |s| format!("{s:+.2}"));
+        writeln!(
+            out,
+            "{:20} {:>6} {:>9.3} {:>11.4e} {:>10.2e} {:>11.1} {:>8}",
+            p.variant, p.spp, p.seconds, p.rel_mse, p.rel_mse_se, p.efficiency, slope
+        )
+        .unwrap();
+    }
+    out += match budget {
+        Some(b) => format!("(equal time: each variant at the largest spp rendered within {b} s; ranked by relMSE)\n"),
+        None => "(ranked by efficiency 1 / (relMSE x seconds) at the largest spp; slope: log-log relMSE vs spp)\n".to_string(),
+    }
+    .as_str();
+    out
+}
+
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    lumis_image::write_atomically(path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes()).map_err(|e| e.to_string())
+    })
+    .map_err(|e| Error::msg(e.to_string()))
+}
+
+fn write_outputs(
+    args: &ConvergeArgs,
+    variants: &[Variant],
+    runs: &[Run],
+    points: &[Point],
+) -> Result<()> {
+    let mut csv =
+        String::from("variant,spp,seed,seconds,samples_per_second,rays_per_second,mse,rel_mse\n");
+    for r in runs {
+        writeln!(
+            csv,
+            "{},{},{},{:.6},{:.1},{:.1},{:.6e},{:.6e}",
+            r.variant,
+            r.spp,
+            r.seed,
+            r.seconds,
+            r.samples_per_second,
+            r.rays_per_second,
+            r.mse,
+            r.rel_mse
+        )
+        .unwrap();
+    }
+    write_text(&args.out.join("converge.csv"), &csv)?;
+    let json_points: Vec<String> = points
+        .iter()
+        .map(|p| {
+            format!(
+                "    {{\"variant\": {:?}, \"spp\": {}, \"seconds\": {:.6}, \"mse\": {:.6e}, \"mse_se\": {:.6e}, \"rel_mse\": {:.6e}, \"rel_mse_se\": {:.6e}, \"efficiency\": {:.6e}}}",
+                p.variant, p.spp, p.seconds, p.mse, p.mse_se.max(0.0), p.rel_mse, p.rel_mse_se.max(0.0), p.efficiency
+            )
+        })
+        .collect();
+    let json = format!(
+        "{{\n  \"scene\": {:?},\n  \"reference\": {:?},\n  \"seeds\": {},\n  \"points\": [\n{}\n  ]\n}}\n",
+        args.scene.display().to_string(),
+        args.reference.display().to_string(),
+        args.seeds,
+        json_points.join(",\n")
+    );
+    write_text(&args.out.join("converge.json"), &json)?;
+    for (file, x_label, by_time) in [
+        ("relmse-vs-spp.png", "samples per pixel", false),
+        ("relmse-vs-seconds.png", "seconds", true),
+    ] {
+        let series: Vec<Series> = variants
+            .iter()
+            .map(|v| {
+                let mine: Vec<&Point> = points.iter().filter(|p| p.variant == v.name).collect();
+                let x = |p: &Point| if by_time { p.seconds } else { p.spp as f64 };
+                Series {
+                    name: v.name.clone(),
+                    points: mine.iter().map(|p| (x(p), p.rel_mse)).collect(),
+                    band: Some(
+                        mine.iter()
+                            .map(|p| (x(p), p.rel_mse_min, p.rel_mse_max))
+                            .collect(),
+                    ),
+                }
+            })
+            .collect();
+        let title = format!("relMSE vs {x_label} (band: seed spread)");
+        let axes = Axes {
+            title: &title,
+            x_label,
+            y_label: "relMSE",
+            log_x: true,
+            log_y: true,
+        };
+        plot::line_plot(&args.out.join(file), &axes, &series)?;
+    }
+    Ok(())
+}
