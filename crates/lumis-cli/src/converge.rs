@@ -4,7 +4,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressStyle};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use lumis_analysis::convergence::loglog_slope;
 use lumis_analysis::image_error::{check_same_size, error_metrics};
 use lumis_analysis::plot::{self, Axes, Series};
@@ -181,10 +183,18 @@ pub struct ConvergeReport {
     /// Per variant: fitted log-log slope of relMSE vs spp.
     pub slopes: Vec<(String, Option<f64>)>,
     pub table: String,
+    /// Stopped by `stop` (Ctrl-C) before every render was done.
+    pub interrupted: bool,
 }
 
 /// Renders every variant at each spp and seed and measures its error.
-pub fn converge(args: &ConvergeArgs, registry: &Registry) -> Result<ConvergeReport> {
+/// When `stop` becomes true (Ctrl-C) it finishes the render in flight,
+/// then writes and reports everything measured so far.
+pub fn converge(
+    args: &ConvergeArgs,
+    registry: &Registry,
+    stop: &AtomicBool,
+) -> Result<ConvergeReport> {
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
     let variants_path = args.variants.display().to_string();
     let text = std::fs::read_to_string(&args.variants)
@@ -244,48 +254,63 @@ pub fn converge(args: &ConvergeArgs, registry: &Registry) -> Result<ConvergeRepo
         })
     };
 
-    let total = match args.time_budget {
-        Some(_) => 0,
-        None => (variants.len() * args.spp.len()) as u64 * args.seeds,
-    };
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{msg:28} [{bar:40}] {pos}/{len} {elapsed}")
-            .expect("valid template")
-            .progress_chars("=> "),
-    );
+    let style = ProgressStyle::with_template("{msg:28} [{bar:40}] {pos}/{len} {elapsed}")
+        .expect("valid template")
+        .progress_chars("=> ");
+    let bars = MultiProgress::new();
+    let overall = bars.add(ProgressBar::new(variants.len() as u64));
+    overall.set_style(style.clone());
+    overall.set_message("variants");
     let mut runs = Vec::new();
     let mut points = Vec::new();
-    for variant in &variants {
-        let mut spp_list: Vec<u32> = args.spp.clone();
-        if args.time_budget.is_some() {
-            spp_list = vec![1];
-        }
+    let mut interrupted = false;
+    'variants: for variant in &variants {
+        let mut spp_list: Vec<u32> = match args.time_budget {
+            Some(_) => vec![1],
+            None => args.spp.clone(),
+        };
+        let per_spp = args.seeds;
+        let bar = bars.add(ProgressBar::new(spp_list.len() as u64 * per_spp));
+        bar.set_style(style.clone());
         let mut i = 0;
         while i < spp_list.len() {
             let spp = spp_list[i];
             bar.set_message(format!("{} @ {spp} spp", variant.name));
             let mut these = Vec::new();
             for s in 0..args.seeds {
+                if stop.load(Ordering::Relaxed) {
+                    interrupted = true;
+                    runs.extend(these);
+                    bar.abandon();
+                    break 'variants;
+                }
                 these.push(render_once(variant, spp, s)?);
                 bar.inc(1);
             }
             let point = summarise(&these);
             runs.extend(these);
             if let Some(budget) = args.time_budget {
+                if point.seconds > budget && i > 0 {
+                    break;
+                }
                 // Keep doubling while the next render would still fit.
                 if point.seconds * 2.0 <= budget {
                     spp_list.push(spp * 2);
-                }
-                if point.seconds > budget && !points.is_empty() {
-                    break;
+                    bar.inc_length(per_spp);
                 }
             }
             points.push(point);
             i += 1;
         }
+        bar.finish_and_clear();
+        overall.inc(1);
     }
-    bar.finish_and_clear();
+    overall.finish_and_clear();
+    if points.is_empty() {
+        return Err(Error::msg(
+            "interrupted before the first (variant, spp) was measured: nothing to report",
+        ));
+    }
 
     let slopes: Vec<(String, Option<f64>)> = variants
         .iter()
@@ -299,12 +324,16 @@ pub fn converge(args: &ConvergeArgs, registry: &Registry) -> Result<ConvergeRepo
         })
         .collect();
     write_outputs(args, &variants, &runs, &points)?;
-    let table = ranked_table(&variants, &points, &slopes, args.time_budget);
+    let mut table = ranked_table(&variants, &points, &slopes, args.time_budget);
+    if interrupted {
+        table += "(interrupted: the rows above are those measured before Ctrl-C)\n";
+    }
     Ok(ConvergeReport {
         runs,
         points,
         slopes,
         table,
+        interrupted,
     })
 }
 
@@ -403,6 +432,7 @@ fn write_outputs(
     ] {
         let series: Vec<Series> = variants
             .iter()
+            .filter(|v| points.iter().any(|p| p.variant == v.name))
             .map(|v| {
                 let mine: Vec<&Point> = points.iter().filter(|p| p.variant == v.name).collect();
                 let x = |p: &Point| if by_time { p.seconds } else { p.spp as f64 };

@@ -5,12 +5,14 @@
 mod converge;
 mod diff;
 mod listing;
+mod reference;
 mod render;
 mod samplers_analyze;
 
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;
+pub use reference::{render_reference, ReferenceArgs, ReferenceMetadata};
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
 

@@ -7,7 +7,8 @@ use clap::{Parser, Subcommand};
 use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
 use lumis_cli::{
     analyze_samplers, converge, diff_images, plugin_listing, registry_with_search_path,
-    render_scene_file, AnalyzeArgs, ConvergeArgs, DiffArgs, RenderArgs,
+    render_reference, render_scene_file, AnalyzeArgs, ConvergeArgs, DiffArgs, ReferenceArgs,
+    RenderArgs,
 };
 use lumis_core::{Error, PluginKind, Result};
 
@@ -54,6 +55,9 @@ enum Command {
         #[arg(long, default_value = ".")]
         out: PathBuf,
     },
+    /// Render a high-spp reference with the scene's own settings, saved
+    /// after every pass with its metadata (PATH.json); rerun to resume.
+    Reference(ReferenceArgs),
     /// Error vs samples and vs time against a reference, for variants of a
     /// scene (sampler, strategy, heuristic, BSDF sampling...) over seeds:
     /// CSV, JSON, two log-log plots and a table ranked by efficiency.
@@ -98,8 +102,20 @@ fn main() -> ExitCode {
             bins,
             out,
         } => check_plugin(library, bsdf, samples, bins, &out),
+        Command::Reference(args) => registry_with_search_path().and_then(|registry| {
+            let stop = stop_on_ctrl_c()?;
+            let (path, meta) = render_reference(&args, &registry, &stop)?;
+            println!(
+                "{}: {} spp in {:.1} s (metadata in {}.json)",
+                path.display(),
+                meta.spp,
+                meta.seconds,
+                path.display()
+            );
+            Ok(true)
+        }),
         Command::Converge(args) => registry_with_search_path()
-            .and_then(|registry| converge(&args, &registry))
+            .and_then(|registry| converge(&args, &registry, &*stop_on_ctrl_c()?))
             .map(|report| {
                 print!("{}", report.table);
                 println!("CSV, JSON and plots in {}", args.out.display());
@@ -125,6 +141,16 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// A flag Ctrl-C sets: long commands finish the render in flight and keep
+/// what they measured instead of dying.
+fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let flag = stop.clone();
+    ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed))
+        .map_err(|e| Error::msg(format!("cannot install the Ctrl-C handler: {e}")))?;
+    Ok(stop)
 }
 
 /// `lumis check-plugin`: returns whether every case passed.

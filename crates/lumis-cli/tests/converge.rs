@@ -2,6 +2,7 @@
 //! convergence rate Monte Carlo theory predicts.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 use lumis_cli::{builtin_registry, converge, render_scene_file, ConvergeArgs, RenderArgs};
 
@@ -58,7 +59,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
         threads: 0,
         out: out.clone(),
     };
-    let report = converge(&args, &registry).unwrap();
+    let report = converge(&args, &registry, &AtomicBool::new(false)).unwrap();
     for file in [
         "converge.csv",
         "converge.json",
@@ -108,14 +109,56 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
         threads: 0,
         out: dir.join("out"),
     };
-    let e = converge(&args, &registry).err().unwrap().to_string();
+    let e = converge(&args, &registry, &AtomicBool::new(false))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(
         e.contains("variants.toml:3") && e.contains("key.path=value"),
         "{e}"
     );
     std::fs::write(&variants, "[[variant]]\nname = \"a\"\nset = []\n").unwrap();
-    let e = converge(&args, &registry).err().unwrap().to_string();
+    let e = converge(&args, &registry, &AtomicBool::new(false))
+        .err()
+        .unwrap()
+        .to_string();
     assert!(e.contains("differ in size: 16x16 vs 256x256"), "{e}");
+    let e = converge(&args, &registry, &AtomicBool::new(true))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("interrupted before the first"), "{e}");
     args.seeds = 0;
-    assert!(converge(&args, &registry).is_err());
+    assert!(converge(&args, &registry, &AtomicBool::new(false)).is_err());
+}
+
+/// A reference rendered in two runs (interrupted at 64 spp, then resumed to
+/// 128) is bit-identical to one rendered in a single run: passes keep their
+/// seeds. A changed scene starts over instead of mixing images.
+#[test]
+fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
+    use lumis_cli::{render_reference, ReferenceArgs};
+    let dir = scratch("reference");
+    let registry = builtin_registry().unwrap();
+    let stop = AtomicBool::new(false);
+    let args = |spp: u32, output: &str, extra: &[&str]| ReferenceArgs {
+        scene: scene(),
+        spp,
+        pass_spp: 32,
+        output: Some(dir.join(output)),
+        set: [TINY].iter().chain(extra).map(|s| s.to_string()).collect(),
+        threads: 0,
+    };
+    let (path, meta) = render_reference(&args(64, "resumed.exr", &[]), &registry, &stop).unwrap();
+    assert_eq!((meta.spp, meta.passes), (64, 2));
+    let (_, meta) = render_reference(&args(128, "resumed.exr", &[]), &registry, &stop).unwrap();
+    assert_eq!((meta.spp, meta.passes), (128, 4));
+    let (whole, _) = render_reference(&args(128, "whole.exr", &[]), &registry, &stop).unwrap();
+    let read = |p: &Path| lumis_image::read_exr(p).unwrap();
+    assert_eq!(read(&path), read(&whole));
+    let changed = ["integrator.max_depth=2"];
+    let (_, meta) =
+        render_reference(&args(128, "resumed.exr", &changed), &registry, &stop).unwrap();
+    assert_eq!((meta.spp, meta.passes), (128, 4), "restarted from zero");
+    assert_ne!(read(&path), read(&whole));
 }
