@@ -35,7 +35,7 @@ pub struct ConvergeArgs {
     pub seeds: u64,
     /// Equal time instead of equal samples: each variant doubles its spp
     /// from 1 while one render fits in this many seconds.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_budget: Option<f64>,
     /// Overrides applied to every variant (like `lumis render --set`).
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
@@ -46,6 +46,17 @@ pub struct ConvergeArgs {
     /// Output directory for converge.csv, converge.json and the plots.
     #[arg(long, default_value = "converge")]
     pub out: PathBuf,
+}
+
+/// `10`, `10s` or `2.5s`: a positive number of seconds.
+fn parse_seconds(text: &str) -> std::result::Result<f64, String> {
+    let number = text.trim().trim_end_matches('s');
+    match number.parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of seconds such as 10s, got \"{text}\""
+        )),
+    }
 }
 
 /// One variant: a name and its scene overrides.
