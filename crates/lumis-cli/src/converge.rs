@@ -15,6 +15,7 @@ use lumis_core::{Error, Registry, Result};
 use lumis_image::read_exr;
 use lumis_render::{render, RenderSettings};
 
+use crate::reference::{fnv1a, metadata_path, ReferenceMetadata};
 use crate::render::{load, RenderArgs};
 
 #[derive(clap::Args, Debug, Clone)]
@@ -207,6 +208,7 @@ pub fn converge(
     stop: &AtomicBool,
 ) -> Result<ConvergeReport> {
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
+    let provenance = reference_provenance(args);
     let variants_path = args.variants.display().to_string();
     let text = std::fs::read_to_string(&args.variants)
         .map_err(|e| Error::msg(format!("{variants_path}: {e}")))?;
@@ -335,7 +337,7 @@ pub fn converge(
         })
         .collect();
     write_outputs(args, &variants, &runs, &points)?;
-    let mut table = ranked_table(&variants, &points, &slopes, args.time_budget);
+    let mut table = provenance + &ranked_table(&variants, &points, &slopes, args.time_budget);
     if interrupted {
         table += "(interrupted: the rows above are those measured before Ctrl-C)\n";
     }
@@ -346,6 +348,28 @@ pub fn converge(
         table,
         interrupted,
     })
+}
+
+/// What the reference's metadata (written by `lumis reference`) says, and a
+/// warning when it was rendered from another version of the scene file.
+fn reference_provenance(args: &ConvergeArgs) -> String {
+    let Some(meta) = std::fs::read_to_string(metadata_path(&args.reference))
+        .ok()
+        .and_then(|t| ReferenceMetadata::from_json(&t))
+    else {
+        return String::new();
+    };
+    let mut out = format!(
+        "reference: {} spp, {} passes from seed {}, {:.1} s\n",
+        meta.spp, meta.passes, meta.base_seed, meta.seconds
+    );
+    let same_scene = std::fs::read(&args.scene)
+        .map(|text| fnv1a(&text) == meta.scene_text_hash)
+        .unwrap_or(false);
+    if !same_scene {
+        out += "warning: the reference was rendered from a different version of the scene file\n";
+    }
+    out
 }
 
 /// Ranks the variants by efficiency at their last (largest) spp.

@@ -38,6 +38,9 @@ pub struct ReferenceArgs {
 pub struct ReferenceMetadata {
     /// FNV-1a of the scene text and the overrides: a changed scene starts over.
     pub scene_hash: u64,
+    /// FNV-1a of the scene text alone: `converge` warns when the scene it
+    /// measures is not the one the reference was rendered from.
+    pub scene_text_hash: u64,
     pub spp: u32,
     /// Passes rendered; pass `k` used seed `base_seed + k`.
     pub passes: u64,
@@ -47,7 +50,7 @@ pub struct ReferenceMetadata {
 
 /// FNV-1a 64 (Fowler, Noll, Vo): stable across Rust versions, unlike
 /// `DefaultHasher`, so a hash written today still matches tomorrow.
-fn fnv1a(bytes: &[u8]) -> u64 {
+pub fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
         (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
     })
@@ -56,13 +59,13 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 impl ReferenceMetadata {
     fn to_json(&self) -> String {
         format!(
-            "{{\n  \"scene_hash\": \"{:016x}\",\n  \"spp\": {},\n  \"passes\": {},\n  \"base_seed\": {},\n  \"seconds\": {:.3}\n}}\n",
-            self.scene_hash, self.spp, self.passes, self.base_seed, self.seconds
+            "{{\n  \"scene_hash\": \"{:016x}\",\n  \"scene_text_hash\": \"{:016x}\",\n  \"spp\": {},\n  \"passes\": {},\n  \"base_seed\": {},\n  \"seconds\": {:.3}\n}}\n",
+            self.scene_hash, self.scene_text_hash, self.spp, self.passes, self.base_seed, self.seconds
         )
     }
 
     /// Reads the fields `to_json` writes (a fixed, flat format).
-    fn from_json(text: &str) -> Option<Self> {
+    pub fn from_json(text: &str) -> Option<Self> {
         let field = |name: &str| -> Option<&str> {
             let start = text.find(&format!("\"{name}\":"))? + name.len() + 3;
             let rest = text[start..].trim_start();
@@ -71,6 +74,7 @@ impl ReferenceMetadata {
         };
         Some(Self {
             scene_hash: u64::from_str_radix(field("scene_hash")?, 16).ok()?,
+            scene_text_hash: u64::from_str_radix(field("scene_text_hash")?, 16).ok()?,
             spp: field("spp")?.parse().ok()?,
             passes: field("passes")?.parse().ok()?,
             base_seed: field("base_seed")?.parse().ok()?,
@@ -79,7 +83,8 @@ impl ReferenceMetadata {
     }
 }
 
-fn metadata_path(exr: &Path) -> PathBuf {
+/// Where a reference's metadata lives: `PATH.exr.json`.
+pub fn metadata_path(exr: &Path) -> PathBuf {
     let mut name = exr.as_os_str().to_owned();
     name.push(".json");
     PathBuf::from(name)
@@ -143,6 +148,7 @@ pub fn render_reference(
         None => (
             ReferenceMetadata {
                 scene_hash: hash,
+                scene_text_hash: fnv1a(scene_text.as_bytes()),
                 spp: 0,
                 passes: 0,
                 base_seed,
@@ -215,6 +221,7 @@ mod tests {
     fn metadata_round_trips_and_hash_is_stable() {
         let m = ReferenceMetadata {
             scene_hash: 0x0123_4567_89ab_cdef,
+            scene_text_hash: 42,
             spp: 4096,
             passes: 16,
             base_seed: 7,
