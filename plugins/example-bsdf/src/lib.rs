@@ -31,8 +31,21 @@ pub const SPEC: PluginSpec = PluginSpec {
         ParamSpec::with_default("specular", ParamType::Rgb, "0.2", "glossy albedo rho_s; rho_d + rho_s <= 1 per channel"),
         ParamSpec::with_default("exponent", ParamType::Float, "30.0", "Phong exponent n in [0, 1e4]; larger = sharper")
             .in_range(0.0, 1e4),
+        ParamSpec::with_default("sampling", ParamType::String, "\"lobes\"", "lobes: each lobe's own shape (the model's sampling); cosine or uniform hemisphere, for comparison")
+            .one_of(&["lobes", "cosine", "uniform"]),
     ],
 };
+
+/// How `sample_f` draws directions; `pdf` always matches it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sampling {
+    /// Pick a lobe by albedo, then sample its own shape.
+    Lobes,
+    /// Cosine-weighted hemisphere, ignoring the glossy lobe.
+    Cosine,
+    /// Uniform hemisphere, ignoring both lobes.
+    Uniform,
+}
 
 /// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
 pub fn register(registry: &mut Registry) -> Result<()> {
@@ -48,6 +61,7 @@ pub struct Phong {
     exponent: f32,
     /// Probability of sampling the glossy lobe.
     glossy_probability: f32,
+    sampling: Sampling,
 }
 
 impl Phong {
@@ -59,7 +73,13 @@ impl Phong {
             specular,
             exponent,
             glossy_probability,
+            sampling: Sampling::Lobes,
         }
+    }
+
+    /// The same BSDF drawing directions another way.
+    pub fn with_sampling(self, sampling: Sampling) -> Self {
+        Self { sampling, ..self }
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
@@ -78,7 +98,12 @@ impl Phong {
             ));
         }
         let exponent = params.get_in_range("exponent")?;
-        Ok(Self::new(diffuse, specular, exponent))
+        let sampling = match params.get_choice("sampling")?.as_str() {
+            "cosine" => Sampling::Cosine,
+            "uniform" => Sampling::Uniform,
+            _ => Sampling::Lobes,
+        };
+        Ok(Self::new(diffuse, specular, exponent).with_sampling(sampling))
     }
 
     #[inline]
@@ -116,7 +141,10 @@ impl Bsdf for Phong {
         if wo.z <= 0.0 || self.diffuse.is_black() && self.specular.is_black() {
             return None;
         }
-        let wi = if u1 < self.glossy_probability {
+        let glossy = self.sampling == Sampling::Lobes && u1 < self.glossy_probability;
+        let wi = if self.sampling == Sampling::Uniform {
+            warp::square_to_uniform_hemisphere(u2)
+        } else if glossy {
             let cos_alpha = u2.x.powf(1.0 / (self.exponent + 1.0));
             let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
             let phi = 2.0 * PI * u2.y;
@@ -133,7 +161,7 @@ impl Bsdf for Phong {
             f: self.f(ctx, wo, wi),
             wi,
             pdf,
-            flags: if u1 < self.glossy_probability {
+            flags: if glossy || self.sampling != Sampling::Lobes {
                 BsdfFlags::GLOSSY | BsdfFlags::REFLECTION
             } else {
                 BsdfFlags::DIFFUSE_REFLECTION
@@ -146,9 +174,15 @@ impl Bsdf for Phong {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let glossy = (self.exponent + 1.0) * 0.5 * FRAC_1_PI * self.lobe(wo, wi);
-        (1.0 - self.glossy_probability) * warp::cosine_hemisphere_pdf(wi.z)
-            + self.glossy_probability * glossy
+        match self.sampling {
+            Sampling::Uniform => warp::uniform_hemisphere_pdf(wi.z),
+            Sampling::Cosine => warp::cosine_hemisphere_pdf(wi.z),
+            Sampling::Lobes => {
+                let glossy = (self.exponent + 1.0) * 0.5 * FRAC_1_PI * self.lobe(wo, wi);
+                (1.0 - self.glossy_probability) * warp::cosine_hemisphere_pdf(wi.z)
+                    + self.glossy_probability * glossy
+            }
+        }
     }
 }
 
