@@ -6,7 +6,9 @@
 //! - chi-square goodness of fit of `sample_f` against `pdf`;
 //! - `pdf` integrates to at most 1 (and to the fraction of samples returned);
 //! - `sample_f` returns the `f` and `pdf` that `f()` and `pdf()` give;
-//! - energy: the directional albedo is at most 1 (a white furnace per lobe);
+//! - energy: the directional albedo is at most 1 (a white furnace per lobe),
+//!   measured in importance transport so that the `1/eta^2` radiance
+//!   scaling of refraction (a change of units, not of energy) is left out;
 //! - reciprocity `f(wo, wi) = f(wi, wo)` for reflection-only models;
 //! - no NaN, infinite or negative value anywhere.
 
@@ -19,12 +21,14 @@ use lumis_core::params::ParamDefault;
 use lumis_core::registry::TableRef;
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginKind, PluginSpec, Registry,
-    Result, Vec2, Vec3,
+    Result, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
+use rayon::prelude::*;
 
 use crate::adapters::bsdf_pair;
-use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
+use crate::lobe_zoom::chi_square_zoomed;
 use crate::corrected_significance;
 
 /// How thoroughly to check.
@@ -72,6 +76,9 @@ pub struct CaseResult {
     pub variant: String,
     pub cos_theta_o: f32,
     pub chi_square: ChiSquareReport,
+    /// Magnification of the lobe for the chi-square test (1: none; see
+    /// [`crate::lobe_zoom`]).
+    pub zoom: f64,
     /// Directional albedo estimate and its standard error.
     pub albedo: f64,
     pub albedo_se: f64,
@@ -104,6 +111,14 @@ fn stand_in(
                 ty.name()
             )))
         }
+    })
+}
+
+/// A named parameter setting, from TOML text (`"roughness = 0.01\n..."`).
+pub fn variant(label: impl Into<String>, toml: &str) -> Result<Variant> {
+    Ok(Variant {
+        label: label.into(),
+        table: doc::parse(toml, "<sweep>")?,
     })
 }
 
@@ -176,7 +191,10 @@ fn direction(cos_theta: f32, phi: f32) -> Vec3 {
 
 /// Albedo, consistency, reciprocity and finiteness for one incident direction.
 fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f64, Vec<String>) {
-    let ctx = BsdfContext::default();
+    let ctx = BsdfContext {
+        mode: TransportMode::Importance,
+        ..Default::default()
+    };
     let mut rng = Pcg32::new(seed, 0xa1be);
     let mut problems = Vec::new();
     let mut note = |p: String| {
@@ -237,7 +255,8 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
         }
         // Evaluation anywhere on the sphere must be finite and non-negative.
         let wi = warp::square_to_uniform_sphere(u2);
-        let (f, pdf) = (bsdf.f(&ctx, wo, wi), bsdf.pdf(&ctx, wo, wi));
+        let radiance = BsdfContext::default();
+        let (f, pdf) = (bsdf.f(&radiance, wo, wi), bsdf.pdf(&radiance, wo, wi));
         if !f.is_finite() || f.min_component() < 0.0 || !pdf.is_finite() || pdf < 0.0 {
             note(format!("f() = {f:?}, pdf() = {pdf} at wi = {wi:?}"));
         }
@@ -253,7 +272,8 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
     (albedo, se, problems)
 }
 
-/// Runs every check over the sweep for the BSDF plugin `name`.
+/// Runs every check over the sweep of the plugin's declared parameters
+/// (see [`parameter_sweep`]) for the BSDF plugin `name`.
 pub fn check_bsdf(
     registry: &Registry,
     name: &str,
@@ -262,33 +282,59 @@ pub fn check_bsdf(
     let plugin = registry
         .find(PluginKind::Bsdf, name)
         .ok_or_else(|| Error::msg(format!("no bsdf plugin named \"{name}\"")))?;
-    let variants = parameter_sweep(&plugin.spec)?;
+    check_bsdf_variants(registry, name, &parameter_sweep(&plugin.spec)?, cfg)
+}
+
+/// Runs every check for each of `variants` of the BSDF plugin `name` and
+/// each incident direction of `cfg`, the cases in parallel; the chi-square
+/// significance is corrected for the number of cases.
+pub fn check_bsdf_variants(
+    registry: &Registry,
+    name: &str,
+    variants: &[Variant],
+    cfg: &BsdfCheckConfig,
+) -> Result<Vec<CaseResult>> {
     let cases = variants.len() * cfg.cos_theta_o.len();
     let chi_cfg = ChiSquareConfig {
         significance: corrected_significance(cfg.alpha, cases),
         ..cfg.chi_square
     };
-    let mut results = Vec::with_capacity(cases);
-    for variant in &variants {
-        let bsdf = instantiate(registry, name, variant)?;
+    let bsdfs = variants
+        .iter()
+        .map(|v| instantiate(registry, name, v))
+        .collect::<Result<Vec<_>>>()?;
+    let mut work = Vec::with_capacity(cases);
+    for (variant, bsdf) in variants.iter().zip(&bsdfs) {
         for (i, &c) in cfg.cos_theta_o.iter().enumerate() {
+            work.push((work.len(), variant, bsdf, i, c));
+        }
+    }
+    Ok(work
+        .into_par_iter()
+        .map(|(case, variant, bsdf, i, c)| {
             let wo = direction(c, 0.3 + i as f32);
             let (sample, pdf) = bsdf_pair(bsdf.as_ref(), wo);
-            let report = chi_square(sample, pdf, &chi_cfg);
+            // Each case draws its own samples, so the tests are independent
+            // as the Sidak correction assumes.
+            let case_cfg = ChiSquareConfig {
+                seed: chi_cfg.seed.wrapping_add(case as u64),
+                ..chi_cfg
+            };
+            let (report, zoom) = chi_square_zoomed(sample, pdf, &case_cfg);
             let (albedo, albedo_se, problems) =
                 check_values(bsdf.as_ref(), wo, cfg.samples, i as u64);
-            results.push(CaseResult {
+            CaseResult {
                 bsdf: name.to_string(),
                 variant: variant.label.clone(),
                 cos_theta_o: c,
                 chi_square: report,
+                zoom,
                 albedo,
                 albedo_se,
                 problems,
-            });
-        }
-    }
-    Ok(results)
+            }
+        })
+        .collect())
 }
 
 /// A readable table of results, one line per case, failures explained.
@@ -296,17 +342,18 @@ pub fn format_results(results: &[CaseResult]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "{:<12} {:<28} {:>8} {:>10} {:>9} {:>9} {:>8}  result",
-        "bsdf", "parameters", "cos_o", "p-value", "pdf int", "sampled", "albedo"
+        "{:<11} {:<44} {:>8} {:>7} {:>10} {:>9} {:>9} {:>8}  result",
+        "bsdf", "parameters", "cos_o", "zoom", "p-value", "pdf int", "sampled", "albedo"
     );
     for r in results {
         let c = &r.chi_square;
         let _ = writeln!(
             out,
-            "{:<12} {:<28} {:>8} {:>10.3e} {:>9.5} {:>9.5} {:>8.4}  {}",
+            "{:<11} {:<44} {:>8} {:>7.0} {:>10.3e} {:>9.5} {:>9.5} {:>8.4}  {}",
             r.bsdf,
             r.variant,
             r.cos_theta_o,
+            r.zoom,
             c.p_value,
             c.pdf_integral,
             c.sampled_fraction,

@@ -10,9 +10,11 @@
 pub mod adapters;
 pub mod bsdf_suite;
 pub mod chi_square;
+pub mod lobe_zoom;
 pub mod uniformity;
 
 pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+pub use lobe_zoom::chi_square_zoomed;
 pub use uniformity::{uniformity_2d, UniformityReport};
 
 /// The per-test significance level that keeps the chance of any false

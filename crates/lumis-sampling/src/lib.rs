@@ -11,6 +11,7 @@ pub mod radical_inverse;
 pub mod rng;
 pub mod scramble;
 pub mod sobol;
+pub mod special;
 pub mod spherical_rectangle;
 pub mod spherical_triangle;
 pub mod warp;

@@ -1,0 +1,314 @@
+//! `conductor`: rough metal, the Cook-Torrance microfacet BRDF
+//!
+//! f(wo, wi) = F(<wo, m>) D(m) G(wo, wi) / (4 cos theta_o cos theta_i),
+//! m = normalize(wo + wi)
+//!
+//! (Walter et al. 2007, "Microfacet Models for Refraction through Rough
+//! Surfaces", eq. 20) with Beckmann or GGX normals, height-correlated Smith
+//! masking and the complex Fresnel term of the metal. `mirror` is its
+//! delta limit, which `conductor` also becomes below a roughness of 1e-3.
+//! One-sided, like Mitsuba's: black from behind.
+
+use lumis_core::{
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
+};
+
+use crate::fresnel;
+use crate::lobe_sampling::LobeSampling;
+use crate::microfacet::{half_vector, Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_PARAM, ROUGHNESS_V_PARAM};
+
+const METAL_CHOICES: &[&str] = &["none", "Ag", "Al", "Au", "Cr", "Cu", "Fe", "Pt"];
+
+const MATERIAL_PARAM: ParamSpec = ParamSpec::with_default(
+    "material",
+    ParamType::String,
+    "\"none\"",
+    "named metal (complex IOR at 650/550/450 nm) or none: a perfect reflector, Fresnel = 1",
+)
+.one_of(METAL_CHOICES);
+const ETA_PARAM: ParamSpec = ParamSpec::optional(
+    "eta",
+    ParamType::Rgb,
+    "real part of the IOR per channel, with k; replaces material",
+);
+const K_PARAM: ParamSpec = ParamSpec::optional(
+    "k",
+    ParamType::Rgb,
+    "imaginary part (absorption) of the IOR per channel, with eta",
+);
+const SCALE_PARAM: ParamSpec = ParamSpec::with_default(
+    "specular_reflectance",
+    ParamType::Rgb,
+    "1.0",
+    "multiplies the Fresnel term (not physical; for artistic tints), each channel in [0, 1]",
+);
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Bsdf,
+    name: "conductor",
+    doc: "rough metal: Cook-Torrance with GGX or Beckmann normals, Smith masking, complex Fresnel; one-sided",
+    params: &[
+        DISTRIBUTION_PARAM,
+        ROUGHNESS_PARAM,
+        ROUGHNESS_V_PARAM,
+        MATERIAL_PARAM,
+        ETA_PARAM,
+        K_PARAM,
+        SCALE_PARAM,
+        ParamSpec::with_default(
+            "sampling",
+            ParamType::String,
+            "\"visible\"",
+            "visible normals (Heitz 2018 / Heitz-d'Eon 2014), full D cos, or cosine/uniform hemisphere for comparison",
+        )
+        .one_of(&["visible", "full", "cosine", "uniform"]),
+    ],
+};
+
+pub const MIRROR_SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Bsdf,
+    name: "mirror",
+    doc: "smooth metal: delta reflection with the Fresnel term of the metal (conductor with roughness 0)",
+    params: &[MATERIAL_PARAM, ETA_PARAM, K_PARAM, SCALE_PARAM],
+};
+
+/// The metal's reflectance at each angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ConductorFresnel {
+    /// Reflects everything at every angle (Fresnel = 1).
+    Perfect,
+    Complex { eta: Rgb, k: Rgb },
+}
+
+impl ConductorFresnel {
+    #[inline]
+    pub fn eval(&self, cos_theta: f32) -> Rgb {
+        match *self {
+            Self::Perfect => Rgb::WHITE,
+            Self::Complex { eta, k } => fresnel::conductor(cos_theta, eta, k),
+        }
+    }
+
+    /// Reads `material`, `eta` and `k`.
+    fn from_params(params: &Params) -> Result<Self> {
+        let material = params.get_choice("material")?;
+        let eta: Option<Rgb> = params.get_opt("eta")?;
+        let k: Option<Rgb> = params.get_opt("k")?;
+        match (eta, k) {
+            (None, None) => Ok(match fresnel::metal(&material) {
+                Some(m) => Self::Complex {
+                    eta: m.eta.into(),
+                    k: m.k.into(),
+                },
+                None => Self::Perfect,
+            }),
+            (Some(eta), Some(k)) => {
+                if params.is_given("material") {
+                    return Err(params.error(
+                        "material",
+                        "give either material or eta and k, not both",
+                    ));
+                }
+                if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
+                    return Err(params.error(
+                        "eta",
+                        format!("eta must be > 0 and k >= 0 per channel, got eta {eta:?}, k {k:?}"),
+                    ));
+                }
+                Ok(Self::Complex { eta, k })
+            }
+            (Some(_), None) => Err(params.error("eta", "needs k too (the absorption)")),
+            (None, Some(_)) => Err(params.error("k", "needs eta too (the real part)")),
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub struct Conductor {
+    /// `None`: a delta mirror.
+    microfacet: Option<Microfacet>,
+    fresnel: ConductorFresnel,
+    scale: Rgb,
+    sampling: LobeSampling,
+}
+
+fn scale_from_params(params: &Params) -> Result<Rgb> {
+    let scale: Rgb = params.get("specular_reflectance")?;
+    if !(scale.min_component() >= 0.0 && scale.max_component() <= 1.0) {
+        return Err(params.error(
+            "specular_reflectance",
+            format!("each channel must be in [0, 1], got {scale:?}"),
+        ));
+    }
+    Ok(scale)
+}
+
+impl Conductor {
+    /// A rough conductor; a delta mirror if `microfacet` is smooth.
+    pub fn new(microfacet: Microfacet, fresnel: ConductorFresnel, sampling: LobeSampling) -> Self {
+        Self {
+            microfacet: (!microfacet.is_smooth()).then_some(match sampling {
+                LobeSampling::Model(s) => microfacet.with_sampling(s),
+                _ => microfacet,
+            }),
+            fresnel,
+            scale: Rgb::WHITE,
+            sampling,
+        }
+    }
+
+    pub fn mirror(fresnel: ConductorFresnel) -> Self {
+        Self {
+            microfacet: None,
+            fresnel,
+            scale: Rgb::WHITE,
+            sampling: LobeSampling::Cosine,
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let microfacet = Microfacet::from_params(params)?;
+        let fresnel = ConductorFresnel::from_params(params)?;
+        let sampling = LobeSampling::parse(&params.get_choice("sampling")?);
+        Ok(Self {
+            scale: scale_from_params(params)?,
+            ..Self::new(microfacet, fresnel, sampling)
+        })
+    }
+
+    pub fn mirror_from_params(params: &Params) -> Result<Self> {
+        Ok(Self {
+            scale: scale_from_params(params)?,
+            ..Self::mirror(ConductorFresnel::from_params(params)?)
+        })
+    }
+
+    #[inline]
+    fn rough_f(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        let Some((m, wo_m)) = half_vector(wo, wi) else {
+            return Rgb::BLACK;
+        };
+        let d = mf.d(m);
+        if d == 0.0 {
+            return Rgb::BLACK;
+        }
+        let g = mf.g(wo, wi);
+        self.scale * self.fresnel.eval(wo_m) * (d * g / (4.0 * wo.z * wi.z))
+    }
+
+    #[inline]
+    fn rough_pdf(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        match self.sampling {
+            LobeSampling::Model(_) => {
+                let Some((m, wo_m)) = half_vector(wo, wi) else {
+                    return 0.0;
+                };
+                // Reflection Jacobian d(omega_m)/d(omega_i) = 1 / (4 <wo, m>)
+                // (Walter et al. 2007, eq. 14).
+                mf.pdf_normal(wo, m) / (4.0 * wo_m)
+            }
+            baseline => baseline.baseline_pdf(wi.z),
+        }
+    }
+}
+
+impl Bsdf for Conductor {
+    fn flags(&self) -> BsdfFlags {
+        match self.microfacet {
+            Some(_) => BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            None => BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
+        }
+    }
+
+    #[inline]
+    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        match &self.microfacet {
+            Some(mf) => self.rough_f(mf, wo, wi),
+            None => Rgb::BLACK,
+        }
+    }
+
+    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let Some(mf) = &self.microfacet else {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(BsdfSample {
+                f: self.scale * self.fresnel.eval(wo.z) / wo.z,
+                wi,
+                pdf: 1.0,
+                flags: BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
+                eta: 1.0,
+            });
+        };
+        let wi = match self.sampling {
+            LobeSampling::Model(_) => {
+                let m = mf.sample_normal(wo, u2);
+                // A facet facing away from wo would reflect into itself.
+                if wo.dot(m) <= 0.0 {
+                    return None;
+                }
+                fresnel::reflect(wo, m)
+            }
+            baseline => baseline.sample_baseline(u2)?,
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.rough_pdf(mf, wo, wi);
+        if pdf <= 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        Some(BsdfSample {
+            f: self.rough_f(mf, wo, wi),
+            wi,
+            pdf,
+            flags: BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    #[inline]
+    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        match &self.microfacet {
+            Some(mf) => self.rough_pdf(mf, wo, wi),
+            None => 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::microfacet::Distribution;
+
+    #[test]
+    fn below_the_threshold_roughness_is_a_mirror() {
+        let ctx = BsdfContext::default();
+        let c = Conductor::new(
+            Microfacet::new(Distribution::Ggx, 1e-4, 1e-4),
+            ConductorFresnel::Perfect,
+            LobeSampling::parse("visible"),
+        );
+        assert!(c.flags().is_specular());
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let s = c.sample_f(&ctx, wo, 0.5, Vec2::splat(0.5)).unwrap();
+        assert_eq!(s.wi, Vec3::new(-0.6, 0.0, 0.8));
+        assert!((s.f.r * s.wi.z / s.pdf - 1.0).abs() < 1e-6, "reflects all");
+        assert_eq!(c.pdf(&ctx, wo, s.wi), 0.0);
+    }
+
+    #[test]
+    fn metal_names_are_the_choices() {
+        let names: Vec<&str> = fresnel::METALS.iter().map(|m| m.name).collect();
+        assert_eq!(&METAL_CHOICES[1..], names.as_slice());
+    }
+}

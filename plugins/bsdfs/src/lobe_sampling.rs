@@ -1,0 +1,52 @@
+//! The sampling baselines every glossy BSDF offers besides its own, so
+//! that a scene can measure what importance sampling buys (`sampling =
+//! "cosine"` or `"uniform"` on the same material).
+
+use lumis_core::{Vec2, Vec3};
+use lumis_sampling::warp;
+
+use crate::microfacet::NormalSampling;
+
+/// How a glossy reflection lobe draws `wi`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LobeSampling {
+    /// The model's own importance sampling (of its half vectors).
+    Model(NormalSampling),
+    /// Cosine-weighted hemisphere: ignores the lobe's shape.
+    Cosine,
+    /// Uniform hemisphere: ignores both the lobe and the cosine.
+    Uniform,
+}
+
+impl LobeSampling {
+    /// `"visible"`, `"full"`, `"cosine"` or `"uniform"`; `model` names the
+    /// model's own strategy for BSDFs with only one (e.g. `"blinn"`).
+    pub fn parse(choice: &str) -> Self {
+        match choice {
+            "cosine" => Self::Cosine,
+            "uniform" => Self::Uniform,
+            "full" => Self::Model(NormalSampling::Full),
+            _ => Self::Model(NormalSampling::Visible),
+        }
+    }
+
+    /// For the two baselines: a direction in the upper hemisphere, or
+    /// `None` on the horizon (where reflection is zero).
+    #[inline]
+    pub fn sample_baseline(self, u: Vec2) -> Option<Vec3> {
+        let wi = match self {
+            Self::Uniform => warp::square_to_uniform_hemisphere(u),
+            _ => warp::square_to_cosine_hemisphere(u),
+        };
+        (wi.z > 0.0).then_some(wi)
+    }
+
+    /// Density of a baseline at `cos_theta > 0`.
+    #[inline]
+    pub fn baseline_pdf(self, cos_theta: f32) -> f32 {
+        match self {
+            Self::Uniform => warp::uniform_hemisphere_pdf(cos_theta),
+            _ => warp::cosine_hemisphere_pdf(cos_theta),
+        }
+    }
+}
