@@ -28,8 +28,8 @@ use rayon::prelude::*;
 
 use crate::adapters::bsdf_pair;
 use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
-use crate::lobe_zoom::chi_square_zoomed;
 use crate::corrected_significance;
+use crate::lobe_zoom::chi_square_zoomed;
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -172,7 +172,8 @@ pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
         .collect()
 }
 
-fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
+/// The BSDF plugin `name` with the parameters of `variant`.
+pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
     let owner = format!("bsdf \"{name}\" [{}]", variant.label);
     registry.create_bsdf(&TableRef {
         owner: &owner,

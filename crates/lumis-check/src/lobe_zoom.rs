@@ -5,16 +5,22 @@
 //! the (cos theta, phi) grid is coarsest in angle, so neither the histogram
 //! nor the quadrature of the pdf resolve it. The test is done instead on a
 //! bijective image of the sphere that magnifies the lobe: rotate its centre
-//! to the pole, scale the stereographic radius `r = tan(theta/2)` by `k`
-//! (a conformal map, so the lobe keeps its shape), and rotate the pole to
-//! the equator where the grid is finest. The samples are mapped forward;
-//! the pdf is evaluated at the preimage of each quadrature node and
-//! divided by the Jacobian `d(omega')/d(omega) = (k (1 + r^2) / (1 +
-//! k^2 r^2))^2`, so the transformed pair is exactly as right or wrong as
-//! the original.
+//! to the pole, stretch the polar angle by `k` out to `theta_b` (a few lobe
+//! widths) and compress the rest of the sphere linearly into what is left,
+//! `g(theta) = k theta` below `theta_b`, `k theta_b + s (theta - theta_b)`
+//! above, with `s = (pi - k theta_b) / (pi - theta_b)`; then rotate the pole
+//! to the equator where the grid is finest. Because the far part is only
+//! compressed by `s` (about 1/3), a wide lobe beside the narrow one (the
+//! diffuse base of a coated material) stays resolved too. The samples are
+//! mapped forward; the pdf is evaluated at the preimage of each quadrature
+//! node and divided by the Jacobian `d(omega')/d(omega) = g'(theta) sin
+//! g(theta) / sin theta`, so the transformed pair is exactly as right or
+//! wrong as the original.
 //!
 //! Centre and width come from a pilot batch drawn with another seed, so
-//! the map does not depend on the samples it tests.
+//! the map does not depend on the samples it tests: the centre is where
+//! the pdf peaks among the pilot samples, the width the spread of the
+//! samples whose pdf is within a factor 100 of that peak.
 
 use lumis_core::glam::DVec3;
 use lumis_core::{Vec2, Vec3};
@@ -24,8 +30,13 @@ use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 
 /// The magnified lobe spans about this angle (radians) after the map.
 const TARGET_WIDTH: f64 = 0.5;
+/// The magnified part ends this many lobe widths from the centre.
+const MAGNIFIED_WIDTHS: f64 = 4.0;
 /// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are tested as they are.
 const MIN_ZOOM: f64 = 4.0;
+const PILOT_SAMPLES: usize = 20_000;
+/// Fewer samples than this in the peak: no lobe to magnify.
+const MIN_PEAK_SAMPLES: usize = 100;
 
 /// The map `d -> d'` for one lobe.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,45 +46,89 @@ pub struct LobeZoom {
     y: DVec3,
     z: DVec3,
     k: f64,
+    theta_b: f64,
 }
 
 impl LobeZoom {
-    pub fn new(centre: Vec3, k: f64) -> Self {
+    /// Magnifies the polar angle around `centre` by `k` out to `theta_b`
+    /// (`k theta_b < pi`).
+    pub fn new(centre: Vec3, k: f64, theta_b: f64) -> Self {
+        debug_assert!(k * theta_b < std::f64::consts::PI && theta_b > 0.0);
         let z = centre.as_dvec3().normalize();
         let helper = if z.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
         let x = helper.cross(z).normalize();
         let y = z.cross(x);
-        Self { x, y, z, k }
+        Self {
+            x,
+            y,
+            z,
+            k,
+            theta_b,
+        }
     }
 
-    /// The magnification factor.
+    /// The magnification factor at the centre.
     pub fn k(&self) -> f64 {
         self.k
     }
 
-    /// Scales the stereographic radius of `v` (local frame, pole = centre)
-    /// by `s`; returns the new local vector and `r`, `r'`.
-    fn scale(v: DVec3, s: f64) -> (DVec3, f64, f64) {
-        let sin = (v.x * v.x + v.y * v.y).sqrt();
-        if sin == 0.0 {
-            // The pole stays put (r = 0), and so does the antipode (r = inf).
-            let r = if v.z > 0.0 { 0.0 } else { f64::INFINITY };
-            return (v, r, r);
-        }
-        // r = tan(theta/2) = sin / (1 + cos), stable except at the antipode.
-        let r = sin / (1.0 + v.z);
-        let r2 = s * r;
-        let (z, sin2) = if r2.is_finite() {
-            let d = 1.0 + r2 * r2;
-            ((1.0 - r2 * r2) / d, 2.0 * r2 / d)
+    /// Slope of the compressed part.
+    fn s(&self) -> f64 {
+        use std::f64::consts::PI;
+        (PI - self.k * self.theta_b) / (PI - self.theta_b)
+    }
+
+    /// `g(theta)` and `sin g(theta) / sin(theta) * g'(theta)`, the Jacobian;
+    /// near the antipode from `pi - theta` so that the ratio of two tiny
+    /// sines stays exact.
+    fn map_angle(&self, theta: f64, antipode_distance: f64) -> (f64, f64) {
+        use std::f64::consts::PI;
+        if theta <= self.theta_b {
+            let g = self.k * theta;
+            let ratio = if theta == 0.0 {
+                self.k
+            } else {
+                g.sin() / theta.sin()
+            };
+            (g, self.k * ratio)
         } else {
-            (-1.0, 0.0)
+            let s = self.s();
+            let g = PI - s * antipode_distance;
+            let ratio = if antipode_distance == 0.0 {
+                s
+            } else {
+                (s * antipode_distance).sin() / antipode_distance.sin()
+            };
+            (g, s * ratio)
+        }
+    }
+
+    fn inverse_angle(&self, g: f64) -> f64 {
+        let edge = self.k * self.theta_b;
+        if g <= edge {
+            g / self.k
+        } else {
+            self.theta_b + (g - edge) / self.s()
+        }
+    }
+
+    /// Moves `v` (local frame, pole = centre) to polar angle `theta'`,
+    /// keeping its azimuth.
+    fn with_polar_angle(v: DVec3, theta: f64) -> DVec3 {
+        let sin = (v.x * v.x + v.y * v.y).sqrt();
+        let (cos_phi, sin_phi) = if sin > 0.0 {
+            (v.x / sin, v.y / sin)
+        } else {
+            (1.0, 0.0)
         };
-        (
-            DVec3::new(v.x / sin * sin2, v.y / sin * sin2, z),
-            r,
-            r2,
-        )
+        DVec3::new(theta.sin() * cos_phi, theta.sin() * sin_phi, theta.cos())
+    }
+
+    /// Polar angle of `v` and its distance from the antipode, both by atan2
+    /// (exact near either pole, unlike acos).
+    fn polar(v: DVec3) -> (f64, f64) {
+        let sin = (v.x * v.x + v.y * v.y).sqrt();
+        (sin.atan2(v.z), sin.atan2(-v.z))
     }
 
     /// Local frame (pole = centre) -> the grid's frame (pole on the equator).
@@ -88,56 +143,63 @@ impl LobeZoom {
     pub fn forward(&self, d: Vec3) -> Vec3 {
         let d = d.as_dvec3().normalize();
         let local = DVec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z));
-        let (zoomed, _, _) = Self::scale(local, self.k);
-        Self::to_grid(zoomed).normalize().as_vec3()
+        let (theta, antipode) = Self::polar(local);
+        let (g, _) = self.map_angle(theta, antipode);
+        Self::to_grid(Self::with_polar_angle(local, g)).as_vec3()
     }
 
     /// The preimage of `d'` and the Jacobian `d(omega')/d(omega)` there.
     pub fn inverse(&self, d: Vec3) -> (Vec3, f64) {
-        let local = Self::from_grid(d.as_dvec3());
-        let (v, r2, r) = Self::scale(local, 1.0 / self.k);
+        let local = Self::from_grid(d.as_dvec3().normalize());
+        let (g, _) = Self::polar(local);
+        let theta = self.inverse_angle(g);
+        let v = Self::with_polar_angle(local, theta);
+        let (_, jacobian) = self.map_angle(theta, std::f64::consts::PI - theta);
         let world = (self.x * v.x + self.y * v.y + self.z * v.z).normalize();
-        let jacobian = if r2.is_finite() {
-            (self.k * (1.0 + r * r) / (1.0 + r2 * r2)).powi(2)
-        } else {
-            // At the antipode the factor tends to 1/k^2.
-            1.0 / (self.k * self.k)
-        };
         (world.as_vec3(), jacobian)
     }
 
-    /// The map suited to what `sample` draws: `None` if the lobe is wide
-    /// enough for the plain test (or there is no single lobe).
+    /// The map suited to what `sample` draws with density `pdf`: `None` if
+    /// there is no peak narrow enough to need it.
     pub fn for_sampler(
         sample: &mut dyn FnMut(f32, Vec2) -> Option<Vec3>,
+        pdf: &dyn Fn(Vec3) -> f32,
         seed: u64,
     ) -> Option<Self> {
         let mut rng = Pcg32::new(seed ^ 0x9e37_79b9, 0x10be);
-        let mut pilot = Vec::with_capacity(20_000);
-        for _ in 0..20_000 {
+        let mut pilot = Vec::with_capacity(PILOT_SAMPLES);
+        for _ in 0..PILOT_SAMPLES {
             let u1 = rng.next_f32();
             let u2 = Vec2::new(rng.next_f32(), rng.next_f32());
             if let Some(d) = sample(u1, u2).filter(|d| d.is_finite()) {
-                pilot.push(d.as_dvec3());
+                let p = pdf(d) as f64;
+                if p.is_finite() && p > 0.0 {
+                    pilot.push((d.as_dvec3().normalize(), p));
+                }
             }
         }
-        if pilot.len() < 1000 {
-            return None;
-        }
-        let mean: DVec3 = pilot.iter().sum::<DVec3>() / pilot.len() as f64;
-        // A diffuse or two-lobed distribution has a short mean vector.
-        if mean.length() < 0.5 {
-            return None;
-        }
-        let centre = mean.normalize();
+        let peak = pilot.iter().map(|&(_, p)| p).fold(0.0, f64::max);
+        // The core of the peak locates the centre (its mean is inside the
+        // lobe even where the horizon cuts it); the samples within a factor
+        // 100 of the peak density measure the width.
+        let core: DVec3 = pilot
+            .iter()
+            .filter(|&&(_, p)| p >= 0.5 * peak)
+            .map(|&(d, _)| d)
+            .sum();
+        let centre = core.try_normalize()?;
         let mut angles: Vec<f64> = pilot
             .iter()
-            .map(|d| d.normalize().dot(centre).clamp(-1.0, 1.0).acos())
+            .filter(|&&(_, p)| p >= 1e-2 * peak)
+            .map(|&(d, _)| d.dot(centre).clamp(-1.0, 1.0).acos())
             .collect();
+        if angles.len() < MIN_PEAK_SAMPLES {
+            return None;
+        }
         angles.sort_by(f64::total_cmp);
-        let width = angles[angles.len() * 9 / 10];
-        let k = TARGET_WIDTH / width.max(1e-9);
-        (k >= MIN_ZOOM).then(|| Self::new(centre.as_vec3(), k.min(1e6)))
+        let width = angles[angles.len() * 9 / 10].max(1e-9);
+        let k = (TARGET_WIDTH / width).min(1e6);
+        (k >= MIN_ZOOM).then(|| Self::new(centre.as_vec3(), k, MAGNIFIED_WIDTHS * width))
     }
 }
 
@@ -149,7 +211,7 @@ pub fn chi_square_zoomed(
     pdf: impl Fn(Vec3) -> f32,
     cfg: &ChiSquareConfig,
 ) -> (ChiSquareReport, f64) {
-    match LobeZoom::for_sampler(&mut sample, cfg.seed) {
+    match LobeZoom::for_sampler(&mut sample, &pdf, cfg.seed) {
         None => (chi_square(sample, pdf, cfg), 1.0),
         Some(zoom) => {
             let report = chi_square(
@@ -172,7 +234,7 @@ mod tests {
 
     #[test]
     fn forward_and_inverse_are_inverse_with_the_right_jacobian() {
-        let zoom = LobeZoom::new(Vec3::new(0.3, -0.2, 0.9).normalize(), 50.0);
+        let zoom = LobeZoom::new(Vec3::new(0.3, -0.2, 0.9).normalize(), 50.0, 0.04);
         for d in [
             Vec3::new(0.31, -0.19, 0.9),
             Vec3::new(0.0, 0.0, 1.0),
@@ -182,16 +244,22 @@ mod tests {
             let (back, _) = zoom.inverse(zoom.forward(d));
             assert!((back - d).length() < 1e-5, "{d:?} -> {back:?}");
         }
-        // Jacobian by finite areas: a tiny cap around a point.
-        let d = Vec3::new(0.305, -0.2, 0.9).normalize();
-        let (_, j) = zoom.inverse(zoom.forward(d));
-        let e1 = d.any_orthonormal_vector();
-        let e2 = d.cross(e1);
-        let h = 1e-4;
-        let a = zoom.forward((d + e1 * h).normalize()) - zoom.forward(d);
-        let b = zoom.forward((d + e2 * h).normalize()) - zoom.forward(d);
-        let area_ratio = a.cross(b).length() as f64 / (h * h) as f64;
-        assert!((area_ratio / j - 1.0).abs() < 2e-2, "{area_ratio} vs {j}");
+        // Jacobian by finite areas around a point in the magnified part
+        // and one in the compressed part.
+        for d in [Vec3::new(0.305, -0.2, 0.9), Vec3::new(-0.5, 0.4, 0.2)] {
+            let d = d.normalize();
+            let (_, j) = zoom.inverse(zoom.forward(d));
+            let e1 = d.any_orthonormal_vector();
+            let e2 = d.cross(e1);
+            let h = 1e-4;
+            let a = zoom.forward((d + e1 * h).normalize()) - zoom.forward(d);
+            let b = zoom.forward((d + e2 * h).normalize()) - zoom.forward(d);
+            let area_ratio = a.cross(b).length() as f64 / (h * h) as f64;
+            assert!(
+                (area_ratio / j - 1.0).abs() < 2e-2,
+                "{d:?}: {area_ratio} vs {j}"
+            );
+        }
     }
 
     #[test]
@@ -241,6 +309,49 @@ mod tests {
             pdf,
             &cfg,
         );
+        assert!(!bad.passed, "p {}", bad.p_value);
+    }
+
+    #[test]
+    fn a_narrow_lobe_beside_a_wide_one_is_resolved() {
+        // 10% in a cone of half-angle 1e-3 rad, 90% cosine-weighted: the
+        // mixture of a coated material. The wide part must stay testable
+        // after the map, and a wrong weight of the narrow part be caught.
+        let axis = Vec3::new(0.0, 0.6, 0.8);
+        let frame = lumis_core::Frame::from_z(axis);
+        let h = warp::one_minus_cos_from_sin2(1e-6);
+        let unit_axis = axis.as_dvec3().normalize();
+        let pdf = move |d: Vec3| {
+            let c = d.as_dvec3().normalize().dot(unit_axis);
+            let cone = if 1.0 - c <= h as f64 {
+                warp::uniform_cone_pdf(h)
+            } else {
+                0.0
+            };
+            0.1 * cone + 0.9 * warp::cosine_hemisphere_pdf(d.z.max(0.0))
+        };
+        let sample = |weight: f32| {
+            move |u1: f32, u: Vec2| {
+                Some(if u1 < weight {
+                    frame.to_world(warp::square_to_uniform_cone(u, h))
+                } else {
+                    warp::square_to_cosine_hemisphere(u)
+                })
+            }
+        };
+        let cfg = ChiSquareConfig {
+            samples: 1_000_000,
+            ..Default::default()
+        };
+        let (good, k) = chi_square_zoomed(sample(0.1), pdf, &cfg);
+        assert!(
+            k > 100.0 && good.passed,
+            "zoom {k}: p {} integral {} {:?}",
+            good.p_value,
+            good.pdf_integral,
+            good.defect
+        );
+        let (bad, _) = chi_square_zoomed(sample(0.105), pdf, &cfg);
         assert!(!bad.passed, "p {}", bad.p_value);
     }
 }

@@ -74,6 +74,17 @@ pub fn relative_ior(params: &Params) -> Result<f32> {
     Ok(int_ior / ext_ior)
 }
 
+/// The generalized half vector of a pair of directions and its cosines.
+#[derive(Debug, Clone, Copy)]
+struct HalfVector {
+    m: Vec3,
+    cos_om: f32,
+    cos_im: f32,
+    /// Relative index along `wi` (1 for reflection).
+    etap: f32,
+    reflection: bool,
+}
+
 #[derive(Debug, Clone)]
 pub struct Dielectric {
     /// Inside over outside.
@@ -131,11 +142,11 @@ impl Dielectric {
         })
     }
 
-    /// The generalized half vector of `(wo, wi)` on the upper side, the
-    /// relative index along `wi` and whether it is a reflection; `None` if
-    /// the pair has no microfacet that connects them from the front.
+    /// The generalized half vector of `(wo, wi)` on the upper side, with
+    /// the relative index along `wi` and whether the pair is a reflection;
+    /// `None` if no microfacet connects them from the front.
     #[inline]
-    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, f32, bool)> {
+    fn half_vector(&self, wo: Vec3, wi: Vec3) -> Option<HalfVector> {
         let (cos_o, cos_i) = (wo.z, wi.z);
         if cos_o == 0.0 || cos_i == 0.0 {
             return None;
@@ -148,52 +159,61 @@ impl Dielectric {
         } else {
             1.0 / self.eta
         };
-        // In f64 for the same reason as `half_vector`: at grazing angles
-        // (and for eta near 1 in transmission) the terms nearly cancel.
-        let m = wi.as_dvec3() * etap as f64 + wo.as_dvec3();
+        // In f64 from normalised inputs, and the cosines with it, for the
+        // reasons of `microfacet::half_vector`: at grazing angles (and for
+        // eta near 1 in transmission) the two terms nearly cancel.
+        let (o, i) = (wo.as_dvec3().normalize(), wi.as_dvec3().normalize());
+        let m = i * etap as f64 + o;
         if m.length_squared() == 0.0 {
             return None;
         }
-        let m = m.normalize().as_vec3();
+        let m = m.normalize();
         let m = if m.z < 0.0 { -m } else { m };
+        let (cos_om, cos_im) = (o.dot(m), i.dot(m));
         // Back-facing microfacets (seen from behind by either direction).
-        if m.dot(wi) * cos_i <= 0.0 || m.dot(wo) * cos_o <= 0.0 {
+        if cos_im * cos_i as f64 <= 0.0 || cos_om * cos_o as f64 <= 0.0 {
             return None;
         }
-        Some((m, etap, reflection))
+        Some(HalfVector {
+            m: m.as_vec3(),
+            cos_om: cos_om as f32,
+            cos_im: cos_im as f32,
+            etap,
+            reflection,
+        })
     }
 
     fn rough_f(&self, mf: &Microfacet, mode: TransportMode, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((m, etap, reflection)) = self.half_vector(wo, wi) else {
+        let Some(h) = self.half_vector(wo, wi) else {
             return 0.0;
         };
-        let d = mf.d(m);
+        let d = mf.d(h.m);
         let g = mf.g(wo, wi);
-        let f = fresnel::dielectric(wo.dot(m), self.eta);
+        let f = fresnel::dielectric(h.cos_om, self.eta);
         let (cos_o, cos_i) = (wo.z, wi.z);
-        if reflection {
+        if h.reflection {
             return d * g * f / (4.0 * cos_i * cos_o).abs();
         }
-        let denom = (wi.dot(m) + wo.dot(m) / etap).powi(2) * cos_i * cos_o;
-        let mut ft = d * (1.0 - f) * g * (wi.dot(m) * wo.dot(m) / denom).abs();
+        let denom = (h.cos_im + h.cos_om / h.etap).powi(2) * cos_i * cos_o;
+        let mut ft = d * (1.0 - f) * g * (h.cos_im * h.cos_om / denom).abs();
         if mode == TransportMode::Radiance {
-            ft /= etap * etap;
+            ft /= h.etap * h.etap;
         }
         ft
     }
 
     fn rough_pdf(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((m, etap, reflection)) = self.half_vector(wo, wi) else {
+        let Some(h) = self.half_vector(wo, wi) else {
             return 0.0;
         };
-        let r = fresnel::dielectric(wo.dot(m), self.eta);
+        let r = fresnel::dielectric(h.cos_om, self.eta);
         let t = 1.0 - r;
-        let pdf_m = mf.pdf_normal(wo, m);
-        if reflection {
-            pdf_m / (4.0 * wo.dot(m).abs()) * r / (r + t)
+        let pdf_m = mf.pdf_normal(wo, h.m, h.cos_om);
+        if h.reflection {
+            pdf_m / (4.0 * h.cos_om.abs()) * r / (r + t)
         } else {
-            let denom = (wi.dot(m) + wo.dot(m) / etap).powi(2);
-            pdf_m * (wi.dot(m).abs() / denom) * t / (r + t)
+            let denom = (h.cos_im + h.cos_om / h.etap).powi(2);
+            pdf_m * (h.cos_im.abs() / denom) * t / (r + t)
         }
     }
 
@@ -311,7 +331,9 @@ mod tests {
         let g = Dielectric::new(1.0001, Microfacet::new(Distribution::Ggx, 0.5, 0.5));
         assert!(g.flags().is_specular());
         let wo = Vec3::new(0.0, 0.6, 0.8);
-        let s = g.sample_f(&BsdfContext::default(), wo, 0.5, Vec2::splat(0.5)).unwrap();
+        let s = g
+            .sample_f(&BsdfContext::default(), wo, 0.5, Vec2::splat(0.5))
+            .unwrap();
         assert!((s.wi + wo).length() < 1e-3, "passes straight through");
     }
 

@@ -66,14 +66,16 @@ pub const ROUGHNESS_V_PARAM: ParamSpec = ParamSpec::optional(
 /// The half vector `h` of unit `wo`, `wi` and `<wo, h> = <wi, h> = |wo +
 /// wi| / 2`; `None` if they are opposite.
 ///
-/// The sum is formed in f64, where it is exact: near retro-reflection at
-/// grazing angles `|wo + wi|` is ~1e-3 and an f32 sum would tilt `h` by
-/// ~1e-4 rad, several percent of a lobe of roughness 1e-3. The cosine is
-/// symmetric in `wo` and `wi` by construction, so models built on it are
-/// reciprocal to the last bit.
+/// Formed in f64 from the f32 directions normalised in f64: near
+/// retro-reflection at grazing angles `|wo + wi|` is ~1e-4, where both the
+/// f32 sum and the inputs' own deviation from unit length (~1e-7) would
+/// tilt `h` by ~1e-3 rad, the width of a lobe of roughness 1e-3, and could
+/// even make `<wo, h>` negative. The cosine is returned rather than
+/// recomputed for the same reason, and it is symmetric in `wo` and `wi` by
+/// construction, so models built on it are reciprocal to the last bit.
 #[inline]
 pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<(Vec3, f32)> {
-    let sum = wo.as_dvec3() + wi.as_dvec3();
+    let sum = wo.as_dvec3().normalize() + wi.as_dvec3().normalize();
     let len = sum.length();
     (len > 0.0).then(|| ((sum / len).as_vec3(), (0.5 * len) as f32))
 }
@@ -174,7 +176,8 @@ impl Microfacet {
                     return 0.0;
                 }
                 let a = 1.0 / (a2t2 as f64).sqrt();
-                let l = 0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
+                let l =
+                    0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
                 l.max(0.0) as f32
             }
         }
@@ -193,23 +196,28 @@ impl Microfacet {
     }
 
     /// The distribution of normals visible from `w`, `G1(w) D(m) <w, m>^+ /
-    /// cos theta_w` (Heitz 2014, eq. 38); `w` below the surface is flipped
-    /// up, as `sample_normal` does.
+    /// cos theta_w` (Heitz 2014, eq. 38), with `cos_wm = <w, m>` from the
+    /// caller (see [`half_vector`] for why it is not recomputed); `w` below
+    /// the surface is flipped up, as `sample_normal` does.
     #[inline]
-    pub fn d_visible(&self, w: Vec3, m: Vec3) -> f32 {
-        let w = if w.z < 0.0 { -w } else { w };
-        let cos_m = w.dot(m);
-        if w.z == 0.0 || cos_m <= 0.0 {
+    pub fn d_visible(&self, w: Vec3, m: Vec3, cos_wm: f32) -> f32 {
+        let (w, cos_wm) = if w.z < 0.0 {
+            (-w, -cos_wm)
+        } else {
+            (w, cos_wm)
+        };
+        if w.z == 0.0 || cos_wm <= 0.0 {
             return 0.0;
         }
-        self.g1(w) * self.d(m) * cos_m / w.z
+        self.g1(w) * self.d(m) * cos_wm / w.z
     }
 
-    /// Density of `sample_normal(w, ..)` at `m`, w.r.t. solid angle.
+    /// Density of `sample_normal(w, ..)` at `m`, w.r.t. solid angle;
+    /// `cos_wm = <w, m>` as for [`Self::d_visible`].
     #[inline]
-    pub fn pdf_normal(&self, w: Vec3, m: Vec3) -> f32 {
+    pub fn pdf_normal(&self, w: Vec3, m: Vec3, cos_wm: f32) -> f32 {
         match self.sampling {
-            NormalSampling::Visible => self.d_visible(w, m),
+            NormalSampling::Visible => self.d_visible(w, m, cos_wm),
             NormalSampling::Full => self.d(m) * m.z.max(0.0),
         }
     }
@@ -359,7 +367,11 @@ mod tests {
     }
 
     fn direction(theta: f32, phi: f32) -> Vec3 {
-        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
     }
 
     /// Midpoint quadrature over the hemisphere in (theta, phi) with theta
@@ -396,7 +408,7 @@ mod tests {
         for m in all() {
             for theta in [0.0f32, 0.7, 1.3, 1.55] {
                 let w = direction(theta, 0.4);
-                let total = hemisphere_integral(|n| m.d_visible(w, n) as f64);
+                let total = hemisphere_integral(|n| m.d_visible(w, n, w.dot(n)) as f64);
                 assert!((total - 1.0).abs() < 3e-3, "{m:?} theta {theta}: {total}");
             }
         }
@@ -422,8 +434,8 @@ mod tests {
                     // Weight <w, m> G1 / cos theta_w / pdf integrates to 1
                     // exactly for visible sampling; to the projected-area
                     // constraint for full sampling.
-                    let p = m.pdf_normal(w, wm) as f64;
-                    sum += (m.d_visible(w, wm) as f64) / p;
+                    let p = m.pdf_normal(w, wm, w.dot(wm)) as f64;
+                    sum += (m.d_visible(w, wm, w.dot(wm)) as f64) / p;
                 }
                 let mean = sum / n as f64;
                 assert!((mean - 1.0).abs() < 0.02, "{m:?}: {mean}");
@@ -439,7 +451,10 @@ mod tests {
         for u in [1e-6, 0.3, 0.999999] {
             let c = 0.01f64;
             let (x, _) = beckmann_visible_slopes(c, u, 0.5);
-            assert!(x.is_finite() && x <= c / (1.0 - c * c).sqrt() + 1e-9, "{u}: {x}");
+            assert!(
+                x.is_finite() && x <= c / (1.0 - c * c).sqrt() + 1e-9,
+                "{u}: {x}"
+            );
         }
     }
 }
