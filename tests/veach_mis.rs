@@ -8,7 +8,10 @@ use std::sync::OnceLock;
 
 use lumis_core::Registry;
 use lumis_image::Image;
-use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml_with};
+use lumis_tests::{
+    assert_same_mean, bonferroni_z, mean_image, read_scene, region_error, render_toml_with,
+    shape_mask,
+};
 
 const WIDTH: usize = 192;
 const HEIGHT: usize = 128;
@@ -81,93 +84,9 @@ fn direct_runs() -> &'static Vec<Vec<Image>> {
     RUNS_DIRECT.get_or_init(|| runs(2))
 }
 
-/// Pixelwise mean of images.
-fn mean(images: &[Image]) -> Image {
-    let mut out = Image::new(images[0].width, images[0].height);
-    for im in images {
-        for (o, p) in out.pixels.iter_mut().zip(&im.pixels) {
-            for c in 0..3 {
-                o[c] += p[c] / images.len() as f32;
-            }
-        }
-    }
-    out
-}
-
-/// Which pixels show plate `i` entirely: make it emit pure blue, look at
-/// emitters only, keep pixels that are fully blue.
+/// Which pixels show plate `i` entirely.
 fn plate_mask(i: usize) -> Vec<bool> {
-    let image = render(&[
-        "integrator.max_depth=1".into(),
-        "sampler.spp=4".into(),
-        format!("shape.{i}.emission={{ radiance = [0.0, 0.0, 1.0] }}"),
-    ]);
-    image
-        .pixels
-        .iter()
-        .map(|p| p[2] >= 0.999 && p[0] == 0.0)
-        .collect()
-}
-
-/// Per-pixel relMSE of one `SPP` image of an estimator: the variance across
-/// its independent runs over `ref^2 + EPSILON`, channels averaged. Pixels of
-/// an unbiased estimator have MSE = variance, so no converged reference is
-/// needed beyond `reference` (the mean of every run of every estimator) in
-/// the denominator.
-fn rel_mse(runs: &[Image], reference: &Image) -> Vec<f64> {
-    let n = runs.len() as f64;
-    (0..reference.pixels.len())
-        .map(|i| {
-            let mut total = 0.0;
-            for c in 0..3 {
-                let m = runs.iter().map(|im| im.pixels[i][c] as f64).sum::<f64>() / n;
-                let var = runs
-                    .iter()
-                    .map(|im| (im.pixels[i][c] as f64 - m).powi(2))
-                    .sum::<f64>()
-                    / (n - 1.0);
-                let r = reference.pixels[i][c] as f64;
-                total += var / (r * r + EPSILON);
-            }
-            total / 3.0
-        })
-        .collect()
-}
-
-/// The mean relMSE over the pixels in `mask`, and its standard error by the
-/// jackknife over the runs (leave one run out, recompute; Efron and Stein
-/// 1981): the noise of the variance estimates themselves, heavy tails
-/// included, without pretending that the pixels of a plate are a random
-/// sample.
-fn region(runs: &[Image], reference: &Image, mask: &[bool]) -> (f64, f64) {
-    let pixels = mask.iter().filter(|&&m| m).count();
-    assert!(pixels > 200, "region too small: {pixels} pixels");
-    let over = |runs: &[Image]| {
-        let e = rel_mse(runs, reference);
-        e.iter()
-            .zip(mask)
-            .filter(|(_, &m)| m)
-            .map(|(v, _)| *v)
-            .sum::<f64>()
-            / pixels as f64
-    };
-    let full = over(runs);
-    let k = runs.len();
-    let leave_one_out: Vec<f64> = (0..k)
-        .map(|i| {
-            let rest: Vec<Image> = runs
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i)
-                .map(|(_, im)| im.clone())
-                .collect();
-            over(&rest)
-        })
-        .collect();
-    let m = leave_one_out.iter().sum::<f64>() / k as f64;
-    let var =
-        leave_one_out.iter().map(|x| (x - m).powi(2)).sum::<f64>() * (k as f64 - 1.0) / k as f64;
-    (full, var.sqrt())
+    shape_mask(|o| render(o), i)
 }
 
 /// Every estimator agrees with MIS-power in the mean, block by block
@@ -178,7 +97,7 @@ fn region(runs: &[Image], reference: &Image, mask: &[bool]) -> (f64, f64) {
 #[test]
 fn estimators_agree_in_the_mean() {
     let runs = direct_runs();
-    let means: Vec<Image> = runs.iter().map(|r| mean(r)).collect();
+    let means: Vec<Image> = runs.iter().map(|r| mean_image(r)).collect();
     let block = 32;
     let tests = 3 * (WIDTH / block) * (HEIGHT / block) * 3;
     let z = bonferroni_z(1e-3, tests);
@@ -199,7 +118,7 @@ fn estimators_agree_in_the_mean() {
 fn mis_power_is_robust_on_every_plate() {
     let runs = direct_runs();
     let all: Vec<Image> = runs.iter().flatten().cloned().collect();
-    let reference = mean(&all);
+    let reference = mean_image(&all);
     let masks: Vec<Vec<bool>> = (0..4).map(plate_mask).collect();
     let everything = vec![true; WIDTH * HEIGHT];
 
@@ -212,7 +131,10 @@ fn mis_power_is_robust_on_every_plate() {
     println!("| --- | --- | --- | --- | --- | --- |");
     let mut rows = Vec::new();
     for (i, mask) in masks.iter().chain(std::iter::once(&everything)).enumerate() {
-        let r: Vec<(f64, f64)> = runs.iter().map(|e| region(e, &reference, mask)).collect();
+        let r: Vec<(f64, f64)> = runs
+            .iter()
+            .map(|e| region_error(e, &reference, mask, Some(EPSILON)))
+            .collect();
         let name = if i < 4 {
             format!("plate {} (exponent {})", i + 1, PLATE_EXPONENTS[i])
         } else {

@@ -141,6 +141,106 @@ fn two_sided_tail(z: f64) -> f64 {
         .exp()
 }
 
+/// Pixelwise mean of images.
+pub fn mean_image(images: &[Image]) -> Image {
+    let mut out = Image::new(images[0].width, images[0].height);
+    for im in images {
+        for (o, p) in out.pixels.iter_mut().zip(&im.pixels) {
+            for c in 0..3 {
+                o[c] += p[c] / images.len() as f32;
+            }
+        }
+    }
+    out
+}
+
+/// Which pixels show shape `i` entirely, for a scene rendered by
+/// `render(overrides)`: make the shape emit pure blue, look at emitters
+/// only, keep the pixels that are fully blue.
+pub fn shape_mask(render: impl Fn(&[String]) -> Image, i: usize) -> Vec<bool> {
+    let image = render(&[
+        "integrator.max_depth=1".into(),
+        "sampler.spp=4".into(),
+        format!("shape.{i}.emission={{ radiance = [0.0, 0.0, 1.0] }}"),
+    ]);
+    image
+        .pixels
+        .iter()
+        .map(|p| p[2] >= 0.999 && p[0] == 0.0)
+        .collect()
+}
+
+/// Per-pixel error of one image of an estimator, from independent `runs`
+/// of it: the variance across the runs (an unbiased estimator's MSE),
+/// channels averaged; with `Some(epsilon)` over `ref^2 + epsilon`, the
+/// relMSE (pbrt-v4 `imgtool`, Mitsuba's `relmse`), `ref` being a converged
+/// image used only in that denominator.
+pub fn per_pixel_error(runs: &[Image], reference: &Image, epsilon: Option<f64>) -> Vec<f64> {
+    let n = runs.len() as f64;
+    (0..reference.pixels.len())
+        .map(|i| {
+            let mut total = 0.0;
+            for c in 0..3 {
+                let m = runs.iter().map(|im| im.pixels[i][c] as f64).sum::<f64>() / n;
+                let var = runs
+                    .iter()
+                    .map(|im| (im.pixels[i][c] as f64 - m).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0);
+                total += match epsilon {
+                    Some(e) => {
+                        let r = reference.pixels[i][c] as f64;
+                        var / (r * r + e)
+                    }
+                    None => var,
+                };
+            }
+            total / 3.0
+        })
+        .collect()
+}
+
+/// The mean [`per_pixel_error`] over the pixels in `mask`, and its standard
+/// error by the jackknife over the runs (leave one run out, recompute;
+/// Efron and Stein 1981): the noise of the variance estimates themselves,
+/// heavy tails included, without pretending that the pixels of a region
+/// are a random sample.
+pub fn region_error(
+    runs: &[Image],
+    reference: &Image,
+    mask: &[bool],
+    epsilon: Option<f64>,
+) -> (f64, f64) {
+    let pixels = mask.iter().filter(|&&m| m).count();
+    assert!(pixels > 200, "region too small: {pixels} pixels");
+    let over = |runs: &[Image]| {
+        let e = per_pixel_error(runs, reference, epsilon);
+        e.iter()
+            .zip(mask)
+            .filter(|(_, &m)| m)
+            .map(|(v, _)| *v)
+            .sum::<f64>()
+            / pixels as f64
+    };
+    let full = over(runs);
+    let k = runs.len();
+    let leave_one_out: Vec<f64> = (0..k)
+        .map(|i| {
+            let rest: Vec<Image> = runs
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i)
+                .map(|(_, im)| im.clone())
+                .collect();
+            over(&rest)
+        })
+        .collect();
+    let m = leave_one_out.iter().sum::<f64>() / k as f64;
+    let var =
+        leave_one_out.iter().map(|x| (x - m).powi(2)).sum::<f64>() * (k as f64 - 1.0) / k as f64;
+    (full, var.sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
