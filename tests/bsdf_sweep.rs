@@ -12,18 +12,34 @@
 //! - cos theta_o = 1e-4, 0.01, 0.1, 0.5, 1 and -1e-4, -0.5, -1.
 
 use lumis_check::bsdf_suite::{
-    check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
+    check_bsdf_variants, format_results, variant, BsdfCheckConfig, CaseResult, Variant,
 };
 
 const ROUGHNESS: [f64; 6] = [1e-4, 1e-3, 0.01, 0.1, 0.5, 1.0];
 
 fn run(name: &str, variants: Vec<Variant>) {
+    run_except(name, variants, &[]);
+}
+
+/// [`run`], with the chi-square of the cases `(variant label, cos theta_o)`
+/// in `beyond_f32` left out (every other check still applies to them).
+fn run_except(name: &str, variants: Vec<Variant>, beyond_f32: &[(&str, f32)]) {
     let registry = lumis_cli::builtin_registry().unwrap();
     let results =
         check_bsdf_variants(&registry, name, &variants, &BsdfCheckConfig::default()).unwrap();
     let report = format_results(&results);
     println!("{report}");
-    assert!(results.iter().all(|r| r.passed()), "{report}");
+    let ok = |r: &CaseResult| {
+        let exempt = beyond_f32
+            .iter()
+            .any(|&(label, c)| r.variant == label && r.cos_theta_o == c);
+        if exempt {
+            r.problems.is_empty()
+        } else {
+            r.passed()
+        }
+    };
+    assert!(results.iter().all(ok), "{report}");
 }
 
 fn v(label: String, toml: String) -> Variant {
@@ -79,7 +95,13 @@ fn blinn_sweep() {
             format!("exponent = 10.0\nsampling = \"{sampling}\"\n"),
         ));
     }
-    run("blinn", variants);
+    // n = 1e6 seen at cos theta_o = 1e-4: the lobe is 2e-7 rad wide across
+    // the plane of incidence (a half vector tilted by delta moves wi
+    // sideways by 2 cos theta_o delta), three f32 ulps of a unit vector, so
+    // the density of the rounded directions is not the pdf and no
+    // chi-square on f32 directions can pass (README, BSDF section).
+    // Finiteness, sample_f/f/pdf consistency and energy are still checked.
+    run_except("blinn", variants, &[("exponent 1000000", 1e-4)]);
 }
 
 #[test]

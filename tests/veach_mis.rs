@@ -86,7 +86,7 @@ fn direct_runs() -> &'static Vec<Vec<Image>> {
 
 /// Which pixels show plate `i` entirely.
 fn plate_mask(i: usize) -> Vec<bool> {
-    shape_mask(|o| render(o), i)
+    shape_mask(render, i)
 }
 
 /// Every estimator agrees with MIS-power in the mean, block by block

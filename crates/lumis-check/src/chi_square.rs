@@ -101,11 +101,16 @@ fn cell_integral(pdf: &dyn Fn(Vec3) -> f32, z0: f64, hz: f64, phi0: f64, hphi: f
     sum * 0.25 * hz * hphi
 }
 
-/// Adaptive quadrature: a cell is split in four until the four halves agree
-/// with the whole to `tolerance` (absolute, in probability), so peaked pdfs
-/// (area lights seen at grazing angles) are integrated accurately where
-/// they need it and cheaply elsewhere. The nodes are interior, so pdfs that
-/// jump at a cell edge (a hemisphere's rim) are handled too.
+/// Adaptive quadrature: a cell is split in four until the four quarters
+/// agree with the whole to `tolerance` (absolute, in probability), so
+/// peaked pdfs (area lights seen at grazing angles) are integrated
+/// accurately where they need it and cheaply elsewhere. Each quarter gets
+/// half the tolerance: what keeps refining is a jump along a curve (a
+/// horizon seen through the lobe zoom), whose error sits in about two of
+/// the four quarters and halves with each level, so a quarter of the
+/// tolerance would never be met and every such cell would go to the
+/// maximum depth. The nodes are interior, so pdfs that jump at a cell edge
+/// (a hemisphere's rim) are handled too.
 fn adaptive_integral(
     pdf: &dyn Fn(Vec3) -> f32,
     (z0, hz, phi0, hphi): (f64, f64, f64, f64),
@@ -133,13 +138,19 @@ fn adaptive_integral(
                 pdf,
                 (z, qz, phi, qphi),
                 part,
-                0.25 * tolerance,
+                0.5 * tolerance,
                 depth - 1,
                 forced.saturating_sub(1),
             )
         })
         .sum()
 }
+
+/// Bins whose first-pass mass is below this many expected samples, but
+/// where samples landed, are integrated again with full refinement. (A
+/// sample in a bin expecting 0.5 is ordinary in the tails; one in a bin
+/// expecting 1e-2 says the first pass missed something.)
+const MISSED_FEATURE: f64 = 1e-2;
 
 /// The probability mass of every bin. Bins where samples landed but the
 /// quadrature found (almost) no mass are integrated again with full
@@ -148,8 +159,13 @@ fn adaptive_integral(
 fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareConfig) -> Vec<f64> {
     let dz = 2.0 / cfg.z_bins as f64;
     let dphi = 2.0 * PI / cfg.phi_bins as f64;
-    // A total quadrature error well below one expected sample.
-    let tolerance = 0.01 / (cfg.samples as f64 * (cfg.z_bins * cfg.phi_bins) as f64).sqrt();
+    // Each bin's quadrature error must be small against its Poisson noise:
+    // an error delta in a bin of mass m adds N delta^2 / m to the
+    // statistic, so delta <= 0.05 sqrt(m / N) adds at most 0.0025 a bin.
+    // Bins of (almost) no mass keep an absolute floor, a total well below
+    // one expected sample over the whole grid.
+    let floor = 0.01 / (cfg.samples as f64 * (cfg.z_bins * cfg.phi_bins) as f64).sqrt();
+    let tolerance = |whole: f64| floor.max(0.05 * (whole.max(0.0) / cfg.samples as f64).sqrt());
     let mut mass = vec![0.0; cfg.z_bins * cfg.phi_bins];
     for zi in 0..cfg.z_bins {
         for pi in 0..cfg.phi_bins {
@@ -158,13 +174,13 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
             let i = zi * cfg.phi_bins + pi;
             // The first levels are always refined: a feature narrower than
             // the coarse nodes' spacing would otherwise go unseen.
-            mass[i] = adaptive_integral(pdf, cell, whole, tolerance, cfg.max_refinement, 2);
-            if observed[i] > 0 && mass[i] * (cfg.samples as f64) < 1.0 {
+            mass[i] = adaptive_integral(pdf, cell, whole, tolerance(whole), cfg.max_refinement, 2);
+            if observed[i] > 0 && mass[i] * (cfg.samples as f64) < MISSED_FEATURE {
                 mass[i] = adaptive_integral(
                     pdf,
                     cell,
                     whole,
-                    tolerance,
+                    floor,
                     cfg.max_refinement,
                     cfg.max_refinement,
                 );

@@ -5,17 +5,19 @@
 //! the (cos theta, phi) grid is coarsest in angle, so neither the histogram
 //! nor the quadrature of the pdf resolve it. The test is done instead on a
 //! bijective image of the sphere that magnifies the lobe: rotate its centre
-//! to the pole, stretch the polar angle by `k` out to `theta_b` (a few lobe
-//! widths) and compress the rest of the sphere linearly into what is left,
-//! `g(theta) = k theta` below `theta_b`, `k theta_b + s (theta - theta_b)`
-//! above, with `s = (pi - k theta_b) / (pi - theta_b)`; then rotate the pole
+//! to the pole, stretch the polar angle by `k` out to `theta_1` (two lobe
+//! widths), let the stretch relax smoothly to a compression `s` by
+//! `theta_2` (six widths), and compress the rest of the sphere linearly
+//! into what is left (`g(theta) = k theta`, then `g'` falling linearly from
+//! `k` to `s`, then `g(theta) = pi - s (pi - theta)`); then rotate the pole
 //! to the equator where the grid is finest. Because the far part is only
 //! compressed by `s` (about 1/3), a wide lobe beside the narrow one (the
-//! diffuse base of a coated material) stays resolved too. The samples are
-//! mapped forward; the pdf is evaluated at the preimage of each quadrature
-//! node and divided by the Jacobian `d(omega')/d(omega) = g'(theta) sin
-//! g(theta) / sin theta`, so the transformed pair is exactly as right or
-//! wrong as the original.
+//! diffuse base of a coated material) stays resolved too, and because `g`
+//! is C1 the mapped pdf has no jump for the quadrature to chase. The
+//! samples are mapped forward; the pdf is evaluated at the preimage of each
+//! quadrature node and divided by the Jacobian `d(omega')/d(omega) =
+//! g'(theta) sin g(theta) / sin theta`, so the transformed pair is exactly
+//! as right or wrong as the original.
 //!
 //! Centre and width come from a pilot batch drawn with another seed, so
 //! the map does not depend on the samples it tests: the centre is where
@@ -30,13 +32,16 @@ use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 
 /// The magnified lobe spans about this angle (radians) after the map.
 const TARGET_WIDTH: f64 = 0.5;
-/// The magnified part ends this many lobe widths from the centre.
-const MAGNIFIED_WIDTHS: f64 = 4.0;
+/// The full magnification holds to this many lobe widths from the centre,
+/// and the compression is reached at `RELAXED_WIDTHS`.
+const MAGNIFIED_WIDTHS: f64 = 2.0;
+const RELAXED_WIDTHS: f64 = 6.0;
 /// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are tested as they are.
 const MIN_ZOOM: f64 = 4.0;
 const PILOT_SAMPLES: usize = 20_000;
-/// Fewer samples than this in the peak: no lobe to magnify.
-const MIN_PEAK_SAMPLES: usize = 100;
+/// A peak holding less than this share of the pilot samples is not a lobe
+/// to magnify (the `1 / <wo, h>` spike of a wide lobe at grazing angles).
+const MIN_PEAK_SHARE: f64 = 0.02;
 
 /// The map `d -> d'` for one lobe.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,24 +51,35 @@ pub struct LobeZoom {
     y: DVec3,
     z: DVec3,
     k: f64,
-    theta_b: f64,
+    theta_1: f64,
+    theta_2: f64,
+    /// Slope of the compressed part, from `g(pi) = pi`.
+    s: f64,
 }
 
 impl LobeZoom {
-    /// Magnifies the polar angle around `centre` by `k` out to `theta_b`
-    /// (`k theta_b < pi`).
-    pub fn new(centre: Vec3, k: f64, theta_b: f64) -> Self {
-        debug_assert!(k * theta_b < std::f64::consts::PI && theta_b > 0.0);
+    /// Magnifies the polar angle around `centre` by `k` out to `theta_1`,
+    /// relaxing to the compression by `theta_2`. Needs `k (theta_1 +
+    /// theta_2) / 2 < pi`.
+    pub fn new(centre: Vec3, k: f64, theta_1: f64, theta_2: f64) -> Self {
+        use std::f64::consts::PI;
         let z = centre.as_dvec3().normalize();
         let helper = if z.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
         let x = helper.cross(z).normalize();
         let y = z.cross(x);
+        // g(theta_2) = k (theta_1 + theta_2) / 2 + s (theta_2 - theta_1) / 2
+        // must equal pi - s (pi - theta_2).
+        let span = theta_2 - theta_1;
+        let s = (PI - 0.5 * k * (theta_1 + theta_2)) / (PI - theta_2 + 0.5 * span);
+        debug_assert!(s > 0.0 && span > 0.0, "k {k}, theta {theta_1}..{theta_2}");
         Self {
             x,
             y,
             z,
             k,
-            theta_b,
+            theta_1,
+            theta_2,
+            s,
         }
     }
 
@@ -72,43 +88,54 @@ impl LobeZoom {
         self.k
     }
 
-    /// Slope of the compressed part.
-    fn s(&self) -> f64 {
-        use std::f64::consts::PI;
-        (PI - self.k * self.theta_b) / (PI - self.theta_b)
-    }
-
-    /// `g(theta)` and `sin g(theta) / sin(theta) * g'(theta)`, the Jacobian;
-    /// near the antipode from `pi - theta` so that the ratio of two tiny
-    /// sines stays exact.
+    /// `g(theta)` and the Jacobian `g'(theta) sin g(theta) / sin theta`;
+    /// in the compressed part from the distance to the antipode, so that
+    /// the ratio of two tiny sines stays exact there.
     fn map_angle(&self, theta: f64, antipode_distance: f64) -> (f64, f64) {
         use std::f64::consts::PI;
-        if theta <= self.theta_b {
-            let g = self.k * theta;
-            let ratio = if theta == 0.0 {
+        let ratio = |g: f64| {
+            if theta == 0.0 {
                 self.k
             } else {
                 g.sin() / theta.sin()
-            };
-            (g, self.k * ratio)
+            }
+        };
+        if theta <= self.theta_1 {
+            let g = self.k * theta;
+            (g, self.k * ratio(g))
+        } else if theta <= self.theta_2 {
+            let x = theta - self.theta_1;
+            let span = self.theta_2 - self.theta_1;
+            let slope = self.k + (self.s - self.k) * x / span;
+            let g = self.k * theta + 0.5 * (self.s - self.k) * x * x / span;
+            (g, slope * ratio(g))
         } else {
-            let s = self.s();
-            let g = PI - s * antipode_distance;
+            let d = self.s * antipode_distance;
             let ratio = if antipode_distance == 0.0 {
-                s
+                self.s
             } else {
-                (s * antipode_distance).sin() / antipode_distance.sin()
+                d.sin() / antipode_distance.sin()
             };
-            (g, s * ratio)
+            (PI - d, self.s * ratio)
         }
     }
 
     fn inverse_angle(&self, g: f64) -> f64 {
-        let edge = self.k * self.theta_b;
-        if g <= edge {
+        use std::f64::consts::PI;
+        let span = self.theta_2 - self.theta_1;
+        let g_1 = self.k * self.theta_1;
+        let g_2 = PI - self.s * (PI - self.theta_2);
+        if g <= g_1 {
             g / self.k
+        } else if g <= g_2 {
+            // (s - k) / (2 span) x^2 + k x = g - g_1, by the root that
+            // cancels nothing.
+            let a = 0.5 * (self.s - self.k) / span;
+            let c = g - g_1;
+            let disc = (self.k * self.k + 4.0 * a * c).max(0.0);
+            self.theta_1 + 2.0 * c / (self.k + disc.sqrt())
         } else {
-            self.theta_b + (g - edge) / self.s()
+            PI - (PI - g) / self.s
         }
     }
 
@@ -193,13 +220,20 @@ impl LobeZoom {
             .filter(|&&(_, p)| p >= 1e-2 * peak)
             .map(|&(d, _)| d.dot(centre).clamp(-1.0, 1.0).acos())
             .collect();
-        if angles.len() < MIN_PEAK_SAMPLES {
+        if (angles.len() as f64) < MIN_PEAK_SHARE * pilot.len() as f64 {
             return None;
         }
         angles.sort_by(f64::total_cmp);
         let width = angles[angles.len() * 9 / 10].max(1e-9);
         let k = (TARGET_WIDTH / width).min(1e6);
-        (k >= MIN_ZOOM).then(|| Self::new(centre.as_vec3(), k, MAGNIFIED_WIDTHS * width))
+        (k >= MIN_ZOOM).then(|| {
+            Self::new(
+                centre.as_vec3(),
+                k,
+                MAGNIFIED_WIDTHS * width,
+                RELAXED_WIDTHS * width,
+            )
+        })
     }
 }
 
@@ -234,7 +268,7 @@ mod tests {
 
     #[test]
     fn forward_and_inverse_are_inverse_with_the_right_jacobian() {
-        let zoom = LobeZoom::new(Vec3::new(0.3, -0.2, 0.9).normalize(), 50.0, 0.04);
+        let zoom = LobeZoom::new(Vec3::new(0.3, -0.2, 0.9).normalize(), 50.0, 0.02, 0.05);
         for d in [
             Vec3::new(0.31, -0.19, 0.9),
             Vec3::new(0.0, 0.0, 1.0),
@@ -246,7 +280,11 @@ mod tests {
         }
         // Jacobian by finite areas around a point in the magnified part
         // and one in the compressed part.
-        for d in [Vec3::new(0.305, -0.2, 0.9), Vec3::new(-0.5, 0.4, 0.2)] {
+        for d in [
+            Vec3::new(0.305, -0.2, 0.9),
+            Vec3::new(0.33, -0.2, 0.9),
+            Vec3::new(-0.5, 0.4, 0.2),
+        ] {
             let d = d.normalize();
             let (_, j) = zoom.inverse(zoom.forward(d));
             let e1 = d.any_orthonormal_vector();
