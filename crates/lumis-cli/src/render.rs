@@ -132,6 +132,11 @@ pub fn render_scene_file(
     registry: &lumis_core::Registry,
 ) -> Result<RenderReport> {
     let loaded = load(args, registry)?;
+    if !args.quiet {
+        for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
+            eprintln!("{line}");
+        }
+    }
     if args.verbose {
         eprintln!("{}", describe(&loaded));
     }

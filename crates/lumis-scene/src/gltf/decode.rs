@@ -1,0 +1,204 @@
+//! glTF mesh primitives to triangle lists, checked before they are read.
+//!
+//! Every accessor is checked against its buffer view and buffer first, so a
+//! truncated buffer or a bad offset is an error naming the asset, the mesh
+//! and the primitive, never a panic or a silently shortened mesh.
+
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::{Mode, Semantic};
+use lumis_core::Vec3;
+
+use super::buffers::Asset;
+use super::normals;
+
+/// One primitive, decoded: what a lumis mesh needs.
+pub(crate) struct Part {
+    pub positions: Vec<[f32; 3]>,
+    pub indices: Vec<[u32; 3]>,
+    /// `None`: flat shading (no normals in the file and none generated).
+    pub normals: Option<Vec<Vec3>>,
+    /// `None`: the glTF default material.
+    pub material: Option<usize>,
+}
+
+/// How to obtain shading normals a file does not have.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum MissingNormals {
+    /// Flat shading: nothing stored, nothing interpolated.
+    Flat,
+    /// Generated with this crease threshold (cosine of the crease angle).
+    Generate { cos_crease: f32 },
+}
+
+/// `mesh "name" (#3)` or `mesh #3`, the way errors name a mesh.
+pub(crate) fn mesh_label(mesh: &gltf::Mesh) -> String {
+    match mesh.name() {
+        Some(name) => format!("mesh \"{name}\" (#{})", mesh.index()),
+        None => format!("mesh #{}", mesh.index()),
+    }
+}
+
+/// Decodes every primitive of `mesh`.
+pub(crate) fn mesh(
+    asset: &Asset,
+    mesh: &gltf::Mesh,
+    missing_normals: MissingNormals,
+) -> Result<Vec<Part>, String> {
+    mesh.primitives()
+        .map(|p| {
+            primitive(asset, &p, missing_normals).map_err(|e| {
+                format!(
+                    "'{}': {} primitive #{}: {e}",
+                    asset.label,
+                    mesh_label(mesh),
+                    p.index()
+                )
+            })
+        })
+        .collect()
+}
+
+fn primitive(
+    asset: &Asset,
+    primitive: &gltf::Primitive,
+    missing_normals: MissingNormals,
+) -> Result<Part, String> {
+    if primitive.mode() != Mode::Triangles {
+        return Err(format!(
+            "mode {:?} is not supported; only TRIANGLES (mode 4) is",
+            primitive.mode()
+        ));
+    }
+    let position_accessor = primitive
+        .get(&Semantic::Positions)
+        .ok_or("has no POSITION attribute")?;
+    check_accessor(
+        asset,
+        &position_accessor,
+        "POSITION",
+        &[DataType::F32],
+        Dimensions::Vec3,
+    )?;
+    let normal_accessor = primitive.get(&Semantic::Normals);
+    if let Some(a) = &normal_accessor {
+        check_accessor(asset, a, "NORMAL", &[DataType::F32], Dimensions::Vec3)?;
+        if a.count() != position_accessor.count() {
+            return Err(format!(
+                "NORMAL has {} entries for {} positions",
+                a.count(),
+                position_accessor.count()
+            ));
+        }
+    }
+    if let Some(a) = primitive.indices() {
+        check_accessor(
+            asset,
+            &a,
+            "indices",
+            &[DataType::U8, DataType::U16, DataType::U32],
+            Dimensions::Scalar,
+        )?;
+    }
+
+    let reader = primitive.reader(|b| Some(asset.buffer(b.index())));
+    let positions: Vec<[f32; 3]> = reader
+        .read_positions()
+        .ok_or("cannot read POSITION")?
+        .collect();
+    if positions.iter().flatten().any(|c| !c.is_finite()) {
+        return Err("POSITION holds a NaN or infinite coordinate".into());
+    }
+    let n = positions.len();
+    let flat: Vec<u32> = match reader.read_indices() {
+        Some(indices) => indices.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if flat.len() % 3 != 0 {
+        return Err(format!(
+            "{} indices is not a whole number of triangles",
+            flat.len()
+        ));
+    }
+    if let Some((i, bad)) = flat.iter().enumerate().find(|(_, &v)| v as usize >= n) {
+        return Err(format!(
+            "index {bad} (element {i}) is out of range for {n} vertices"
+        ));
+    }
+    let indices: Vec<[u32; 3]> = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    drop(flat);
+    if indices.is_empty() {
+        return Err("has no triangles".into());
+    }
+
+    let (positions, indices, normals) = match normal_accessor {
+        Some(_) => {
+            let normals: Vec<Vec3> = reader
+                .read_normals()
+                .ok_or("cannot read NORMAL")?
+                .map(Vec3::from)
+                .collect();
+            (positions, indices, Some(normals))
+        }
+        None => match missing_normals {
+            MissingNormals::Flat => (positions, indices, None),
+            MissingNormals::Generate { cos_crease } => {
+                let g = normals::generate(positions, indices, cos_crease);
+                (g.positions, g.indices, Some(g.normals))
+            }
+        },
+    };
+    Ok(Part {
+        positions,
+        indices,
+        normals,
+        material: primitive.material().index(),
+    })
+}
+
+/// Checks an accessor's type and that its bytes lie within its buffer
+/// view and the view within its buffer.
+fn check_accessor(
+    asset: &Asset,
+    accessor: &gltf::Accessor,
+    what: &str,
+    types: &[DataType],
+    dimensions: Dimensions,
+) -> Result<(), String> {
+    let name = format!("{what} (accessor #{})", accessor.index());
+    if !types.contains(&accessor.data_type()) || accessor.dimensions() != dimensions {
+        return Err(format!(
+            "{name} is {:?} {:?}; expected {dimensions:?} of {types:?}",
+            accessor.dimensions(),
+            accessor.data_type()
+        ));
+    }
+    let Some(view) = accessor.view() else {
+        // Sparse-only accessors have no view; the reader fills them in.
+        return Ok(());
+    };
+    let buffer = view.buffer();
+    let data_len = asset.buffer(buffer.index()).len();
+    let view_end = view.offset() + view.length();
+    if view_end > data_len {
+        return Err(format!(
+            "{name}: buffer view #{} ends at byte {view_end}, past the {data_len} bytes of buffer #{} (truncated buffer?)",
+            view.index(),
+            buffer.index()
+        ));
+    }
+    if accessor.count() == 0 {
+        return Ok(());
+    }
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    let end = accessor.offset() + stride * (accessor.count() - 1) + size;
+    if end > view.length() {
+        return Err(format!(
+            "{name}: {} elements need {end} bytes but buffer view #{} has {}",
+            accessor.count(),
+            view.index(),
+            view.length()
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,523 @@
+//! `[[shape]] type = "gltf"`: glTF 2.0 assets (`.gltf` with external or
+//! embedded buffers, `.glb`).
+//!
+//! Every triangle primitive of every mesh the asset's scene uses is loaded,
+//! placed by its node hierarchy and the shape's `transform`. A mesh used by
+//! one node is transformed into world space and joins the top-level BVH; a
+//! mesh used by several nodes is built once in its own Embree scene and
+//! placed by Embree instances, so its vertices, indices, normals and BVH
+//! exist once however often it appears. Materials map onto BSDF plugins
+//! (see [`material`]) unless the TOML overrides them by name; emissive
+//! materials make their triangles area lights.
+
+mod buffers;
+pub(crate) mod camera;
+mod decode;
+mod material;
+mod normals;
+mod scene_graph;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use lumis_core::doc::{self, Node, Table, Value};
+use lumis_core::glam::{Mat3, Mat4};
+use lumis_core::registry::TableRef;
+use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Result, Vec3};
+use lumis_embree::{PaddedBuffer, SceneBuilder};
+use rayon::prelude::*;
+
+use crate::render_scene::{Geometry, MeshData, Placement, Prototype, NO_LIGHT};
+use crate::report::Phase;
+use crate::transform::parse_transform;
+use crate::Assembly;
+use decode::{MissingNormals, Part};
+
+pub(crate) const GLTF_PARAMS: &[ParamSpec] = &[
+    ParamSpec::required(
+        "file",
+        ParamType::String,
+        "glTF 2.0 asset (.gltf with its buffers, or .glb), relative to the scene file",
+    ),
+    ParamSpec::optional(
+        "transform",
+        ParamType::Table,
+        "placement of the whole asset: { matrix = [16 numbers, row-major] } or { scale, rotate = [ax, ay, az, degrees], translate }",
+    ),
+    ParamSpec::optional(
+        "bsdf",
+        ParamType::String,
+        "a [[bsdf]] for every primitive instead of the asset's materials (their emission stays)",
+    ),
+    ParamSpec::optional(
+        "bsdf_overrides",
+        ParamType::Table,
+        "{ \"glTF material name\" = \"[[bsdf]] name\", ... }: replaces those materials' BSDFs",
+    ),
+    ParamSpec::with_default(
+        "crease_angle",
+        ParamType::Float,
+        "30.0",
+        "degrees; normals missing from the file are generated, smooth across edges whose faces meet at less than this; 0 = flat shading (nothing stored)",
+    )
+    .in_range(0.0, 180.0),
+];
+
+/// A parsed `[[shape]] type = "gltf"`.
+pub(crate) struct GltfShape {
+    path: PathBuf,
+    /// `file` as written, for messages.
+    label: String,
+    file_location: Location,
+    transform: Mat4,
+    bsdf: Option<(String, Location)>,
+    /// (glTF material name, `[[bsdf]]` name, where the override is written).
+    overrides: Vec<(String, String, Location)>,
+    missing_normals: MissingNormals,
+}
+
+pub(crate) fn parse(
+    owner: &str,
+    params: &Params,
+    table: &Table,
+    scene_dir: &Path,
+) -> Result<GltfShape> {
+    let label: String = params.get("file")?;
+    let located = |key: &str| {
+        table
+            .get(key)
+            .map_or(Location::Builtin, |n| n.location.clone())
+    };
+    let transform = match params.table("transform")? {
+        Some((t, at)) => parse_transform(&format!("{owner} transform"), t, at)?,
+        None => Mat4::IDENTITY,
+    };
+    let bsdf = params
+        .get_opt::<String>("bsdf")?
+        .map(|b| (b, located("bsdf")));
+    let mut overrides = Vec::new();
+    if let Some((t, _)) = params.table("bsdf_overrides")? {
+        for entry in &t.entries {
+            match &entry.node.value {
+                Value::String(s) => {
+                    overrides.push((entry.key.clone(), s.clone(), entry.node.location.clone()))
+                }
+                v => {
+                    return Err(Error::at(
+                        &entry.node.location,
+                        format!(
+                            "{owner} bsdf_overrides.\"{}\": expected the name of a [[bsdf]] (a string), found {}",
+                            entry.key,
+                            v.type_name()
+                        ),
+                    ))
+                }
+            }
+        }
+    }
+    if bsdf.is_some() && !overrides.is_empty() {
+        return Err(params.error(
+            "bsdf_overrides",
+            "'bsdf' already replaces every material; give one or the other",
+        ));
+    }
+    let crease = params.get_in_range("crease_angle")?;
+    let missing_normals = if crease == 0.0 {
+        MissingNormals::Flat
+    } else {
+        MissingNormals::Generate {
+            cos_crease: crease.to_radians().cos(),
+        }
+    };
+    Ok(GltfShape {
+        path: scene_dir.join(&label),
+        label,
+        file_location: located("file"),
+        transform,
+        bsdf,
+        overrides,
+        missing_normals,
+    })
+}
+
+/// What a glTF material became: a BSDF of the scene and, if it emits, the
+/// light table its triangles share.
+#[derive(Clone)]
+struct Resolved {
+    bsdf: u32,
+    emission: Option<Table>,
+}
+
+/// Loads the asset and adds its meshes, instances and emissive triangles.
+pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<()> {
+    let at = shape.file_location.clone();
+    let err = |e: String| Error::at(&at, format!("{owner}: {e}"));
+    let asset = asm
+        .report
+        .time(Phase::Parse, || buffers::load(&shape.path, &shape.label))
+        .map_err(err)?;
+    let uses = scene_graph::mesh_uses(&asset.document, shape.transform)
+        .map_err(|e| err(format!("'{}': {e}", shape.label)))?;
+
+    let meshes: Vec<gltf::Mesh> = asset.document.meshes().collect();
+    let missing_normals = shape.missing_normals;
+    let decoded: Vec<Option<Vec<Part>>> = asm
+        .report
+        .time(Phase::Attributes, || {
+            meshes
+                .par_iter()
+                .map(|m| {
+                    if uses[m.index()].is_empty() {
+                        Ok(None)
+                    } else {
+                        decode::mesh(&asset, m, missing_normals).map(Some)
+                    }
+                })
+                .collect::<std::result::Result<Vec<_>, String>>()
+        })
+        .map_err(err)?;
+
+    let resolved = resolve_materials(owner, &shape, &asset, asm)?;
+    let light_owner = format!("{owner} emission");
+
+    // Meshes used once: into world space, into the top-level BVH.
+    let mut instanced = Vec::new();
+    for (mesh_index, parts) in decoded.into_iter().enumerate() {
+        let Some(parts) = parts else { continue };
+        let worlds = &uses[mesh_index];
+        if worlds.len() > 1 {
+            instanced.push((mesh_index, parts));
+            continue;
+        }
+        let world = worlds[0];
+        for part in parts {
+            let r = &resolved[&part.material];
+            let triangles = part.indices.len();
+            let (positions, indices, normals) =
+                asm.report.time(Phase::Attributes, || bake(part, &world));
+            let lights = match &r.emission {
+                Some(table) => {
+                    let tris = indices
+                        .iter()
+                        .map(|t| t.map(|i| Vec3::from(positions[i as usize])));
+                    triangle_lights(tris, table, &light_owner, &at, asm)?
+                }
+                None => Vec::new(),
+            };
+            let mesh = MeshData {
+                vertices: Arc::new(PaddedBuffer::new(positions)),
+                indices: Arc::new(PaddedBuffer::new(indices)),
+                normals,
+                bsdf: r.bsdf,
+                lights,
+                orientation: 1.0,
+            };
+            asm.counts.shading_normals |= mesh.normals.is_some();
+            asm.builder
+                .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
+                .map_err(|e| err(e.to_string()))?;
+            asm.geometries.push(Geometry::Mesh(mesh));
+            asm.counts.meshes += 1;
+            asm.counts.triangles += triangles;
+            asm.counts.unique_triangles += triangles;
+        }
+    }
+
+    // Meshes used by several nodes: one Embree scene each, built in parallel.
+    let mut pending = Vec::new();
+    for (mesh_index, parts) in instanced {
+        let mut child =
+            SceneBuilder::new(&asm.device, asm.options).map_err(|e| err(e.to_string()))?;
+        let mut meshes = Vec::with_capacity(parts.len());
+        let mut emissions = Vec::with_capacity(parts.len());
+        for part in parts {
+            let r = &resolved[&part.material];
+            let mesh = MeshData {
+                vertices: Arc::new(PaddedBuffer::new(part.positions)),
+                indices: Arc::new(PaddedBuffer::new(part.indices)),
+                normals: part.normals,
+                bsdf: r.bsdf,
+                lights: Vec::new(),
+                orientation: 1.0,
+            };
+            child
+                .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
+                .map_err(|e| err(e.to_string()))?;
+            asm.counts.shading_normals |= mesh.normals.is_some();
+            emissions.push(r.emission.clone());
+            meshes.push(mesh);
+        }
+        pending.push((mesh_index, child, meshes, emissions));
+    }
+    let (builders, rest): (Vec<_>, Vec<_>) = pending
+        .into_iter()
+        .map(|(i, child, meshes, emissions)| (child, (i, meshes, emissions)))
+        .unzip();
+    let scenes = asm
+        .report
+        .time(Phase::Bvh, || {
+            builders
+                .into_par_iter()
+                .map(|b| b.commit())
+                .collect::<std::result::Result<Vec<_>, _>>()
+        })
+        .map_err(|e| err(e.to_string()))?;
+    for (scene, (mesh_index, meshes, emissions)) in scenes.into_iter().zip(rest) {
+        let scene = Arc::new(scene);
+        let prototype = asm.prototypes.len() as u32;
+        let triangles: usize = meshes.iter().map(|m| m.indices.len()).sum();
+        for world in &uses[mesh_index] {
+            let lights = instance_lights(&meshes, &emissions, world, &light_owner, &at, asm)?;
+            let columns = world.to_cols_array();
+            let transform: [f32; 12] = [
+                columns[0],
+                columns[1],
+                columns[2],
+                columns[4],
+                columns[5],
+                columns[6],
+                columns[8],
+                columns[9],
+                columns[10],
+                columns[12],
+                columns[13],
+                columns[14],
+            ];
+            asm.builder
+                .add_instance(scene.clone(), &transform)
+                .map_err(|e| err(e.to_string()))?;
+            let linear = Mat3::from_mat4(*world);
+            asm.geometries.push(Geometry::Instance {
+                prototype,
+                placement: Placement {
+                    linear,
+                    translation: world.w_axis.truncate(),
+                    normal: linear.inverse().transpose(),
+                },
+                lights,
+            });
+            asm.counts.instances += 1;
+            asm.counts.triangles += triangles;
+        }
+        asm.counts.meshes += meshes.len();
+        asm.counts.prototypes += 1;
+        asm.counts.unique_triangles += triangles;
+        asm.prototypes.push(Prototype { meshes });
+    }
+    Ok(())
+}
+
+/// Transforms a part into world space. A mirroring transform (negative
+/// determinant) reverses the winding, as the glTF spec says it does, so
+/// the front side stays where the asset meant it.
+fn bake(part: Part, world: &Mat4) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Option<Vec<Vec3>>) {
+    let Part {
+        mut positions,
+        mut indices,
+        mut normals,
+        ..
+    } = part;
+    if *world == Mat4::IDENTITY {
+        return (positions, indices, normals);
+    }
+    positions
+        .par_iter_mut()
+        .for_each(|p| *p = world.transform_point3(Vec3::from(*p)).into());
+    let normal_matrix = Mat3::from_mat4(*world).inverse().transpose();
+    if let Some(ns) = &mut normals {
+        ns.par_iter_mut()
+            .for_each(|n| *n = (normal_matrix * *n).normalize_or_zero());
+    }
+    if world.determinant() < 0.0 {
+        indices.par_iter_mut().for_each(|t| t.swap(1, 2));
+    }
+    (positions, indices, normals)
+}
+
+/// One triangle light per non-degenerate triangle (world-space vertices,
+/// front side by winding), `NO_LIGHT` for degenerate ones.
+fn triangle_lights(
+    triangles: impl Iterator<Item = [Vec3; 3]>,
+    table: &Table,
+    owner: &str,
+    at: &Location,
+    asm: &mut Assembly,
+) -> Result<Vec<u32>> {
+    let mut out = Vec::new();
+    for p in triangles {
+        let [a, b, c] = p;
+        if (b - a).cross(c - a).length_squared() == 0.0 {
+            out.push(NO_LIGHT);
+            continue;
+        }
+        let light = asm.registry.create_light(
+            &TableRef {
+                owner,
+                table,
+                location: at,
+                type_name: "triangle",
+                type_location: at,
+                structural: &["type"],
+            },
+            &LightShape::Triangle { p },
+        )?;
+        asm.lights.push(light);
+        asm.counts.area_lights += 1;
+        out.push(asm.lights.len() as u32 - 1);
+    }
+    Ok(out)
+}
+
+/// The world-space triangle lights of one instance of a prototype.
+fn instance_lights(
+    meshes: &[MeshData],
+    emissions: &[Option<Table>],
+    world: &Mat4,
+    owner: &str,
+    at: &Location,
+    asm: &mut Assembly,
+) -> Result<Vec<Vec<u32>>> {
+    if emissions.iter().all(Option::is_none) {
+        return Ok(Vec::new());
+    }
+    let mirrored = world.determinant() < 0.0;
+    let mut out = Vec::with_capacity(meshes.len());
+    for (mesh, emission) in meshes.iter().zip(emissions) {
+        let Some(table) = emission else {
+            out.push(Vec::new());
+            continue;
+        };
+        let vertices = &mesh.vertices;
+        let tris = mesh.indices.iter().map(|t| {
+            let [a, b, c] = t.map(|i| world.transform_point3(Vec3::from(vertices[i as usize])));
+            if mirrored {
+                [a, c, b]
+            } else {
+                [a, b, c]
+            }
+        });
+        out.push(triangle_lights(tris, table, owner, at, asm)?);
+    }
+    Ok(out)
+}
+
+/// Maps every material the asset's primitives use (and the default
+/// material) to a BSDF of the scene, honouring `bsdf` and `bsdf_overrides`.
+fn resolve_materials(
+    owner: &str,
+    shape: &GltfShape,
+    asset: &buffers::Asset,
+    asm: &mut Assembly,
+) -> Result<HashMap<Option<usize>, Resolved>> {
+    let at = &shape.file_location;
+    let err = |e: String| Error::at(at, format!("{owner}: '{}': {e}", shape.label));
+    let document = &asset.document;
+    for (name, _, location) in &shape.overrides {
+        if !document
+            .materials()
+            .any(|m| m.name() == Some(name.as_str()))
+        {
+            let names: Vec<String> = document
+                .materials()
+                .filter_map(|m| m.name().map(|n| format!("\"{n}\"")))
+                .collect();
+            return Err(Error::at(
+                location,
+                format!(
+                    "{owner} bsdf_overrides: '{}' has no material named \"{name}\"; named materials: {}",
+                    shape.label,
+                    if names.is_empty() { "none".into() } else { names.join(", ") }
+                ),
+            ));
+        }
+    }
+    let named = |name: &str, location: &Location, asm: &Assembly| -> Result<u32> {
+        asm.bsdfs
+            .iter()
+            .position(|(n, _)| n == name)
+            .map(|i| i as u32)
+            .ok_or_else(|| Error::at(location, format!("{owner}: no [[bsdf]] named \"{name}\"")))
+    };
+    let mut out = HashMap::new();
+    let materials = std::iter::once(None).chain(document.materials().map(|m| m.index()));
+    for index in materials {
+        let material = match index {
+            Some(i) => document
+                .materials()
+                .nth(i)
+                .expect("index from the document"),
+            None => {
+                // The default material, used by primitives without one.
+                let Some(m) = document
+                    .meshes()
+                    .flat_map(|m| m.primitives().collect::<Vec<_>>())
+                    .map(|p| p.material())
+                    .find(|m| m.index().is_none())
+                else {
+                    continue;
+                };
+                m
+            }
+        };
+        let label = match (material.name(), index) {
+            (Some(n), _) => format!("\"{n}\""),
+            (None, Some(i)) => format!("#{i}"),
+            (None, None) => "(default)".into(),
+        };
+        let override_ = match &shape.bsdf {
+            Some((b, l)) => Some((b.clone(), l.clone())),
+            None => shape
+                .overrides
+                .iter()
+                .find(|(m, _, _)| Some(m.as_str()) == material.name())
+                .map(|(_, b, l)| (b.clone(), l.clone())),
+        };
+        let bsdf = match override_ {
+            Some((name, location)) => named(&name, &location, asm)?,
+            None => {
+                let (text, warnings) = material::bsdf_table(&material, &label).map_err(err)?;
+                asm.report.warnings.extend(
+                    warnings
+                        .into_iter()
+                        .map(|w| format!("'{}': {w}", shape.label)),
+                );
+                let source = format!("{} material {label}", shape.label);
+                let table = doc::parse(&text, &source)?;
+                let Some(Node {
+                    value: Value::String(kind),
+                    ..
+                }) = table.get("type")
+                else {
+                    unreachable!("bsdf_table writes a type")
+                };
+                let bsdf = asm.registry.create_bsdf(&TableRef {
+                    owner: &format!("{owner} material {label}"),
+                    table: &table,
+                    location: at,
+                    type_name: kind,
+                    type_location: at,
+                    structural: &["type"],
+                })?;
+                asm.bsdfs.push((format!("{}#{label}", shape.label), bsdf));
+                asm.bsdfs.len() as u32 - 1
+            }
+        };
+        let mut warnings = Vec::new();
+        let emission = material::emission(&material, &label, &mut warnings).map_err(err)?;
+        asm.report.warnings.extend(
+            warnings
+                .into_iter()
+                .map(|w| format!("'{}': {w}", shape.label)),
+        );
+        let emission = match emission {
+            Some(radiance) => Some(doc::parse(
+                &material::emission_table(radiance, material.double_sided()),
+                &format!("{} material {label} emission", shape.label),
+            )?),
+            None => None,
+        };
+        out.insert(index, Resolved { bsdf, emission });
+    }
+    Ok(out)
+}
