@@ -114,17 +114,18 @@ pub(crate) fn from_table(
         .cameras()
         .nth(camera_index)
         .expect("index from the document");
-    let yfov =
-        match camera.projection() {
-            gltf::camera::Projection::Perspective(p) => p.yfov(),
-            gltf::camera::Projection::Orthographic(_) => return Err(params.error(
+    let yfov = match camera.projection() {
+        gltf::camera::Projection::Perspective(p) => p.yfov(),
+        gltf::camera::Projection::Orthographic(_) => {
+            return Err(params.error(
                 "file",
                 format!(
                     "'{file}': camera {} is orthographic; only perspective cameras are supported",
                     names[camera_index]
                 ),
-            )),
-        };
+            ))
+        }
+    };
     // lumis's fov is the full angle of the smaller image axis; glTF's yfov
     // is vertical, and the film's aspect ratio decides the horizontal one.
     let (w, h) = (resolution.x as f32, resolution.y as f32);
