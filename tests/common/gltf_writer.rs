@@ -115,7 +115,7 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
     let mut accessors = Vec::new();
     // Adds a view + accessor over `bytes`; returns the accessor index.
     let mut add = |bytes: &[u8], count: usize, ty: &str, component: u32, extra: String| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(format!(
@@ -236,7 +236,7 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             )
         })
         .collect();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let buffer = match uri {
@@ -288,7 +288,7 @@ pub fn write(dir: &Path, name: &str, asset: &Asset, container: Container) -> Str
         Container::Glb => {
             let (json, bin) = encode(asset, None);
             let mut json = json.into_bytes();
-            while json.len() % 4 != 0 {
+            while !json.len().is_multiple_of(4) {
                 json.push(b' ');
             }
             let total = 12 + 8 + json.len() + 8 + bin.len();

@@ -19,6 +19,25 @@ pub(crate) struct Part {
     pub normals: Option<Vec<Vec3>>,
     /// `None`: the glTF default material.
     pub material: Option<usize>,
+    /// Set when normals are missing and must be generated with this crease
+    /// threshold: [`Part::generate_normals`] does it once the asset's
+    /// buffers are freed, to lower peak memory.
+    pub pending_normals: Option<f32>,
+}
+
+impl Part {
+    /// Generates the normals this part is waiting for, if any.
+    pub fn generate_normals(&mut self) {
+        let Some(cos_crease) = self.pending_normals.take() else {
+            return;
+        };
+        let positions = std::mem::take(&mut self.positions);
+        let indices = std::mem::take(&mut self.indices);
+        let g = normals::generate(positions, indices, cos_crease);
+        self.positions = g.positions;
+        self.indices = g.indices;
+        self.normals = Some(g.normals);
+    }
 }
 
 /// How to obtain shading normals a file does not have.
@@ -113,7 +132,7 @@ fn primitive(
         Some(indices) => indices.into_u32().collect(),
         None => (0..n as u32).collect(),
     };
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(format!(
             "{} indices is not a whole number of triangles",
             flat.len()
@@ -130,21 +149,18 @@ fn primitive(
         return Err("has no triangles".into());
     }
 
-    let (positions, indices, normals) = match normal_accessor {
+    let (normals, pending_normals) = match normal_accessor {
         Some(_) => {
             let normals: Vec<Vec3> = reader
                 .read_normals()
                 .ok_or("cannot read NORMAL")?
                 .map(Vec3::from)
                 .collect();
-            (positions, indices, Some(normals))
+            (Some(normals), None)
         }
         None => match missing_normals {
-            MissingNormals::Flat => (positions, indices, None),
-            MissingNormals::Generate { cos_crease } => {
-                let g = normals::generate(positions, indices, cos_crease);
-                (g.positions, g.indices, Some(g.normals))
-            }
+            MissingNormals::Flat => (None, None),
+            MissingNormals::Generate { cos_crease } => (None, Some(cos_crease)),
         },
     };
     Ok(Part {
@@ -152,6 +168,7 @@ fn primitive(
         indices,
         normals,
         material: primitive.material().index(),
+        pending_normals,
     })
 }
 

@@ -153,18 +153,18 @@ struct Resolved {
 pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<()> {
     let at = shape.file_location.clone();
     let err = |e: String| Error::at(&at, format!("{owner}: {e}"));
-    let asset = asm
+    let mut asset = asm
         .report
         .time(Phase::Parse, || buffers::load(&shape.path, &shape.label))
         .map_err(err)?;
     let uses = scene_graph::mesh_uses(&asset.document, shape.transform)
         .map_err(|e| err(format!("'{}': {e}", shape.label)))?;
 
-    let meshes: Vec<gltf::Mesh> = asset.document.meshes().collect();
     let missing_normals = shape.missing_normals;
-    let decoded: Vec<Option<Vec<Part>>> = asm
+    let mut decoded: Vec<Option<Vec<Part>>> = asm
         .report
         .time(Phase::Attributes, || {
+            let meshes: Vec<gltf::Mesh> = asset.document.meshes().collect();
             meshes
                 .par_iter()
                 .map(|m| {
@@ -177,6 +177,16 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 .collect::<std::result::Result<Vec<_>, String>>()
         })
         .map_err(err)?;
+    // The raw buffers are decoded: free them before generating normals and
+    // building BVHs, the two phases that need the most memory.
+    asset.buffers = Vec::new();
+    asm.report.time(Phase::Attributes, || {
+        decoded
+            .par_iter_mut()
+            .flatten()
+            .flat_map(|parts| parts.par_iter_mut())
+            .for_each(Part::generate_normals)
+    });
 
     let resolved = resolve_materials(owner, &shape, &asset, asm)?;
     let light_owner = format!("{owner} emission");
@@ -191,11 +201,17 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
             continue;
         }
         let world = worlds[0];
-        for part in parts {
+        for mut part in parts {
             let r = &resolved[&part.material];
             let triangles = part.indices.len();
-            let (positions, indices, normals) =
-                asm.report.time(Phase::Attributes, || bake(part, &world));
+            asm.report
+                .time(Phase::Attributes, || bake(&mut part, &world));
+            let Part {
+                positions,
+                indices,
+                normals,
+                ..
+            } = part;
             let lights = match &r.emission {
                 Some(table) => {
                     let tris = indices
@@ -311,28 +327,21 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
 /// Transforms a part into world space. A mirroring transform (negative
 /// determinant) reverses the winding, as the glTF spec says it does, so
 /// the front side stays where the asset meant it.
-fn bake(part: Part, world: &Mat4) -> (Vec<[f32; 3]>, Vec<[u32; 3]>, Option<Vec<Vec3>>) {
-    let Part {
-        mut positions,
-        mut indices,
-        mut normals,
-        ..
-    } = part;
+fn bake(part: &mut Part, world: &Mat4) {
     if *world == Mat4::IDENTITY {
-        return (positions, indices, normals);
+        return;
     }
-    positions
+    part.positions
         .par_iter_mut()
         .for_each(|p| *p = world.transform_point3(Vec3::from(*p)).into());
     let normal_matrix = Mat3::from_mat4(*world).inverse().transpose();
-    if let Some(ns) = &mut normals {
+    if let Some(ns) = &mut part.normals {
         ns.par_iter_mut()
             .for_each(|n| *n = (normal_matrix * *n).normalize_or_zero());
     }
     if world.determinant() < 0.0 {
-        indices.par_iter_mut().for_each(|t| t.swap(1, 2));
+        part.indices.par_iter_mut().for_each(|t| t.swap(1, 2));
     }
-    (positions, indices, normals)
 }
 
 /// One triangle light per non-degenerate triangle (world-space vertices,

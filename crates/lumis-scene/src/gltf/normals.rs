@@ -5,8 +5,10 @@
 //! face: smooth across gentle bends, sharp at creases (the "auto smooth" of
 //! DCC tools). A vertex whose corners end up with different normals is split,
 //! so the mesh keeps one normal per vertex and shading interpolates them as
-//! it does for normals read from a file. Face normals and corner normals are
-//! computed in parallel.
+//! it does for normals read from a file. The work is parallel over faces
+//! and vertices.
+
+use std::collections::HashMap;
 
 use lumis_core::Vec3;
 use rayon::prelude::*;
@@ -21,6 +23,13 @@ pub(crate) struct Generated {
 
 /// Generates normals with crease threshold `cos_crease` (the cosine of the
 /// crease angle: faces meeting at a larger angle are not smoothed together).
+///
+/// Works per vertex, in parallel, so that no per-corner array is needed:
+/// each vertex keeps the normal of its first incident corner, and only the
+/// corners whose normal differs (on creases; few on scanned surfaces) are
+/// listed and given a copy of the vertex afterwards. The temporary memory
+/// is the face normals and the vertex-to-face table, about 26 bytes per
+/// triangle.
 pub(crate) fn generate(
     positions: Vec<[f32; 3]>,
     indices: Vec<[u32; 3]>,
@@ -35,7 +44,6 @@ pub(crate) fn generate(
             (b - a).cross(c - a)
         })
         .collect();
-    let units: Vec<Vec3> = faces.par_iter().map(|f| f.normalize_or_zero()).collect();
 
     // Vertex -> incident faces, compressed rows.
     let mut start = vec![0u32; n_vertices + 1];
@@ -57,72 +65,65 @@ pub(crate) fn generate(
     }
     drop(fill);
 
-    let corner_normals: Vec<[Vec3; 3]> = indices
+    // The normal of face f's corner at a vertex whose faces are `around`.
+    let corner_normal = |f: u32, around: &[u32]| -> Vec3 {
+        let own = faces[f as usize].normalize_or_zero();
+        let sum: Vec3 = around
+            .iter()
+            .filter(|&&g| g == f || faces[g as usize].normalize_or_zero().dot(own) >= cos_crease)
+            .map(|&g| faces[g as usize])
+            .sum();
+        sum.normalize_or_zero()
+    };
+    let around = |v: usize| &incident[start[v] as usize..start[v + 1] as usize];
+    // Per vertex: its first corner's normal, and whether other corners differ.
+    let first: Vec<(Vec3, bool)> = (0..n_vertices)
+        .into_par_iter()
+        .map(|v| {
+            let faces_here = around(v);
+            let Some((&f0, rest)) = faces_here.split_first() else {
+                return (Vec3::ZERO, false);
+            };
+            let n0 = corner_normal(f0, faces_here);
+            let differs = rest.iter().any(|&f| corner_normal(f, faces_here) != n0);
+            (n0, differs)
+        })
+        .collect();
+    // The corners that differ: (face, corner, normal).
+    let exceptions: Vec<(u32, u8, Vec3)> = first
         .par_iter()
         .enumerate()
-        .map(|(f, t)| {
-            let own = units[f];
-            t.map(|v| {
-                let around = &incident[start[v as usize] as usize..start[v as usize + 1] as usize];
-                let sum: Vec3 = around
-                    .iter()
-                    .filter(|&&g| g as usize == f || units[g as usize].dot(own) >= cos_crease)
-                    .map(|&g| faces[g as usize])
-                    .sum();
-                sum.normalize_or_zero()
+        .filter(|(_, (_, differs))| *differs)
+        .flat_map_iter(|(v, (n0, _))| {
+            let faces_here = around(v);
+            let indices = &indices;
+            let corner_normal = &corner_normal;
+            faces_here.iter().filter_map(move |&f| {
+                let n = corner_normal(f, faces_here);
+                let k = indices[f as usize].iter().position(|&i| i as usize == v)?;
+                (n != *n0).then_some((f, k as u8, n))
             })
         })
         .collect();
     drop(faces);
-    drop(units);
     drop(incident);
+    drop(start);
 
-    // One normal per vertex: the first corner's normal keeps the vertex,
-    // each further distinct normal gets a copy of it.
+    let mut normals: Vec<Vec3> = first.into_iter().map(|(n, _)| n).collect();
     let mut positions = positions;
     let mut indices = indices;
-    let mut normals: Vec<Option<Vec3>> = vec![None; n_vertices];
-    // Copies made of vertex v so far, as (normal, new index), looked up
-    // linearly: few vertices sit on creases, and those have few normals.
-    let mut copies: Vec<Vec<(Vec3, u32)>> = Vec::new();
-    let mut copy_slot: Vec<u32> = Vec::new();
-    let mut extra_normals = Vec::new();
-    for (t, corners) in indices.iter_mut().zip(&corner_normals) {
-        for k in 0..3 {
-            let v = t[k] as usize;
-            let n = corners[k];
-            match normals[v] {
-                None => normals[v] = Some(n),
-                Some(existing) if existing == n => {}
-                Some(_) => {
-                    if copy_slot.is_empty() {
-                        copy_slot = vec![u32::MAX; n_vertices];
-                    }
-                    if copy_slot[v] == u32::MAX {
-                        copy_slot[v] = copies.len() as u32;
-                        copies.push(Vec::new());
-                    }
-                    let list = &mut copies[copy_slot[v] as usize];
-                    let index = match list.iter().find(|(m, _)| *m == n) {
-                        Some(&(_, i)) => i,
-                        None => {
-                            let i = positions.len() as u32;
-                            positions.push(positions[v]);
-                            extra_normals.push(n);
-                            list.push((n, i));
-                            i
-                        }
-                    };
-                    t[k] = index;
-                }
-            }
-        }
+    // One copy per (vertex, distinct normal).
+    let mut copies: HashMap<(u32, [u32; 3]), u32> = HashMap::new();
+    for (f, k, n) in exceptions {
+        let v = indices[f as usize][k as usize];
+        let key = (v, n.to_array().map(f32::to_bits));
+        let index = *copies.entry(key).or_insert_with(|| {
+            positions.push(positions[v as usize]);
+            normals.push(n);
+            positions.len() as u32 - 1
+        });
+        indices[f as usize][k as usize] = index;
     }
-    let mut normals: Vec<Vec3> = normals
-        .into_iter()
-        .map(|n| n.unwrap_or(Vec3::ZERO))
-        .collect();
-    normals.extend(extra_normals);
     Generated {
         positions,
         indices,
