@@ -750,3 +750,83 @@ fn accel_options_are_checked() {
         &["test.toml:", "quality", "\"low\", \"medium\", \"high\""],
     );
 }
+
+#[test]
+fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
+    let dir = test_dir("textures");
+    // 2x2 texels, rows from the top: red, green / blue, white (sRGB 255 and
+    // 0 are linear 1 and 0).
+    let png = gltf_writer::png_rgb8(
+        2,
+        2,
+        &[[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
+    );
+    let mut tri = Primitive::triangles(
+        vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        vec![0, 1, 2],
+    );
+    tri.material = Some(0);
+    tri.uvs = Some(vec![[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]]);
+    let asset = Asset {
+        materials: vec![Material {
+            base_color_texture: Some(0),
+            ..Material::diffuse("checker", [0.5, 0.8, 1.0])
+        }],
+        images: vec![png],
+        ..one_mesh(tri.clone(), vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "checker", &asset, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    assert!(
+        scene.scene.load_report().warnings.is_empty(),
+        "{:?}",
+        scene.scene.load_report().warnings
+    );
+    let approx = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-3);
+    for ((x, y), expected) in [
+        ((0.25, 0.25), [0.5, 0.0, 0.0]),
+        ((0.75, 0.25), [0.0, 0.8, 0.0]),
+        ((0.25, 0.75), [0.0, 0.0, 1.0]),
+        ((0.75, 0.75), [0.5, 0.8, 1.0]),
+        ((1.25, 0.25), [0.5, 0.0, 0.0]), // repeat
+    ] {
+        let got = reflectance_at_uv(&scene, x, y);
+        assert!(
+            approx(got, expected),
+            "at ({x}, {y}): {got:?} vs {expected:?}"
+        );
+    }
+
+    // A textured material on a primitive without uvs is refused.
+    tri.uvs = None;
+    let asset = Asset {
+        meshes: vec![Mesh {
+            name: "no-uvs".into(),
+            primitives: vec![tri],
+        }],
+        ..asset
+    };
+    let file = gltf_writer::write(&dir, "no-uvs", &asset, Container::Glb);
+    let err = try_load(&dir, &gltf_shape(&file, "")).err().unwrap();
+    assert_names(
+        &err,
+        &[
+            "no-uvs.glb",
+            "mesh \"no-uvs\" (#0) primitive #0",
+            "no TEXCOORD_0",
+        ],
+    );
+}
+
+/// The BSDF's reflectance at a hit, with the hit's own uv in the context.
+fn reflectance_at_uv(scene: &LoadedScene, x: f32, y: f32) -> [f32; 3] {
+    let ray = Ray::new(Vec3::new(x, y, 10.0), Vec3::NEG_Z);
+    let hit = scene.scene.intersect(&ray).expect("hit");
+    let ctx = BsdfContext {
+        uv: hit.uv,
+        ..BsdfContext::default()
+    };
+    let f = hit.bsdf.f(&ctx, Vec3::Z, Vec3::Z);
+    let pi = std::f32::consts::PI;
+    [f.r * pi, f.g * pi, f.b * pi]
+}

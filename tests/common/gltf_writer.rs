@@ -44,6 +44,8 @@ pub struct Material {
     pub roughness: f32,
     pub emissive: [f32; 3],
     pub double_sided: bool,
+    /// Index into [`Asset::images`] (one texture per image).
+    pub base_color_texture: Option<usize>,
 }
 
 impl Material {
@@ -55,6 +57,7 @@ impl Material {
             roughness: 1.0,
             emissive: [0.0; 3],
             double_sided: false,
+            base_color_texture: None,
         }
     }
 }
@@ -87,6 +90,8 @@ pub struct Asset {
     pub cameras: Vec<Camera>,
     /// Root nodes of the one scene.
     pub roots: Vec<usize>,
+    /// PNG files, stored in the buffer.
+    pub images: Vec<Vec<u8>>,
 }
 
 /// How the buffer is stored.
@@ -180,12 +185,31 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             prims.join(",")
         ));
     }
+    let mut images = Vec::new();
+    for png in &asset.images {
+        while !bin.len().is_multiple_of(4) {
+            bin.push(0);
+        }
+        views.push(format!(
+            "{{\"buffer\":0,\"byteOffset\":{},\"byteLength\":{}}}",
+            bin.len(),
+            png.len()
+        ));
+        bin.extend_from_slice(png);
+        images.push(format!(
+            "{{\"bufferView\":{},\"mimeType\":\"image/png\"}}",
+            views.len() - 1
+        ));
+    }
     let materials: Vec<String> = asset
         .materials
         .iter()
         .map(|m| {
+            let texture = m
+                .base_color_texture
+                .map_or(String::new(), |t| format!(",\"baseColorTexture\":{{\"index\":{t}}}"));
             format!(
-                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}}},\"emissiveFactor\":[{}],\"doubleSided\":{}}}",
+                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}}},\"emissiveFactor\":[{}],\"doubleSided\":{}}}",
                 m.name,
                 floats(&m.base_color),
                 m.metallic,
@@ -255,6 +279,18 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
     if !materials.is_empty() {
         write!(json, ",\"materials\":[{}]", materials.join(",")).unwrap();
     }
+    if !images.is_empty() {
+        let textures: Vec<String> = (0..images.len())
+            .map(|i| format!("{{\"source\":{i}}}"))
+            .collect();
+        write!(
+            json,
+            ",\"images\":[{}],\"textures\":[{}]",
+            images.join(","),
+            textures.join(",")
+        )
+        .unwrap();
+    }
     if !cameras.is_empty() {
         write!(json, ",\"cameras\":[{}]", cameras.join(",")).unwrap();
     }
@@ -306,4 +342,18 @@ pub fn write(dir: &Path, name: &str, asset: &Asset, container: Container) -> Str
             format!("{name}.glb")
         }
     }
+}
+
+/// A PNG of `width x height` RGB8 pixels, rows from the top.
+pub fn png_rgb8(width: u32, height: u32, pixels: &[[u8; 3]]) -> Vec<u8> {
+    let mut out = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        let flat: Vec<u8> = pixels.iter().flatten().copied().collect();
+        writer.write_image_data(&flat).unwrap();
+    }
+    out
 }

@@ -759,6 +759,7 @@ fn add_shape(owner: &str, desc: ShapeDesc, asm: &mut Assembly) -> Result<Geometr
                 vertices,
                 indices,
                 normals,
+                uvs: None,
                 bsdf,
                 lights: light_indices,
                 orientation,

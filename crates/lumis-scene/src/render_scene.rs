@@ -21,6 +21,9 @@ pub(crate) struct MeshData {
     /// Per-vertex shading normals; `None` means flat shading (and no
     /// interpolation cost).
     pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, stored only when the material reads
+    /// them; without them a hit's uv is its barycentric coordinates.
+    pub uvs: Option<Vec<Vec2>>,
     pub bsdf: u32,
     /// Light index per triangle (`NO_LIGHT` if none); empty when the
     /// mesh does not emit. Always empty in a [`Prototype`], whose lights
@@ -39,6 +42,10 @@ impl MeshData {
                 .normals
                 .as_ref()
                 .map_or(0, |n| n.capacity() * std::mem::size_of::<Vec3>())
+            + self
+                .uvs
+                .as_ref()
+                .map_or(0, |n| n.capacity() * std::mem::size_of::<Vec2>())
             + self.lights.capacity() * std::mem::size_of::<u32>()
     }
 }
@@ -194,7 +201,7 @@ impl RenderScene {
             unreachable!("inst_id names an instance geometry")
         };
         let mesh = &self.prototypes[*prototype as usize].meshes[hit.geom_id as usize];
-        let (local, ns) = mesh_hit(mesh, hit);
+        let (local, ns, uv) = mesh_hit(mesh, hit);
         let (p, p_error) = placement.point(local.p, local.p_error);
         let n = placement.normal(local.n);
         let ns = placement.normal(ns);
@@ -207,7 +214,7 @@ impl RenderScene {
             point: SurfacePoint { p, p_error, n },
             t: hit.t,
             shading: Frame::from_z(ns),
-            uv: Vec2::new(hit.u, hit.v),
+            uv,
             wo,
             bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
             light,
@@ -215,10 +222,10 @@ impl RenderScene {
     }
 }
 
-/// The hit point (recomputed from barycentrics, with its error bound) and
-/// the shading normal on a mesh, in the mesh's own space.
+/// The hit point (recomputed from barycentrics, with its error bound), the
+/// shading normal on a mesh, in the mesh's own space, and the uv.
 #[inline]
-fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3) {
+fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3, Vec2) {
     let tri = mesh.indices[hit.prim_id as usize];
     let vertices: &[Vertex] = &mesh.vertices;
     let [p0, p1, p2] = tri.map(|i| Vec3::from(vertices[i as usize]));
@@ -246,7 +253,14 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3) {
         }
         None => n,
     };
-    (SurfacePoint { p, p_error, n }, ns)
+    let uv = match &mesh.uvs {
+        Some(uvs) => {
+            let [t0, t1, t2] = tri.map(|i| uvs[i as usize]);
+            t0 * b0 + t1 * b1 + t2 * b2
+        }
+        None => Vec2::new(b1, b2),
+    };
+    (SurfacePoint { p, p_error, n }, ns, uv)
 }
 
 impl Scene for RenderScene {
@@ -263,7 +277,7 @@ impl Scene for RenderScene {
         }
         match &self.geometries[hit.geom_id as usize] {
             Geometry::Mesh(mesh) => {
-                let (point, ns) = mesh_hit(mesh, &hit);
+                let (point, ns, uv) = mesh_hit(mesh, &hit);
                 let light = mesh
                     .lights
                     .get(hit.prim_id as usize)
@@ -272,7 +286,7 @@ impl Scene for RenderScene {
                     point,
                     t: hit.t,
                     shading: Frame::from_z(ns),
-                    uv: Vec2::new(hit.u, hit.v),
+                    uv,
                     wo,
                     bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
                     light,

@@ -19,6 +19,8 @@ pub struct LoadReport {
     pub geometry_bytes: usize,
     /// Bytes Embree allocated for its BVHs (its device memory monitor).
     pub bvh_bytes: usize,
+    /// Bytes of decoded textures.
+    pub texture_bytes: usize,
     /// What the loader could not model and left out (e.g. textures), said
     /// once per asset and material.
     pub warnings: Vec<String>,
@@ -46,6 +48,12 @@ impl LoadReport {
             self.bvh_bytes as f64 * 1e-6,
             self.bvh_bytes as f64 / unique,
         )];
+        if self.texture_bytes > 0 {
+            lines[0].push_str(&format!(
+                " + {:.1} MB textures",
+                self.texture_bytes as f64 * 1e-6
+            ));
+        }
         lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
         lines
     }

@@ -72,7 +72,7 @@ pub(crate) fn load(path: &Path, label: &str) -> Result<Asset, String> {
 }
 
 /// A buffer's bytes from a `data:` URI or a file relative to the asset.
-fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+pub(crate) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
             .split_once(";base64,")

@@ -6,7 +6,7 @@
 
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
-use lumis_core::Vec3;
+use lumis_core::{Vec2, Vec3};
 
 use super::buffers::Asset;
 use super::normals;
@@ -17,6 +17,8 @@ pub(crate) struct Part {
     pub indices: Vec<[u32; 3]>,
     /// `None`: flat shading (no normals in the file and none generated).
     pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates, read only when the material has a texture.
+    pub uvs: Option<Vec<Vec2>>,
     /// `None`: the glTF default material.
     pub material: Option<usize>,
     /// Set when normals are missing and must be generated with this crease
@@ -33,10 +35,11 @@ impl Part {
         };
         let positions = std::mem::take(&mut self.positions);
         let indices = std::mem::take(&mut self.indices);
-        let g = normals::generate(positions, indices, cos_crease);
+        let g = normals::generate(positions, indices, self.uvs.take(), cos_crease);
         self.positions = g.positions;
         self.indices = g.indices;
         self.normals = Some(g.normals);
+        self.uvs = g.uvs;
     }
 }
 
@@ -57,15 +60,17 @@ pub(crate) fn mesh_label(mesh: &gltf::Mesh) -> String {
     }
 }
 
-/// Decodes every primitive of `mesh`.
+/// Decodes every primitive of `mesh`; `uv_set` says which TEXCOORD set a
+/// material's textures read (`None`: no texture, no uvs stored).
 pub(crate) fn mesh(
     asset: &Asset,
     mesh: &gltf::Mesh,
     missing_normals: MissingNormals,
+    uv_set: &(dyn Fn(Option<usize>) -> Option<u32> + Sync),
 ) -> Result<Vec<Part>, String> {
     mesh.primitives()
         .map(|p| {
-            primitive(asset, &p, missing_normals).map_err(|e| {
+            primitive(asset, &p, missing_normals, uv_set(p.material().index())).map_err(|e| {
                 format!(
                     "'{}': {} primitive #{}: {e}",
                     asset.label,
@@ -81,6 +86,7 @@ fn primitive(
     asset: &Asset,
     primitive: &gltf::Primitive,
     missing_normals: MissingNormals,
+    uv_set: Option<u32>,
 ) -> Result<Part, String> {
     if primitive.mode() != Mode::Triangles {
         return Err(format!(
@@ -119,7 +125,39 @@ fn primitive(
         )?;
     }
 
+    if let Some(set) = uv_set {
+        let a = primitive.get(&Semantic::TexCoords(set)).ok_or_else(|| {
+            format!(
+                "its material has a base colour texture but the primitive has no TEXCOORD_{set}"
+            )
+        })?;
+        check_accessor(
+            asset,
+            &a,
+            &format!("TEXCOORD_{set}"),
+            &[DataType::F32, DataType::U8, DataType::U16],
+            Dimensions::Vec2,
+        )?;
+        if a.count() != position_accessor.count() {
+            return Err(format!(
+                "TEXCOORD_{set} has {} entries for {} positions",
+                a.count(),
+                position_accessor.count()
+            ));
+        }
+    }
     let reader = primitive.reader(|b| Some(asset.buffer(b.index())));
+    let uvs = match uv_set {
+        Some(set) => Some(
+            reader
+                .read_tex_coords(set)
+                .ok_or_else(|| format!("cannot read TEXCOORD_{set}"))?
+                .into_f32()
+                .map(Vec2::from)
+                .collect::<Vec<_>>(),
+        ),
+        None => None,
+    };
     let positions: Vec<[f32; 3]> = reader
         .read_positions()
         .ok_or("cannot read POSITION")?
@@ -167,6 +205,7 @@ fn primitive(
         positions,
         indices,
         normals,
+        uvs,
         material: primitive.material().index(),
         pending_normals,
     })

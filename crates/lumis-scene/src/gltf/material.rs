@@ -10,7 +10,8 @@ use lumis_core::Rgb;
 /// A BSDF plugin table (`type = ...` and its parameters) for `material`,
 /// and what the mapping had to leave out.
 ///
-/// Today every material maps to `diffuse` with its base colour factor:
+/// Today every material maps to `diffuse` with its base colour factor (a
+/// base colour texture multiplies it; the caller wraps the BSDF):
 /// lumis has no conductor or rough dielectric yet, so `metallic` and
 /// `roughness` are not modelled (said in the warnings when they would
 /// matter). `doubleSided` maps to `two_sided`.
@@ -27,11 +28,6 @@ pub(crate) fn bsdf_table(
         ));
     }
     let mut warnings = Vec::new();
-    if pbr.base_color_texture().is_some() {
-        warnings.push(format!(
-            "material {label}: baseColorTexture ignored (textures are not supported yet); using baseColorFactor"
-        ));
-    }
     // The default material (no index) is metallic 1 by the spec's defaults
     // but means "untextured grey"; only declared materials are reported.
     let metallic = pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some();

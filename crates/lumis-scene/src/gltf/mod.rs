@@ -16,6 +16,7 @@ mod decode;
 mod material;
 mod normals;
 mod scene_graph;
+mod texture;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -147,6 +148,8 @@ pub(crate) fn parse(
 struct Resolved {
     bsdf: u32,
     emission: Option<Table>,
+    /// The TEXCOORD set the BSDF's texture reads, if it has one.
+    uv_set: Option<u32>,
 }
 
 /// Loads the asset and adds its meshes, instances and emissive triangles.
@@ -160,6 +163,8 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
     let uses = scene_graph::mesh_uses(&asset.document, shape.transform)
         .map_err(|e| err(format!("'{}': {e}", shape.label)))?;
 
+    let resolved = resolve_materials(owner, &shape, &asset, asm)?;
+    let uv_set = |material: Option<usize>| resolved.get(&material).and_then(|r| r.uv_set);
     let missing_normals = shape.missing_normals;
     let mut decoded: Vec<Option<Vec<Part>>> = asm
         .report
@@ -171,7 +176,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                     if uses[m.index()].is_empty() {
                         Ok(None)
                     } else {
-                        decode::mesh(&asset, m, missing_normals).map(Some)
+                        decode::mesh(&asset, m, missing_normals, &uv_set).map(Some)
                     }
                 })
                 .collect::<std::result::Result<Vec<_>, String>>()
@@ -188,7 +193,6 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
             .for_each(Part::generate_normals)
     });
 
-    let resolved = resolve_materials(owner, &shape, &asset, asm)?;
     let light_owner = format!("{owner} emission");
 
     // Meshes used once: into world space, into the top-level BVH.
@@ -210,6 +214,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 positions,
                 indices,
                 normals,
+                uvs,
                 ..
             } = part;
             let lights = match &r.emission {
@@ -225,6 +230,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 vertices: Arc::new(PaddedBuffer::new(positions)),
                 indices: Arc::new(PaddedBuffer::new(indices)),
                 normals,
+                uvs,
                 bsdf: r.bsdf,
                 lights,
                 orientation: 1.0,
@@ -253,6 +259,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 vertices: Arc::new(PaddedBuffer::new(part.positions)),
                 indices: Arc::new(PaddedBuffer::new(part.indices)),
                 normals: part.normals,
+                uvs: part.uvs,
                 bsdf: r.bsdf,
                 lights: Vec::new(),
                 orientation: 1.0,
@@ -482,6 +489,7 @@ fn resolve_materials(
                 .find(|(m, _, _)| Some(m.as_str()) == material.name())
                 .map(|(_, b, l)| (b.clone(), l.clone())),
         };
+        let mut uv_set = None;
         let bsdf = match override_ {
             Some((name, location)) => named(&name, &location, asm)?,
             None => {
@@ -500,7 +508,7 @@ fn resolve_materials(
                 else {
                     unreachable!("bsdf_table writes a type")
                 };
-                let bsdf = asm.registry.create_bsdf(&TableRef {
+                let mut bsdf = asm.registry.create_bsdf(&TableRef {
                     owner: &format!("{owner} material {label}"),
                     table: &table,
                     location: at,
@@ -508,6 +516,22 @@ fn resolve_materials(
                     type_location: at,
                     structural: &["type"],
                 })?;
+                if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
+                    match load_texture(asset, &info.texture(), &shape.path) {
+                        Ok(t) => {
+                            asm.report.texture_bytes += t.byte_size();
+                            bsdf = Arc::new(texture::AlbedoTextured {
+                                inner: bsdf,
+                                texture: Arc::new(t),
+                            });
+                            uv_set = Some(info.tex_coord());
+                        }
+                        Err(why) => asm.report.warnings.push(format!(
+                            "'{}': material {label}: baseColorTexture ignored ({why}); using baseColorFactor",
+                            shape.label
+                        )),
+                    }
+                }
                 asm.bsdfs.push((format!("{}#{label}", shape.label), bsdf));
                 asm.bsdfs.len() as u32 - 1
             }
@@ -526,7 +550,50 @@ fn resolve_materials(
             )?),
             None => None,
         };
-        out.insert(index, Resolved { bsdf, emission });
+        out.insert(
+            index,
+            Resolved {
+                bsdf,
+                emission,
+                uv_set,
+            },
+        );
     }
     Ok(out)
+}
+
+/// Decodes a texture's image: PNG from a buffer view, a file or a data URI.
+fn load_texture(
+    asset: &buffers::Asset,
+    texture: &gltf::Texture,
+    asset_path: &Path,
+) -> std::result::Result<texture::Texture, String> {
+    let image = texture.source();
+    let (bytes, mime): (Vec<u8>, Option<&str>) = match image.source() {
+        gltf::image::Source::View { view, mime_type } => {
+            let data = asset.buffer(view.buffer().index());
+            let end = view.offset() + view.length();
+            let bytes = data.get(view.offset()..end).ok_or_else(|| {
+                format!(
+                    "image #{} lies past the end of buffer #{} (truncated?)",
+                    image.index(),
+                    view.buffer().index()
+                )
+            })?;
+            (bytes.to_vec(), Some(mime_type))
+        }
+        gltf::image::Source::Uri { uri, mime_type } => {
+            let dir = asset_path.parent().unwrap_or(Path::new("."));
+            (buffers::read_uri(uri, dir)?, mime_type)
+        }
+    };
+    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
+    if !bytes.starts_with(PNG_MAGIC) {
+        return Err(format!(
+            "image #{} is {}, only PNG is supported so far",
+            image.index(),
+            mime.unwrap_or("not a PNG")
+        ));
+    }
+    texture::Texture::from_png(&bytes).map_err(|e| format!("image #{}: {e}", image.index()))
 }

@@ -10,7 +10,7 @@
 
 use std::collections::HashMap;
 
-use lumis_core::Vec3;
+use lumis_core::{Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Positions, indices and per-vertex normals after generation; vertices on
@@ -19,6 +19,8 @@ pub(crate) struct Generated {
     pub positions: Vec<[f32; 3]>,
     pub indices: Vec<[u32; 3]>,
     pub normals: Vec<Vec3>,
+    /// The texture coordinates given, extended like the positions.
+    pub uvs: Option<Vec<Vec2>>,
 }
 
 /// Generates normals with crease threshold `cos_crease` (the cosine of the
@@ -33,6 +35,7 @@ pub(crate) struct Generated {
 pub(crate) fn generate(
     positions: Vec<[f32; 3]>,
     indices: Vec<[u32; 3]>,
+    mut uvs: Option<Vec<Vec2>>,
     cos_crease: f32,
 ) -> Generated {
     let n_vertices = positions.len();
@@ -119,6 +122,9 @@ pub(crate) fn generate(
         let key = (v, n.to_array().map(f32::to_bits));
         let index = *copies.entry(key).or_insert_with(|| {
             positions.push(positions[v as usize]);
+            if let Some(uvs) = &mut uvs {
+                uvs.push(uvs[v as usize]);
+            }
             normals.push(n);
             positions.len() as u32 - 1
         });
@@ -128,6 +134,7 @@ pub(crate) fn generate(
         positions,
         indices,
         normals,
+        uvs,
     }
 }
 
@@ -150,7 +157,7 @@ mod tests {
     #[test]
     fn gentle_bend_is_smoothed_without_splitting() {
         let (p, i) = hinge(10.0);
-        let g = generate(p, i, 30f32.to_radians().cos());
+        let g = generate(p, i, None, 30f32.to_radians().cos());
         assert_eq!(g.positions.len(), 4);
         // The shared edge's vertices average both faces.
         let n0 = g.normals[0];
@@ -162,7 +169,7 @@ mod tests {
     #[test]
     fn crease_splits_shared_vertices() {
         let (p, i) = hinge(90.0);
-        let g = generate(p, i, 30f32.to_radians().cos());
+        let g = generate(p, i, None, 30f32.to_radians().cos());
         // Vertices 0 and 1 are shared by faces 90 degrees apart: one copy each.
         assert_eq!(g.positions.len(), 6);
         for (t, face) in g.indices.iter().zip([Vec3::Z, Vec3::Y]) {

@@ -1,0 +1,162 @@
+//! Base colour textures: PNG images of a glTF asset, looked up at the
+//! interpolated texture coordinate of a hit (`BsdfContext::uv`).
+//!
+//! Texels stay 8-bit sRGB in memory (3 bytes each) and are converted to
+//! linear through a 256-entry table on lookup; filtering is bilinear with
+//! repeat wrapping, whatever the asset's sampler says (said in the README).
+
+use std::sync::Arc;
+
+use lumis_core::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, Rgb, Vec2, Vec3};
+
+/// An sRGB image with bilinear, repeating lookups.
+pub(crate) struct Texture {
+    width: usize,
+    height: usize,
+    texels: Vec<[u8; 3]>,
+    to_linear: [f32; 256],
+}
+
+fn srgb_to_linear(v: f32) -> f32 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+impl Texture {
+    /// Decodes a PNG (any bit depth and colour type; alpha is dropped).
+    pub fn from_png(bytes: &[u8]) -> Result<Self, String> {
+        let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        decoder.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let mut reader = decoder.read_info().map_err(|e| format!("bad PNG: {e}"))?;
+        let size = reader
+            .output_buffer_size()
+            .ok_or("PNG too large to decode")?;
+        let mut buf = vec![0u8; size];
+        let info = reader
+            .next_frame(&mut buf)
+            .map_err(|e| format!("bad PNG: {e}"))?;
+        let (width, height) = (info.width as usize, info.height as usize);
+        let channels = match info.color_type {
+            png::ColorType::Grayscale => 1,
+            png::ColorType::GrayscaleAlpha => 2,
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            png::ColorType::Indexed => return Err("indexed PNG was not expanded".into()),
+        };
+        let mut texels = Vec::with_capacity(width * height);
+        for row in buf.chunks_exact(info.line_size).take(height) {
+            for px in row.chunks_exact(channels).take(width) {
+                texels.push(if channels < 3 {
+                    [px[0]; 3]
+                } else {
+                    [px[0], px[1], px[2]]
+                });
+            }
+        }
+        if width == 0 || height == 0 || texels.len() != width * height {
+            return Err(format!("PNG of {width}x{height} pixels could not be read"));
+        }
+        Ok(Self {
+            width,
+            height,
+            texels,
+            to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
+        })
+    }
+
+    fn texel(&self, x: i64, y: i64) -> Rgb {
+        let x = x.rem_euclid(self.width as i64) as usize;
+        let y = y.rem_euclid(self.height as i64) as usize;
+        let [r, g, b] = self.texels[y * self.width + x];
+        Rgb::new(
+            self.to_linear[r as usize],
+            self.to_linear[g as usize],
+            self.to_linear[b as usize],
+        )
+    }
+
+    /// Linear RGB at `uv` (glTF convention: (0, 0) is the image's top-left
+    /// corner), bilinear between texel centres, repeating.
+    pub fn lookup(&self, uv: Vec2) -> Rgb {
+        if !uv.is_finite() {
+            return self.texel(0, 0);
+        }
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        (1.0 - fy) * ((1.0 - fx) * self.texel(x0, y0) + fx * self.texel(x0 + 1, y0))
+            + fy * ((1.0 - fx) * self.texel(x0, y0 + 1) + fx * self.texel(x0 + 1, y0 + 1))
+    }
+
+    pub fn byte_size(&self) -> usize {
+        self.texels.capacity() * 3
+    }
+}
+
+/// A BSDF whose albedo is multiplied by a texture at the hit's uv.
+///
+/// Exact for BSDFs whose value is linear in their albedo and whose sampling
+/// does not depend on it, as `diffuse`: the texture then scales `f` and
+/// leaves `pdf` and the sampled directions alone. The conductor/plastic
+/// mapping to come will need its own treatment of textures.
+pub(crate) struct AlbedoTextured {
+    pub inner: Arc<dyn Bsdf>,
+    pub texture: Arc<Texture>,
+}
+
+impl Bsdf for AlbedoTextured {
+    fn flags(&self) -> BsdfFlags {
+        self.inner.flags()
+    }
+
+    #[inline]
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        self.texture.lookup(ctx.uv) * self.inner.f(ctx, wo, wi)
+    }
+
+    #[inline]
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let mut s = self.inner.sample_f(ctx, wo, u1, u2)?;
+        s.f = self.texture.lookup(ctx.uv) * s.f;
+        Some(s)
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        self.inner.pdf(ctx, wo, wi)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn checker() -> Texture {
+        Texture {
+            width: 2,
+            height: 2,
+            texels: vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
+            to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
+        }
+    }
+
+    #[test]
+    fn texel_centres_and_wrapping() {
+        let t = checker();
+        assert_eq!(t.lookup(Vec2::new(0.25, 0.25)), Rgb::new(1.0, 0.0, 0.0));
+        assert_eq!(t.lookup(Vec2::new(0.75, 0.25)), Rgb::new(0.0, 1.0, 0.0));
+        assert_eq!(t.lookup(Vec2::new(0.25, 0.75)), Rgb::new(0.0, 0.0, 1.0));
+        assert_eq!(t.lookup(Vec2::new(1.75, -0.25)), Rgb::new(1.0, 1.0, 1.0));
+        // Halfway between red and green.
+        let mid = t.lookup(Vec2::new(0.5, 0.25));
+        assert!(
+            (mid.r - 0.5).abs() < 1e-6 && (mid.g - 0.5).abs() < 1e-6,
+            "{mid:?}"
+        );
+    }
+}
