@@ -89,7 +89,7 @@ fn displaced_sphere(levels: u32) -> (Vec<[f32; 3]>, Vec<u32>) {
         .map(|p| {
             let d = 0.08 * (7.0 * p.x).sin() * (9.0 * p.y).sin() * (8.0 * p.z).sin()
                 + 0.02 * (41.0 * p.x + 3.0 * p.y).sin() * (37.0 * p.z).cos()
-                + 0.005 * (173.0 * p.y).sin() * (191.0 * p.x + p.z).cos();
+                + 0.001 * (173.0 * p.y).sin() * (191.0 * p.x + p.z).cos();
             (*p * (1.0 + d)).to_array()
         })
         .collect();
@@ -387,7 +387,7 @@ fn main() {
         &dir,
         "instanced-10m",
         &asset,
-        (Vec3::new(0.0, -6.0, 16.0), Vec3::ZERO),
+        (Vec3::new(1.25, -6.0, 16.0), Vec3::new(1.25, 1.25, 0.0)),
         &accel,
     );
     let (bare_s, bare_b) = bare_build(&positions, &indices, &transforms, options);

@@ -158,10 +158,10 @@ fn primitive(
         ),
         None => None,
     };
-    let positions: Vec<[f32; 3]> = reader
-        .read_positions()
-        .ok_or("cannot read POSITION")?
-        .collect();
+    // Capacities are exact, plus the one spare element PaddedBuffer adds,
+    // so no vector is reallocated or over-allocated on the way to Embree.
+    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(position_accessor.count() + 1);
+    positions.extend(reader.read_positions().ok_or("cannot read POSITION")?);
     if positions.iter().flatten().any(|c| !c.is_finite()) {
         return Err("POSITION holds a NaN or infinite coordinate".into());
     }
@@ -189,11 +189,13 @@ fn primitive(
 
     let (normals, pending_normals) = match normal_accessor {
         Some(_) => {
-            let normals: Vec<Vec3> = reader
-                .read_normals()
-                .ok_or("cannot read NORMAL")?
-                .map(Vec3::from)
-                .collect();
+            let mut normals: Vec<Vec3> = Vec::with_capacity(n);
+            normals.extend(
+                reader
+                    .read_normals()
+                    .ok_or("cannot read NORMAL")?
+                    .map(Vec3::from),
+            );
             (Some(normals), None)
         }
         None => match missing_normals {

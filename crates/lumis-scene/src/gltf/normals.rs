@@ -112,7 +112,9 @@ pub(crate) fn generate(
     drop(incident);
     drop(start);
 
-    let mut normals: Vec<Vec3> = first.into_iter().map(|(n, _)| n).collect();
+    let mut normals: Vec<Vec3> = Vec::with_capacity(n_vertices);
+    normals.extend(first.iter().map(|(n, _)| *n));
+    drop(first);
     let mut positions = positions;
     let mut indices = indices;
     // One copy per (vertex, distinct normal).
@@ -129,6 +131,16 @@ pub(crate) fn generate(
             positions.len() as u32 - 1
         });
         indices[f as usize][k as usize] = index;
+    }
+    if !copies.is_empty() {
+        // Growing by copies doubled the capacities; give the rest back
+        // (keeping the spare element PaddedBuffer adds).
+        positions.reserve_exact(1);
+        positions.shrink_to(positions.len() + 1);
+        normals.shrink_to_fit();
+        if let Some(uvs) = &mut uvs {
+            uvs.shrink_to_fit();
+        }
     }
     Generated {
         positions,
