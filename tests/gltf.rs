@@ -830,3 +830,38 @@ fn reflectance_at_uv(scene: &LoadedScene, x: f32, y: f32) -> [f32; 3] {
     let pi = std::f32::consts::PI;
     [f.r * pi, f.g * pi, f.b * pi]
 }
+
+#[test]
+fn what_is_not_modelled_is_reported() {
+    let dir = test_dir("warnings");
+    let mut tri = triangle();
+    tri.material = Some(0);
+    let asset = Asset {
+        materials: vec![Material {
+            metallic: 1.0,
+            roughness: 0.2,
+            ..Material::diffuse("gold", [1.0, 0.8, 0.3])
+        }],
+        ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "gold", &asset, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    let report = scene.scene.load_report();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("gold.glb") && w.contains("\"gold\"") && w.contains("metallic 1")),
+        "{:?}",
+        report.warnings
+    );
+    // The start-up report shows them.
+    let lines = report.lines(scene.scene.counts());
+    assert!(lines[0].starts_with("loaded 1 triangles"), "{}", lines[0]);
+    assert!(lines
+        .iter()
+        .any(|l| l.starts_with("warning:") && l.contains("gold")));
+    // Overridden, the material's BSDF is not used: no warning.
+    let scene = load(&dir, &gltf_shape(&file, "bsdf = \"white\""));
+    assert!(scene.scene.load_report().warnings.is_empty());
+}

@@ -163,6 +163,11 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
     let uses = scene_graph::mesh_uses(&asset.document, shape.transform)
         .map_err(|e| err(format!("'{}': {e}", shape.label)))?;
 
+    asm.report.warnings.extend(
+        unmodelled_features(&asset.document)
+            .into_iter()
+            .map(|w| format!("'{}': {w}", shape.label)),
+    );
     let resolved = resolve_materials(owner, &shape, &asset, asm)?;
     let uv_set = |material: Option<usize>| resolved.get(&material).and_then(|r| r.uv_set);
     let missing_normals = shape.missing_normals;
@@ -560,6 +565,36 @@ fn resolve_materials(
         );
     }
     Ok(out)
+}
+
+/// What the asset uses that lumis does not model, so a render that looks
+/// different from another viewer says why instead of differing silently.
+fn unmodelled_features(document: &gltf::Document) -> Vec<String> {
+    let mut out = Vec::new();
+    let skins = document.nodes().filter(|n| n.skin().is_some()).count();
+    if skins > 0 {
+        out.push(format!(
+            "{skins} skinned nodes rendered in their bind pose (skins are not modelled)"
+        ));
+    }
+    let primitives = || {
+        document
+            .meshes()
+            .flat_map(|m| m.primitives().collect::<Vec<_>>())
+    };
+    if primitives().any(|p| p.morph_targets().next().is_some()) {
+        out.push("morph targets ignored (the base shape is rendered)".into());
+    }
+    if primitives().any(|p| p.get(&gltf::Semantic::Colors(0)).is_some()) {
+        out.push("vertex colours (COLOR_0) ignored".into());
+    }
+    const MODELLED: &[&str] = &["KHR_materials_emissive_strength"];
+    for ext in document.extensions_used() {
+        if !MODELLED.contains(&ext) {
+            out.push(format!("extension {ext} ignored"));
+        }
+    }
+    out
 }
 
 /// Decodes a texture's image: PNG from a buffer view, a file or a data URI.
