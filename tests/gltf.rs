@@ -865,3 +865,77 @@ fn what_is_not_modelled_is_reported() {
     let scene = load(&dir, &gltf_shape(&file, "bsdf = \"white\""));
     assert!(scene.scene.load_report().warnings.is_empty());
 }
+
+#[test]
+fn emissive_instances_get_their_own_world_space_lights() {
+    let dir = test_dir("emissive-instances");
+    let mut panel = Primitive::triangles(
+        vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ],
+        vec![0, 1, 2, 0, 2, 3],
+    );
+    panel.material = Some(0);
+    let at = |x: f32| Node {
+        translation: Some([x, 0.0, 0.0]),
+        ..mesh_node(0)
+    };
+    let asset = Asset {
+        materials: vec![Material {
+            emissive: [0.5, 0.5, 0.5],
+            ..Material::diffuse("lamp", [0.2, 0.2, 0.2])
+        }],
+        ..one_mesh(panel, vec![at(0.0), at(4.0)], vec![0, 1])
+    };
+    let file = gltf_writer::write(&dir, "panels", &asset, Container::External);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    let c = scene.scene.counts();
+    assert_eq!((c.instances, c.area_lights), (2, 4), "{c:?}");
+    let mut seen = Vec::new();
+    for x in [0.5, 4.5] {
+        let hit = scene
+            .scene
+            .intersect(&Ray::new(Vec3::new(x, 0.25, 10.0), Vec3::NEG_Z))
+            .expect("panel");
+        let light = hit.light.expect("the panel emits");
+        // The light is the triangle of this instance, in world space: its
+        // radiance is seen from the front, at this point.
+        let le = light.light.l(hit.p(), hit.n(), hit.uv, hit.wo);
+        assert!((le.r - 0.5).abs() < 1e-6, "{le:?}");
+        // Sampled points of the light lie on this instance.
+        let ctx = lumis_core::LightSampleContext::at(Vec3::new(x, 0.5, 1.0));
+        for u in [(0.1, 0.2), (0.7, 0.4), (0.95, 0.95)] {
+            let s = light
+                .light
+                .sample_li(&ctx, lumis_core::Vec2::new(u.0, u.1))
+                .expect("the light faces the point");
+            let p = s.p.p;
+            assert!(
+                p.x >= x - 0.5 - 1e-5 && p.x <= x + 0.5 + 1e-5 && p.z.abs() < 1e-5,
+                "{p}"
+            );
+        }
+        seen.push(light.index);
+    }
+    assert_ne!(seen[0], seen[1], "each instance has its own lights");
+}
+
+#[test]
+fn the_example_scene_loads() {
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let scene = lumis_scene::load_file(
+        &lumis_tests::scenes_dir().join("gltf-boxes.toml"),
+        &[],
+        &registry,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let c = scene.scene.counts();
+    assert_eq!(
+        (c.instances, c.prototypes, c.area_lights),
+        (3, 1, 2),
+        "{c:?}"
+    );
+}

@@ -107,11 +107,12 @@ fn describe(loaded: &LoadedScene) -> String {
     let c = loaded.scene.counts();
     let lights = c.area_lights + c.delta_lights + c.infinite_lights;
     format!(
-        "scene '{}': {} meshes ({} triangles), {} spheres; {} lights ({} area, {} delta, {} infinite); \
+        "scene '{}': {} meshes ({} triangles, {} instances), {} spheres; {} lights ({} area, {} delta, {} infinite); \
          shading normals: {}; MIS: {}",
         loaded.name,
         c.meshes,
         c.triangles,
+        c.instances,
         c.spheres,
         lights,
         c.area_lights,
