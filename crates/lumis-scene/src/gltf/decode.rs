@@ -230,9 +230,28 @@ fn check_accessor(
             accessor.data_type()
         ));
     }
+    // lumis indexes vertices with u32; larger counts are also what a
+    // corrupt count would look like, refused before anything is allocated.
+    if accessor.count() > u32::MAX as usize {
+        return Err(format!(
+            "{name} has {} elements, more than lumis indexes (2^32 - 1)",
+            accessor.count()
+        ));
+    }
     let Some(view) = accessor.view() else {
-        // Sparse-only accessors have no view; the reader fills them in.
-        return Ok(());
+        // Sparse-only accessors have no view; the reader fills them in from
+        // the sparse values, so their count must be backed by those.
+        return match accessor.sparse() {
+            Some(sparse) if accessor.count() <= sparse.count() * 64 + (1 << 20) => Ok(()),
+            Some(_) => Err(format!(
+                "{name} has no buffer view and {} elements for {} sparse values",
+                accessor.count(),
+                accessor.sparse().map_or(0, |s| s.count())
+            )),
+            None => Err(format!(
+                "{name} has neither a buffer view nor sparse values"
+            )),
+        };
     };
     let buffer = view.buffer();
     let data_len = asset.buffer(buffer.index()).len();
