@@ -939,3 +939,112 @@ fn the_example_scene_loads() {
         "{c:?}"
     );
 }
+
+/// A bumpy 8x8 heightfield over [0, 1]^2 (front +z), without normals.
+fn bumps() -> Primitive {
+    let n = 8;
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+            let z = 0.15 * (6.0 * x).sin() * (5.0 * y).cos();
+            positions.push([x, y, z]);
+        }
+    }
+    let mut indices = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let a = (j * (n + 1) + i) as u32;
+            let (b, c, d) = (a + 1, a + n as u32 + 2, a + n as u32 + 1);
+            indices.extend([a, b, c, a, c, d]);
+        }
+    }
+    Primitive::triangles(positions, indices)
+}
+
+#[test]
+fn instanced_and_baked_meshes_render_alike() {
+    let dir = test_dir("instanced-vs-baked");
+    let placed = [
+        Node {
+            translation: Some([-1.1, -0.5, 0.0]),
+            rotation: Some([0.0, 0.0, 0.258819, 0.9659258]), // 30 degrees about z
+            scale: Some([1.0, 1.2, 0.8]),
+            ..mesh_node(0)
+        },
+        Node {
+            translation: Some([1.1, -0.5, 0.0]),
+            scale: Some([-1.0, 1.0, 1.0]), // mirrored
+            ..mesh_node(0)
+        },
+    ];
+    let instanced = gltf_writer::write(
+        &dir,
+        "both",
+        &one_mesh(bumps(), placed.to_vec(), vec![0, 1]),
+        Container::Glb,
+    );
+    let first = gltf_writer::write(
+        &dir,
+        "first",
+        &one_mesh(bumps(), vec![placed[0].clone()], vec![0]),
+        Container::Glb,
+    );
+    let second = gltf_writer::write(
+        &dir,
+        "second",
+        &one_mesh(bumps(), vec![placed[1].clone()], vec![0]),
+        Container::Glb,
+    );
+    let scene = |shapes: &str| {
+        format!(
+            "seed = 5\n[film]\nresolution = [48, 32]\n[camera]\ntype = \"perspective\"\norigin = [0.0, -1.5, 3.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 45.0\n\
+             [sampler]\ntype = \"independent\"\nspp = 32\n[integrator]\ntype = \"path\"\nmax_depth = 4\n\
+             [[bsdf]]\nname = \"white\"\ntype = \"diffuse\"\nreflectance = 0.7\n\
+             [[shape]]\ntype = \"quad\"\ncorner = [-2.0, -2.0, 2.0]\nedge_u = [0.0, 4.0, 0.0]\nedge_v = [4.0, 0.0, 0.0]\nbsdf = \"white\"\nemission = {{ radiance = [2.0, 2.0, 2.0] }}\n\
+             [[shape]]\ntype = \"quad\"\ncorner = [-3.0, -3.0, -0.3]\nedge_u = [6.0, 0.0, 0.0]\nedge_v = [0.0, 6.0, 0.0]\nbsdf = \"white\"\n{shapes}"
+        )
+    };
+    let a = load(
+        &dir,
+        &scene(&format!(
+            "[[shape]]\ntype = \"gltf\"\nfile = \"{instanced}\"\nbsdf = \"white\"\n"
+        )),
+    );
+    assert_eq!(a.scene.counts().instances, 2);
+    let b = load(
+        &dir,
+        &scene(&format!(
+            "[[shape]]\ntype = \"gltf\"\nfile = \"{first}\"\nbsdf = \"white\"\n[[shape]]\ntype = \"gltf\"\nfile = \"{second}\"\nbsdf = \"white\"\n"
+        )),
+    );
+    assert_eq!(b.scene.counts().instances, 0);
+    let render_one = |s: &LoadedScene| {
+        render(
+            &s.camera,
+            &s.scene,
+            s.integrator.as_ref(),
+            s.sampler.as_ref(),
+            &RenderSettings {
+                spp: s.sampler.samples_per_pixel(),
+                seed: s.seed,
+                threads: 2,
+                progress: false,
+            },
+        )
+        .unwrap()
+        .image
+    };
+    let (ia, ib) = (render_one(&a), render_one(&b));
+    let blocks = (48 / 8) * (32 / 8) * 3;
+    let z = lumis_tests::bonferroni_z(0.01, blocks);
+    lumis_tests::assert_same_mean(&ia, &ib, 8, z, "instanced vs baked");
+    // The meshes are in the picture: the images are not just the floor.
+    let differs_from_floor = ia
+        .pixels
+        .iter()
+        .zip(&ib.pixels)
+        .filter(|(p, q)| p == q)
+        .count();
+    assert!(differs_from_floor > 0);
+}
