@@ -32,12 +32,16 @@ fn walk(
 }
 
 /// For each mesh of the document, the world transforms of the nodes that
-/// use it (empty for meshes no node of the scene uses).
+/// use it (empty for meshes no node of the scene uses). Nodes scaled to
+/// nothing (a common way to hide an object in glTF) place no geometry.
 pub(crate) fn mesh_uses(document: &gltf::Document, base: Mat4) -> Result<Vec<Vec<Mat4>>, String> {
     let mut uses = vec![Vec::new(); document.meshes().len()];
     walk(document, base, |node, world| {
         if let Some(mesh) = node.mesh() {
-            uses[mesh.index()].push(world);
+            let det = world.determinant();
+            if det != 0.0 && det.is_finite() {
+                uses[mesh.index()].push(world);
+            }
         }
     })?;
     Ok(uses)
