@@ -15,14 +15,15 @@ pub(crate) mod camera;
 mod decode;
 mod material;
 mod normals;
+mod resolve;
 mod scene_graph;
 mod texture;
+mod unmodelled;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use lumis_core::doc::{self, Node, Table, Value};
+use lumis_core::doc::{Table, Value};
 use lumis_core::glam::{Mat3, Mat4};
 use lumis_core::registry::TableRef;
 use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Result, Vec3};
@@ -141,17 +142,6 @@ pub(crate) fn parse(
         missing_normals,
     })
 }
-
-/// What a glTF material became: a BSDF of the scene and, if it emits, the
-/// light table its triangles share.
-#[derive(Clone)]
-struct Resolved {
-    bsdf: u32,
-    emission: Option<Table>,
-    /// The TEXCOORD set the BSDF's texture reads, if it has one.
-    uv_set: Option<u32>,
-}
-
 /// Loads the asset and adds its meshes, instances and emissive triangles.
 pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<()> {
     let at = shape.file_location.clone();
@@ -164,11 +154,11 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
         .map_err(|e| err(format!("'{}': {e}", shape.label)))?;
 
     asm.report.warnings.extend(
-        unmodelled_features(&asset.document)
+        unmodelled::unmodelled_features(&asset.document)
             .into_iter()
             .map(|w| format!("'{}': {w}", shape.label)),
     );
-    let resolved = resolve_materials(owner, &shape, &asset, asm)?;
+    let resolved = resolve::resolve_materials(owner, &shape, &asset, asm)?;
     let uv_set = |material: Option<usize>| resolved.get(&material).and_then(|r| r.uv_set);
     let missing_normals = shape.missing_normals;
     let mut decoded: Vec<Option<Vec<Part>>> = asm
@@ -421,214 +411,4 @@ fn instance_lights(
         out.push(triangle_lights(tris, table, owner, at, asm)?);
     }
     Ok(out)
-}
-
-/// Maps every material the asset's primitives use (and the default
-/// material) to a BSDF of the scene, honouring `bsdf` and `bsdf_overrides`.
-fn resolve_materials(
-    owner: &str,
-    shape: &GltfShape,
-    asset: &buffers::Asset,
-    asm: &mut Assembly,
-) -> Result<HashMap<Option<usize>, Resolved>> {
-    let at = &shape.file_location;
-    let err = |e: String| Error::at(at, format!("{owner}: '{}': {e}", shape.label));
-    let document = &asset.document;
-    for (name, _, location) in &shape.overrides {
-        if !document
-            .materials()
-            .any(|m| m.name() == Some(name.as_str()))
-        {
-            let names: Vec<String> = document
-                .materials()
-                .filter_map(|m| m.name().map(|n| format!("\"{n}\"")))
-                .collect();
-            return Err(Error::at(
-                location,
-                format!(
-                    "{owner} bsdf_overrides: '{}' has no material named \"{name}\"; named materials: {}",
-                    shape.label,
-                    if names.is_empty() { "none".into() } else { names.join(", ") }
-                ),
-            ));
-        }
-    }
-    let named = |name: &str, location: &Location, asm: &Assembly| -> Result<u32> {
-        asm.bsdfs
-            .iter()
-            .position(|(n, _)| n == name)
-            .map(|i| i as u32)
-            .ok_or_else(|| Error::at(location, format!("{owner}: no [[bsdf]] named \"{name}\"")))
-    };
-    let mut out = HashMap::new();
-    let materials = std::iter::once(None).chain(document.materials().map(|m| m.index()));
-    for index in materials {
-        let material = match index {
-            Some(i) => document
-                .materials()
-                .nth(i)
-                .expect("index from the document"),
-            None => {
-                // The default material, used by primitives without one.
-                let Some(m) = document
-                    .meshes()
-                    .flat_map(|m| m.primitives().collect::<Vec<_>>())
-                    .map(|p| p.material())
-                    .find(|m| m.index().is_none())
-                else {
-                    continue;
-                };
-                m
-            }
-        };
-        let label = match (material.name(), index) {
-            (Some(n), _) => format!("\"{n}\""),
-            (None, Some(i)) => format!("#{i}"),
-            (None, None) => "(default)".into(),
-        };
-        let override_ = match &shape.bsdf {
-            Some((b, l)) => Some((b.clone(), l.clone())),
-            None => shape
-                .overrides
-                .iter()
-                .find(|(m, _, _)| Some(m.as_str()) == material.name())
-                .map(|(_, b, l)| (b.clone(), l.clone())),
-        };
-        let mut uv_set = None;
-        let bsdf = match override_ {
-            Some((name, location)) => named(&name, &location, asm)?,
-            None => {
-                let (text, warnings) = material::bsdf_table(&material, &label).map_err(err)?;
-                asm.report.warnings.extend(
-                    warnings
-                        .into_iter()
-                        .map(|w| format!("'{}': {w}", shape.label)),
-                );
-                let source = format!("{} material {label}", shape.label);
-                let table = doc::parse(&text, &source)?;
-                let Some(Node {
-                    value: Value::String(kind),
-                    ..
-                }) = table.get("type")
-                else {
-                    unreachable!("bsdf_table writes a type")
-                };
-                let mut bsdf = asm.registry.create_bsdf(&TableRef {
-                    owner: &format!("{owner} material {label}"),
-                    table: &table,
-                    location: at,
-                    type_name: kind,
-                    type_location: at,
-                    structural: &["type"],
-                })?;
-                if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
-                    match load_texture(asset, &info.texture(), &shape.path) {
-                        Ok(t) => {
-                            asm.report.texture_bytes += t.byte_size();
-                            bsdf = Arc::new(texture::AlbedoTextured {
-                                inner: bsdf,
-                                texture: Arc::new(t),
-                            });
-                            uv_set = Some(info.tex_coord());
-                        }
-                        Err(why) => asm.report.warnings.push(format!(
-                            "'{}': material {label}: baseColorTexture ignored ({why}); using baseColorFactor",
-                            shape.label
-                        )),
-                    }
-                }
-                asm.bsdfs.push((format!("{}#{label}", shape.label), bsdf));
-                asm.bsdfs.len() as u32 - 1
-            }
-        };
-        let mut warnings = Vec::new();
-        let emission = material::emission(&material, &label, &mut warnings).map_err(err)?;
-        asm.report.warnings.extend(
-            warnings
-                .into_iter()
-                .map(|w| format!("'{}': {w}", shape.label)),
-        );
-        let emission = match emission {
-            Some(radiance) => Some(doc::parse(
-                &material::emission_table(radiance, material.double_sided()),
-                &format!("{} material {label} emission", shape.label),
-            )?),
-            None => None,
-        };
-        out.insert(
-            index,
-            Resolved {
-                bsdf,
-                emission,
-                uv_set,
-            },
-        );
-    }
-    Ok(out)
-}
-
-/// What the asset uses that lumis does not model, so a render that looks
-/// different from another viewer says why instead of differing silently.
-fn unmodelled_features(document: &gltf::Document) -> Vec<String> {
-    let mut out = Vec::new();
-    let skins = document.nodes().filter(|n| n.skin().is_some()).count();
-    if skins > 0 {
-        out.push(format!(
-            "{skins} skinned nodes rendered in their bind pose (skins are not modelled)"
-        ));
-    }
-    let primitives = || {
-        document
-            .meshes()
-            .flat_map(|m| m.primitives().collect::<Vec<_>>())
-    };
-    if primitives().any(|p| p.morph_targets().next().is_some()) {
-        out.push("morph targets ignored (the base shape is rendered)".into());
-    }
-    if primitives().any(|p| p.get(&gltf::Semantic::Colors(0)).is_some()) {
-        out.push("vertex colours (COLOR_0) ignored".into());
-    }
-    const MODELLED: &[&str] = &["KHR_materials_emissive_strength"];
-    for ext in document.extensions_used() {
-        if !MODELLED.contains(&ext) {
-            out.push(format!("extension {ext} ignored"));
-        }
-    }
-    out
-}
-
-/// Decodes a texture's image: PNG from a buffer view, a file or a data URI.
-fn load_texture(
-    asset: &buffers::Asset,
-    texture: &gltf::Texture,
-    asset_path: &Path,
-) -> std::result::Result<texture::Texture, String> {
-    let image = texture.source();
-    let (bytes, mime): (Vec<u8>, Option<&str>) = match image.source() {
-        gltf::image::Source::View { view, mime_type } => {
-            let data = asset.buffer(view.buffer().index());
-            let end = view.offset() + view.length();
-            let bytes = data.get(view.offset()..end).ok_or_else(|| {
-                format!(
-                    "image #{} lies past the end of buffer #{} (truncated?)",
-                    image.index(),
-                    view.buffer().index()
-                )
-            })?;
-            (bytes.to_vec(), Some(mime_type))
-        }
-        gltf::image::Source::Uri { uri, mime_type } => {
-            let dir = asset_path.parent().unwrap_or(Path::new("."));
-            (buffers::read_uri(uri, dir)?, mime_type)
-        }
-    };
-    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
-    if !bytes.starts_with(PNG_MAGIC) {
-        return Err(format!(
-            "image #{} is {}, only PNG is supported so far",
-            image.index(),
-            mime.unwrap_or("not a PNG")
-        ));
-    }
-    texture::Texture::from_png(&bytes).map_err(|e| format!("image #{}: {e}", image.index()))
 }
