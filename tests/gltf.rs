@@ -1048,3 +1048,46 @@ fn instanced_and_baked_meshes_render_alike() {
         .count();
     assert!(differs_from_floor > 0);
 }
+
+#[test]
+fn jpeg_base_colour_textures_are_decoded() {
+    let dir = test_dir("jpeg");
+    let (w, h) = (16u32, 16u32);
+    let rgb = [200u8, 100, 50];
+    let pixels: Vec<u8> = (0..w * h).flat_map(|_| rgb).collect();
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 100)
+        .encode(&pixels, w, h, image::ColorType::Rgb8)
+        .unwrap();
+    let mut tri = triangle();
+    tri.material = Some(0);
+    tri.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let asset = Asset {
+        materials: vec![Material {
+            base_color_texture: Some(0),
+            ..Material::diffuse("photo", [1.0, 1.0, 1.0])
+        }],
+        images: vec![jpeg],
+        ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "photo", &asset, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    assert!(
+        scene.scene.load_report().warnings.is_empty(),
+        "{:?}",
+        scene.scene.load_report().warnings
+    );
+    let srgb = |c: u8| {
+        let v = c as f32 / 255.0;
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let got = reflectance_at_uv(&scene, 0.3, 0.3);
+    for (g, c) in got.iter().zip(rgb) {
+        // JPEG at quality 100 reproduces a flat colour within a step or two.
+        assert!((g - srgb(c)).abs() < 0.01, "{got:?} vs {rgb:?}");
+    }
+}

@@ -90,7 +90,7 @@ pub struct Asset {
     pub cameras: Vec<Camera>,
     /// Root nodes of the one scene.
     pub roots: Vec<usize>,
-    /// PNG files, stored in the buffer.
+    /// PNG or JPEG files, stored in the buffer.
     pub images: Vec<Vec<u8>>,
 }
 
@@ -187,6 +187,11 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
     }
     let mut images = Vec::new();
     for png in &asset.images {
+        let mime = if png.starts_with(&[0xff, 0xd8]) {
+            "image/jpeg"
+        } else {
+            "image/png"
+        };
         while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
@@ -197,7 +202,7 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
         ));
         bin.extend_from_slice(png);
         images.push(format!(
-            "{{\"bufferView\":{},\"mimeType\":\"image/png\"}}",
+            "{{\"bufferView\":{},\"mimeType\":\"{mime}\"}}",
             views.len() - 1
         ));
     }

@@ -194,12 +194,17 @@ fn load_texture(
         }
     };
     const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
-    if !bytes.starts_with(PNG_MAGIC) {
+    const JPEG_MAGIC: &[u8] = &[0xff, 0xd8, 0xff];
+    let decoded = if bytes.starts_with(PNG_MAGIC) {
+        texture::Texture::from_png(&bytes)
+    } else if bytes.starts_with(JPEG_MAGIC) {
+        texture::Texture::from_jpeg(&bytes)
+    } else {
         return Err(format!(
-            "image #{} is {}, only PNG is supported so far",
+            "image #{} is {}, only PNG and JPEG are supported",
             image.index(),
-            mime.unwrap_or("not a PNG")
+            mime.unwrap_or("neither PNG nor JPEG")
         ));
-    }
-    texture::Texture::from_png(&bytes).map_err(|e| format!("image #{}: {e}", image.index()))
+    };
+    decoded.map_err(|e| format!("image #{}: {e}", image.index()))
 }

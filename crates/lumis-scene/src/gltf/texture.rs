@@ -1,4 +1,4 @@
-//! Base colour textures: PNG images of a glTF asset, looked up at the
+//! Base colour textures: PNG and JPEG images of a glTF asset, looked up at the
 //! interpolated texture coordinate of a hit (`BsdfContext::uv`).
 //!
 //! Texels stay 8-bit sRGB in memory (3 bytes each) and are converted to
@@ -59,12 +59,37 @@ impl Texture {
         if width == 0 || height == 0 || texels.len() != width * height {
             return Err(format!("PNG of {width}x{height} pixels could not be read"));
         }
-        Ok(Self {
+        Ok(Self::from_srgb8(width, height, texels))
+    }
+
+    /// Decodes a baseline or progressive JPEG (greyscale or RGB).
+    pub fn from_jpeg(bytes: &[u8]) -> Result<Self, String> {
+        let mut decoder = jpeg_decoder::Decoder::new(std::io::Cursor::new(bytes));
+        let pixels = decoder.decode().map_err(|e| format!("bad JPEG: {e}"))?;
+        let info = decoder.info().ok_or("bad JPEG: no frame")?;
+        let (width, height) = (info.width as usize, info.height as usize);
+        let texels: Vec<[u8; 3]> = match info.pixel_format {
+            jpeg_decoder::PixelFormat::L8 => pixels.iter().map(|&l| [l; 3]).collect(),
+            // Big-endian 16-bit luminance: the high byte is the 8-bit value.
+            jpeg_decoder::PixelFormat::L16 => pixels.chunks_exact(2).map(|l| [l[0]; 3]).collect(),
+            jpeg_decoder::PixelFormat::RGB24 => {
+                pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()
+            }
+            jpeg_decoder::PixelFormat::CMYK32 => return Err("CMYK JPEGs are not supported".into()),
+        };
+        if width == 0 || height == 0 || texels.len() != width * height {
+            return Err(format!("JPEG of {width}x{height} pixels could not be read"));
+        }
+        Ok(Self::from_srgb8(width, height, texels))
+    }
+
+    fn from_srgb8(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Self {
+        Self {
             width,
             height,
             texels,
             to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
-        })
+        }
     }
 
     fn texel(&self, x: i64, y: i64) -> Rgb {
@@ -137,12 +162,11 @@ mod tests {
     use super::*;
 
     fn checker() -> Texture {
-        Texture {
-            width: 2,
-            height: 2,
-            texels: vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
-            to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
-        }
+        Texture::from_srgb8(
+            2,
+            2,
+            vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
+        )
     }
 
     #[test]
