@@ -1091,3 +1091,65 @@ fn jpeg_base_colour_textures_are_decoded() {
         assert!((g - srgb(c)).abs() < 0.01, "{got:?} vs {rgb:?}");
     }
 }
+
+#[test]
+fn emissive_textures_modulate_the_triangle_lights() {
+    let dir = test_dir("emissive-texture");
+    // 4x1 texels: black, black, white, white.
+    let png = gltf_writer::png_rgb8(
+        4,
+        1,
+        &[[0, 0, 0], [0, 0, 0], [255, 255, 255], [255, 255, 255]],
+    );
+    let mut tri = Primitive::triangles(
+        vec![[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        vec![0, 1, 2],
+    );
+    tri.material = Some(0);
+    tri.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let asset = Asset {
+        materials: vec![Material {
+            emissive: [1.0, 1.0, 1.0],
+            emissive_texture: Some(0),
+            ..Material::diffuse("sign", [0.1, 0.1, 0.1])
+        }],
+        images: vec![png],
+        ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "sign", &asset, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    assert!(
+        scene.scene.load_report().warnings.is_empty(),
+        "{:?}",
+        scene.scene.load_report().warnings
+    );
+    assert_eq!(scene.scene.counts().area_lights, 1);
+    // Hits: u = x / 2, so x = 0.5 is in the black half, x = 1.5 in the white.
+    let le_at = |x: f32, y: f32| {
+        let hit = scene
+            .scene
+            .intersect(&Ray::new(Vec3::new(x, y, 10.0), Vec3::NEG_Z))
+            .unwrap();
+        let light = hit.light.expect("emissive");
+        light.light.l(hit.p(), hit.n(), hit.uv, hit.wo).r
+    };
+    assert!(le_at(0.5, 0.5).abs() < 1e-6);
+    assert!((le_at(1.5, 0.2) - 1.0).abs() < 1e-5);
+    // Light samples carry the texel at the sampled point.
+    let light = &scene.scene.lights()[0];
+    let ctx = lumis_core::LightSampleContext::at(Vec3::new(0.7, 0.7, 1.0));
+    let (mut dark, mut bright) = (0, 0);
+    for i in 0..64 {
+        let u = lumis_core::Vec2::new((i % 8) as f32 / 8.0 + 0.06, (i / 8) as f32 / 8.0 + 0.06);
+        let s = light.sample_li(&ctx, u).expect("faces the point");
+        let texel_u = s.p.p.x / 2.0;
+        if (0.13..0.37).contains(&texel_u) {
+            assert!(s.l.r.abs() < 1e-6, "{s:?}");
+            dark += 1;
+        } else if (0.63..0.87).contains(&texel_u) {
+            assert!((s.l.r - 1.0).abs() < 1e-5, "{s:?}");
+            bright += 1;
+        }
+    }
+    assert!(dark > 0 && bright > 0, "{dark} {bright}");
+}

@@ -46,6 +46,7 @@ pub struct Material {
     pub double_sided: bool,
     /// Index into [`Asset::images`] (one texture per image).
     pub base_color_texture: Option<usize>,
+    pub emissive_texture: Option<usize>,
 }
 
 impl Material {
@@ -58,6 +59,7 @@ impl Material {
             emissive: [0.0; 3],
             double_sided: false,
             base_color_texture: None,
+            emissive_texture: None,
         }
     }
 }
@@ -213,8 +215,11 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             let texture = m
                 .base_color_texture
                 .map_or(String::new(), |t| format!(",\"baseColorTexture\":{{\"index\":{t}}}"));
+            let emissive_texture = m
+                .emissive_texture
+                .map_or(String::new(), |t| format!(",\"emissiveTexture\":{{\"index\":{t}}}"));
             format!(
-                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}}},\"emissiveFactor\":[{}],\"doubleSided\":{}}}",
+                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}}},\"emissiveFactor\":[{}],\"doubleSided\":{}{emissive_texture}}}",
                 m.name,
                 floats(&m.base_color),
                 m.metallic,

@@ -47,11 +47,8 @@ pub(crate) fn bsdf_table(
 
 /// Emitted radiance of `material`: `emissiveFactor` times
 /// `KHR_materials_emissive_strength`, or `None` for a black emitter.
-pub(crate) fn emission(
-    material: &gltf::Material,
-    label: &str,
-    warnings: &mut Vec<String>,
-) -> Result<Option<Rgb>, String> {
+/// An `emissiveTexture` scales this per point (the caller wraps the lights).
+pub(crate) fn emission(material: &gltf::Material, label: &str) -> Result<Option<Rgb>, String> {
     let [r, g, b] = material.emissive_factor();
     let strength = material.emissive_strength().unwrap_or(1.0);
     let radiance = Rgb::new(r, g, b) * strength;
@@ -59,11 +56,6 @@ pub(crate) fn emission(
         return Err(format!(
             "material {label}: emission {:?} x strength {strength} must be finite and non-negative",
             [r, g, b]
-        ));
-    }
-    if material.emissive_texture().is_some() {
-        warnings.push(format!(
-            "material {label}: emissiveTexture ignored (textures are not supported yet); using emissiveFactor"
         ));
     }
     Ok((radiance.max_component() > 0.0).then_some(radiance))

@@ -26,7 +26,7 @@ use std::sync::Arc;
 use lumis_core::doc::{Table, Value};
 use lumis_core::glam::{Mat3, Mat4};
 use lumis_core::registry::TableRef;
-use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Result, Vec3};
+use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Result, Vec2, Vec3};
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 use rayon::prelude::*;
 
@@ -216,8 +216,12 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 Some(table) => {
                     let tris = indices
                         .iter()
-                        .map(|t| t.map(|i| Vec3::from(positions[i as usize])));
-                    triangle_lights(tris, table, &light_owner, &at, asm)?
+                        .map(|t| (t.map(|i| Vec3::from(positions[i as usize])), *t));
+                    let emission = Emission {
+                        table,
+                        texture: r.emission_texture.as_ref().zip(uvs.as_deref()),
+                    };
+                    triangle_lights(tris, &emission, &light_owner, &at, asm)?
                 }
                 None => Vec::new(),
             };
@@ -263,7 +267,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
                 .map_err(|e| err(e.to_string()))?;
             asm.counts.shading_normals |= mesh.normals.is_some();
-            emissions.push(r.emission.clone());
+            emissions.push((r.emission.clone(), r.emission_texture.clone()));
             meshes.push(mesh);
         }
         pending.push((mesh_index, child, meshes, emissions));
@@ -346,17 +350,25 @@ fn bake(part: &mut Part, world: &Mat4) {
     }
 }
 
+/// How an emissive material's triangles emit: the light table they share
+/// and, with an emissive texture, the texture and the mesh's uvs.
+struct Emission<'a> {
+    table: &'a Table,
+    texture: Option<(&'a Arc<texture::Texture>, &'a [Vec2])>,
+}
+
 /// One triangle light per non-degenerate triangle (world-space vertices,
-/// front side by winding), `NO_LIGHT` for degenerate ones.
+/// front side by winding, with the vertex indices for the uvs), `NO_LIGHT`
+/// for degenerate ones.
 fn triangle_lights(
-    triangles: impl Iterator<Item = [Vec3; 3]>,
-    table: &Table,
+    triangles: impl Iterator<Item = ([Vec3; 3], [u32; 3])>,
+    emission: &Emission,
     owner: &str,
     at: &Location,
     asm: &mut Assembly,
 ) -> Result<Vec<u32>> {
     let mut out = Vec::new();
-    for p in triangles {
+    for (p, vertices) in triangles {
         let [a, b, c] = p;
         if (b - a).cross(c - a).length_squared() == 0.0 {
             out.push(NO_LIGHT);
@@ -365,7 +377,7 @@ fn triangle_lights(
         let light = asm.registry.create_light(
             &TableRef {
                 owner,
-                table,
+                table: emission.table,
                 location: at,
                 type_name: "triangle",
                 type_location: at,
@@ -373,6 +385,15 @@ fn triangle_lights(
             },
             &LightShape::Triangle { p },
         )?;
+        let light: Box<dyn lumis_core::Light> = match emission.texture {
+            Some((texture, uvs)) => Box::new(texture::TexturedEmitter {
+                inner: light,
+                texture: texture.clone(),
+                p,
+                uv: vertices.map(|i| uvs[i as usize]),
+            }),
+            None => light,
+        };
         asm.lights.push(light);
         asm.counts.area_lights += 1;
         out.push(asm.lights.len() as u32 - 1);
@@ -383,32 +404,36 @@ fn triangle_lights(
 /// The world-space triangle lights of one instance of a prototype.
 fn instance_lights(
     meshes: &[MeshData],
-    emissions: &[Option<Table>],
+    emissions: &[(Option<Table>, Option<Arc<texture::Texture>>)],
     world: &Mat4,
     owner: &str,
     at: &Location,
     asm: &mut Assembly,
 ) -> Result<Vec<Vec<u32>>> {
-    if emissions.iter().all(Option::is_none) {
+    if emissions.iter().all(|(t, _)| t.is_none()) {
         return Ok(Vec::new());
     }
     let mirrored = world.determinant() < 0.0;
     let mut out = Vec::with_capacity(meshes.len());
-    for (mesh, emission) in meshes.iter().zip(emissions) {
-        let Some(table) = emission else {
+    for (mesh, (table, texture)) in meshes.iter().zip(emissions) {
+        let Some(table) = table else {
             out.push(Vec::new());
             continue;
+        };
+        let emission = Emission {
+            table,
+            texture: texture.as_ref().zip(mesh.uvs.as_deref()),
         };
         let vertices = &mesh.vertices;
         let tris = mesh.indices.iter().map(|t| {
             let [a, b, c] = t.map(|i| world.transform_point3(Vec3::from(vertices[i as usize])));
             if mirrored {
-                [a, c, b]
+                ([a, c, b], [t[0], t[2], t[1]])
             } else {
-                [a, b, c]
+                ([a, b, c], *t)
             }
         });
-        out.push(triangle_lights(tris, table, owner, at, asm)?);
+        out.push(triangle_lights(tris, &emission, owner, at, asm)?);
     }
     Ok(out)
 }

@@ -20,6 +20,8 @@ use crate::Assembly;
 pub(crate) struct Resolved {
     pub bsdf: u32,
     pub emission: Option<Table>,
+    /// An emissive texture scaling the emission, read at the same uv set.
+    pub emission_texture: Option<Arc<texture::Texture>>,
     /// The TEXCOORD set the BSDF's texture reads, if it has one.
     pub uv_set: Option<u32>,
 }
@@ -142,13 +144,28 @@ pub(crate) fn resolve_materials(
                 asm.bsdfs.len() as u32 - 1
             }
         };
-        let mut warnings = Vec::new();
-        let emission = material::emission(&material, &label, &mut warnings).map_err(err)?;
-        asm.report.warnings.extend(
-            warnings
-                .into_iter()
-                .map(|w| format!("'{}': {w}", shape.label)),
-        );
+        let emission = material::emission(&material, &label).map_err(err)?;
+        let mut emission_texture = None;
+        if let (Some(_), Some(info)) = (emission, material.emissive_texture()) {
+            let set = info.tex_coord();
+            let loaded = match uv_set {
+                Some(base) if base != set => Err(format!(
+                    "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
+                )),
+                _ => load_texture(asset, &info.texture(), &shape.path),
+            };
+            match loaded {
+                Ok(t) => {
+                    asm.report.texture_bytes += t.byte_size();
+                    emission_texture = Some(Arc::new(t));
+                    uv_set = Some(set);
+                }
+                Err(why) => asm.report.warnings.push(format!(
+                    "'{}': material {label}: emissiveTexture ignored ({why}); using emissiveFactor",
+                    shape.label
+                )),
+            }
+        }
         let emission = match emission {
             Some(radiance) => Some(doc::parse(
                 &material::emission_table(radiance, material.double_sided()),
@@ -161,6 +178,7 @@ pub(crate) fn resolve_materials(
             Resolved {
                 bsdf,
                 emission,
+                emission_texture,
                 uv_set,
             },
         );
