@@ -127,9 +127,7 @@ fn primitive(
 
     if let Some(set) = uv_set {
         let a = primitive.get(&Semantic::TexCoords(set)).ok_or_else(|| {
-            format!(
-                "its material has a base colour texture but the primitive has no TEXCOORD_{set}"
-            )
+            format!("its material has a texture but the primitive has no TEXCOORD_{set}")
         })?;
         check_accessor(
             asset,
