@@ -224,5 +224,14 @@ fn load_texture(
             mime.unwrap_or("neither PNG nor JPEG")
         ));
     };
-    decoded.map_err(|e| format!("image #{}: {e}", image.index()))
+    let sampler = texture.sampler();
+    let wrap = |mode: gltf::texture::WrappingMode| match mode {
+        gltf::texture::WrappingMode::Repeat => texture::Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => texture::Wrap::Mirror,
+        gltf::texture::WrappingMode::ClampToEdge => texture::Wrap::Clamp,
+    };
+    let nearest = sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest);
+    decoded
+        .map(|t| t.with_sampler([wrap(sampler.wrap_s()), wrap(sampler.wrap_t())], nearest))
+        .map_err(|e| format!("image #{}: {e}", image.index()))
 }

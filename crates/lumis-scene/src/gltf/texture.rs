@@ -2,8 +2,10 @@
 //! interpolated texture coordinate of a hit (`BsdfContext::uv`).
 //!
 //! Texels stay 8-bit sRGB in memory (3 bytes each) and are converted to
-//! linear through a 256-entry table on lookup; filtering is bilinear with
-//! repeat wrapping, whatever the asset's sampler says (said in the README).
+//! linear through a 256-entry table on lookup. The asset's sampler decides
+//! wrapping (repeat, mirrored repeat, clamp) and magnification (bilinear,
+//! or nearest); there are no mip maps, so minification filters are not
+//! modelled.
 
 use std::sync::Arc;
 
@@ -12,12 +14,41 @@ use lumis_core::{
     Rgb, Vec2, Vec3,
 };
 
-/// An sRGB image with bilinear, repeating lookups.
+/// How lookups outside [0, 1] map back into the image (glTF sampler
+/// `wrapS` / `wrapT`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Wrap {
+    Repeat,
+    Mirror,
+    Clamp,
+}
+
+impl Wrap {
+    fn index(self, i: i64, n: usize) -> usize {
+        let n = n as i64;
+        (match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Mirror => {
+                let m = i.rem_euclid(2 * n);
+                if m >= n {
+                    2 * n - 1 - m
+                } else {
+                    m
+                }
+            }
+            Wrap::Clamp => i.clamp(0, n - 1),
+        }) as usize
+    }
+}
+
+/// An sRGB image with filtered, wrapped lookups.
 pub(crate) struct Texture {
     width: usize,
     height: usize,
     texels: Vec<[u8; 3]>,
     to_linear: [f32; 256],
+    wrap: [Wrap; 2],
+    nearest: bool,
 }
 
 fn srgb_to_linear(v: f32) -> f32 {
@@ -92,12 +123,22 @@ impl Texture {
             height,
             texels,
             to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
+            wrap: [Wrap::Repeat; 2],
+            nearest: false,
         }
     }
 
+    /// Sets the sampler: wrap modes for u and v, and nearest (instead of
+    /// bilinear) magnification.
+    pub fn with_sampler(mut self, wrap: [Wrap; 2], nearest: bool) -> Self {
+        self.wrap = wrap;
+        self.nearest = nearest;
+        self
+    }
+
     fn texel(&self, x: i64, y: i64) -> Rgb {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.rem_euclid(self.height as i64) as usize;
+        let x = self.wrap[0].index(x, self.width);
+        let y = self.wrap[1].index(y, self.height);
         let [r, g, b] = self.texels[y * self.width + x];
         Rgb::new(
             self.to_linear[r as usize],
@@ -107,10 +148,15 @@ impl Texture {
     }
 
     /// Linear RGB at `uv` (glTF convention: (0, 0) is the image's top-left
-    /// corner), bilinear between texel centres, repeating.
+    /// corner), bilinear between texel centres (or the nearest texel).
     pub fn lookup(&self, uv: Vec2) -> Rgb {
         if !uv.is_finite() {
             return self.texel(0, 0);
+        }
+        if self.nearest {
+            let x = (uv.x * self.width as f32).floor() as i64;
+            let y = (uv.y * self.height as f32).floor() as i64;
+            return self.texel(x, y);
         }
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
@@ -236,6 +282,19 @@ mod tests {
             2,
             vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
         )
+    }
+
+    #[test]
+    fn wrap_modes_and_nearest() {
+        let t = checker().with_sampler([Wrap::Clamp, Wrap::Mirror], true);
+        // Clamped in u: far right is the right column; mirrored in v: v in
+        // (1, 1.5) reflects to the bottom row, (1.5, 2) to the top.
+        assert_eq!(t.lookup(Vec2::new(7.0, 0.2)), Rgb::new(0.0, 1.0, 0.0));
+        assert_eq!(t.lookup(Vec2::new(-3.0, 1.2)), Rgb::new(0.0, 0.0, 1.0));
+        assert_eq!(t.lookup(Vec2::new(0.2, 1.7)), Rgb::new(1.0, 0.0, 0.0));
+        // Nearest: no blend halfway between red and green.
+        assert_eq!(t.lookup(Vec2::new(0.49, 0.25)), Rgb::new(1.0, 0.0, 0.0));
+        assert_eq!(t.lookup(Vec2::new(0.51, 0.25)), Rgb::new(0.0, 1.0, 0.0));
     }
 
     #[test]
