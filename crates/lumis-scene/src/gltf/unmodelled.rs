@@ -21,6 +21,15 @@ pub(crate) fn unmodelled_features(document: &gltf::Document) -> Vec<String> {
     if primitives().any(|p| p.get(&gltf::Semantic::Colors(0)).is_some()) {
         out.push("vertex colours (COLOR_0) ignored".into());
     }
+    let see_through = document
+        .materials()
+        .filter(|m| m.alpha_mode() != gltf::material::AlphaMode::Opaque)
+        .count();
+    if see_through > 0 {
+        out.push(format!(
+            "{see_through} materials with alphaMode MASK or BLEND rendered opaque (alpha is not modelled)"
+        ));
+    }
     const MODELLED: &[&str] = &["KHR_materials_emissive_strength"];
     for ext in document.extensions_used() {
         if !MODELLED.contains(&ext) {
