@@ -17,6 +17,8 @@ pub struct Primitive {
     pub material: Option<usize>,
     /// glTF primitive mode; 4 = TRIANGLES.
     pub mode: u32,
+    /// Write the indices as u16 instead of u32.
+    pub u16_indices: bool,
 }
 
 impl Primitive {
@@ -171,8 +173,16 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             }
             let mut prim = format!("{{\"attributes\":{{{attributes}}},\"mode\":{}", p.mode);
             if let Some(indices) = &p.indices {
-                let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-                let a = add(&bytes, indices.len(), "SCALAR", 5125, String::new());
+                let (bytes, component): (Vec<u8>, u32) = if p.u16_indices {
+                    let b = indices
+                        .iter()
+                        .flat_map(|&i| (i as u16).to_le_bytes())
+                        .collect();
+                    (b, 5123)
+                } else {
+                    (indices.iter().flat_map(|i| i.to_le_bytes()).collect(), 5125)
+                };
+                let a = add(&bytes, indices.len(), "SCALAR", component, String::new());
                 write!(prim, ",\"indices\":{a}").unwrap();
             }
             if let Some(m) = p.material {

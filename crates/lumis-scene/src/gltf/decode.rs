@@ -7,6 +7,7 @@
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use lumis_core::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::buffers::Asset;
 use super::normals;
@@ -146,54 +147,111 @@ fn primitive(
     }
     let reader = primitive.reader(|b| Some(asset.buffer(b.index())));
     let uvs = match uv_set {
-        Some(set) => Some(
-            reader
-                .read_tex_coords(set)
-                .ok_or_else(|| format!("cannot read TEXCOORD_{set}"))?
-                .into_f32()
-                .map(Vec2::from)
-                .collect::<Vec<_>>(),
-        ),
+        Some(set) => {
+            let accessor = primitive
+                .get(&Semantic::TexCoords(set))
+                .ok_or_else(|| format!("cannot read TEXCOORD_{set}"))?;
+            match dense_f32(asset, &accessor, 0, Vec2::from) {
+                Some(uvs) => Some(uvs),
+                None => Some(
+                    reader
+                        .read_tex_coords(set)
+                        .ok_or_else(|| format!("cannot read TEXCOORD_{set}"))?
+                        .into_f32()
+                        .map(Vec2::from)
+                        .collect::<Vec<_>>(),
+                ),
+            }
+        }
         None => None,
     };
     // Capacities are exact, plus the one spare element PaddedBuffer adds,
     // so no vector is reallocated or over-allocated on the way to Embree.
-    let mut positions: Vec<[f32; 3]> = Vec::with_capacity(position_accessor.count() + 1);
-    positions.extend(reader.read_positions().ok_or("cannot read POSITION")?);
-    if positions.iter().flatten().any(|c| !c.is_finite()) {
+    let positions: Vec<[f32; 3]> = match dense_f32(asset, &position_accessor, 1, |p: [f32; 3]| p) {
+        Some(p) => p,
+        None => {
+            let mut p = Vec::with_capacity(position_accessor.count() + 1);
+            p.extend(reader.read_positions().ok_or("cannot read POSITION")?);
+            p
+        }
+    };
+    if positions.par_iter().flatten().any(|c| !c.is_finite()) {
         return Err("POSITION holds a NaN or infinite coordinate".into());
     }
     let n = positions.len();
-    let flat: Vec<u32> = match reader.read_indices() {
-        Some(indices) => indices.into_u32().collect(),
-        None => (0..n as u32).collect(),
+    let indices: Vec<[u32; 3]> = match primitive.indices() {
+        Some(accessor) => {
+            if !accessor.count().is_multiple_of(3) {
+                return Err(format!(
+                    "{} indices is not a whole number of triangles",
+                    accessor.count()
+                ));
+            }
+            match dense_triangles(asset, &accessor) {
+                Some(t) => t,
+                None => {
+                    let flat: Vec<u32> = reader
+                        .read_indices()
+                        .ok_or("cannot read indices")?
+                        .into_u32()
+                        .collect();
+                    let mut t = Vec::with_capacity(flat.len() / 3 + 1);
+                    t.extend(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
+                    t
+                }
+            }
+        }
+        None => {
+            if !n.is_multiple_of(3) {
+                return Err(format!(
+                    "{n} vertices without indices is not a whole number of triangles"
+                ));
+            }
+            let mut t = Vec::with_capacity(n / 3 + 1);
+            (0..(n / 3) as u32)
+                .into_par_iter()
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect_into_vec(&mut t);
+            t
+        }
     };
-    if !flat.len().is_multiple_of(3) {
+    if let Some((i, t)) = indices
+        .par_iter()
+        .enumerate()
+        .find_first(|(_, t)| t.iter().any(|&v| v as usize >= n))
+    {
+        let (k, bad) = t
+            .iter()
+            .enumerate()
+            .find(|(_, &v)| v as usize >= n)
+            .expect("found above");
         return Err(format!(
-            "{} indices is not a whole number of triangles",
-            flat.len()
+            "index {bad} (element {}) is out of range for {n} vertices",
+            3 * i + k
         ));
     }
-    if let Some((i, bad)) = flat.iter().enumerate().find(|(_, &v)| v as usize >= n) {
-        return Err(format!(
-            "index {bad} (element {i}) is out of range for {n} vertices"
-        ));
-    }
-    let indices: Vec<[u32; 3]> = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
-    drop(flat);
     if indices.is_empty() {
         return Err("has no triangles".into());
     }
 
     let (normals, pending_normals) = match normal_accessor {
         Some(_) => {
-            let mut normals: Vec<Vec3> = Vec::with_capacity(n);
-            normals.extend(
-                reader
-                    .read_normals()
-                    .ok_or("cannot read NORMAL")?
-                    .map(Vec3::from),
-            );
+            let normals: Vec<Vec3> = match normal_accessor
+                .as_ref()
+                .and_then(|a| dense_f32(asset, a, 0, Vec3::from))
+            {
+                Some(ns) => ns,
+                None => {
+                    let mut ns = Vec::with_capacity(n);
+                    ns.extend(
+                        reader
+                            .read_normals()
+                            .ok_or("cannot read NORMAL")?
+                            .map(Vec3::from),
+                    );
+                    ns
+                }
+            };
             (Some(normals), None)
         }
         None => match missing_normals {
@@ -209,6 +267,63 @@ fn primitive(
         material: primitive.material().index(),
         pending_normals,
     })
+}
+
+/// The common case decoded in parallel: a dense (not sparse) accessor of
+/// little-endian f32 vectors, checked by [`check_accessor`] first. `None`
+/// for anything else, which the gltf crate's reader decodes. `spare` is
+/// extra capacity (PaddedBuffer's padding element).
+fn dense_f32<const N: usize, T: Send>(
+    asset: &Asset,
+    accessor: &gltf::Accessor,
+    spare: usize,
+    convert: impl Fn([f32; N]) -> T + Sync,
+) -> Option<Vec<T>> {
+    if accessor.sparse().is_some() || accessor.data_type() != DataType::F32 {
+        return None;
+    }
+    let view = accessor.view()?;
+    let data = asset.buffer(view.buffer().index());
+    let stride = view.stride().unwrap_or(4 * N);
+    let base = view.offset() + accessor.offset();
+    let mut out = Vec::with_capacity(accessor.count() + spare);
+    (0..accessor.count())
+        .into_par_iter()
+        .map(|i| {
+            let o = base + i * stride;
+            convert(std::array::from_fn(|k| {
+                let b = &data[o + 4 * k..o + 4 * k + 4];
+                f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            }))
+        })
+        .collect_into_vec(&mut out);
+    Some(out)
+}
+
+/// Dense u8/u16/u32 indices as triangles, decoded in parallel (`None`
+/// for sparse ones); the count is a multiple of 3 and the bytes were
+/// checked by [`check_accessor`].
+fn dense_triangles(asset: &Asset, accessor: &gltf::Accessor) -> Option<Vec<[u32; 3]>> {
+    if accessor.sparse().is_some() {
+        return None;
+    }
+    let view = accessor.view()?;
+    let data = asset.buffer(view.buffer().index());
+    let size = accessor.size();
+    let stride = view.stride().unwrap_or(size);
+    let base = view.offset() + accessor.offset();
+    let read: fn(&[u8], usize) -> u32 = match accessor.data_type() {
+        DataType::U8 => |d, o| d[o] as u32,
+        DataType::U16 => |d, o| u16::from_le_bytes([d[o], d[o + 1]]) as u32,
+        DataType::U32 => |d, o| u32::from_le_bytes([d[o], d[o + 1], d[o + 2], d[o + 3]]),
+        _ => return None,
+    };
+    let mut out = Vec::with_capacity(accessor.count() / 3 + 1);
+    (0..accessor.count() / 3)
+        .into_par_iter()
+        .map(|t| std::array::from_fn(|k| read(data, base + (3 * t + k) * stride)))
+        .collect_into_vec(&mut out);
+    Some(out)
 }
 
 /// Checks an accessor's type and that its bytes lie within its buffer
