@@ -797,6 +797,31 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
         );
     }
 
+    // KHR_texture_transform: shifted by half the image in u, the red texel
+    // shows green and the green one red.
+    let shifted = Asset {
+        materials: vec![Material {
+            base_color_transform: Some(([0.5, 0.0], 0.0, [1.0, 1.0])),
+            ..asset.materials[0].clone()
+        }],
+        ..asset.clone()
+    };
+    let file = gltf_writer::write(&dir, "shifted", &shifted, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    assert!(
+        scene.scene.load_report().warnings.is_empty(),
+        "{:?}",
+        scene.scene.load_report().warnings
+    );
+    assert!(approx(
+        reflectance_at_uv(&scene, 0.25, 0.25),
+        [0.0, 0.8, 0.0]
+    ));
+    assert!(approx(
+        reflectance_at_uv(&scene, 0.75, 0.25),
+        [0.5, 0.0, 0.0]
+    ));
+
     // A textured material on a primitive without uvs is refused.
     tri.uvs = None;
     let asset = Asset {

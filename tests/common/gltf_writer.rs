@@ -49,6 +49,9 @@ pub struct Material {
     /// Index into [`Asset::images`] (one texture per image).
     pub base_color_texture: Option<usize>,
     pub emissive_texture: Option<usize>,
+    /// `KHR_texture_transform` of the base colour texture: offset,
+    /// rotation (radians), scale.
+    pub base_color_transform: Option<([f32; 2], f32, [f32; 2])>,
 }
 
 impl Material {
@@ -62,6 +65,7 @@ impl Material {
             double_sided: false,
             base_color_texture: None,
             emissive_texture: None,
+            base_color_transform: None,
         }
     }
 }
@@ -222,9 +226,16 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
         .materials
         .iter()
         .map(|m| {
-            let texture = m
-                .base_color_texture
-                .map_or(String::new(), |t| format!(",\"baseColorTexture\":{{\"index\":{t}}}"));
+            let transform = m.base_color_transform.map_or(String::new(), |(o, r, k)| {
+                format!(
+                    ",\"extensions\":{{\"KHR_texture_transform\":{{\"offset\":[{}],\"rotation\":{r:?},\"scale\":[{}]}}}}",
+                    floats(&o),
+                    floats(&k)
+                )
+            });
+            let texture = m.base_color_texture.map_or(String::new(), |t| {
+                format!(",\"baseColorTexture\":{{\"index\":{t}{transform}}}")
+            });
             let emissive_texture = m
                 .emissive_texture
                 .map_or(String::new(), |t| format!(",\"emissiveTexture\":{{\"index\":{t}}}"));
@@ -310,6 +321,13 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             textures.join(",")
         )
         .unwrap();
+    }
+    if asset
+        .materials
+        .iter()
+        .any(|m| m.base_color_transform.is_some())
+    {
+        json.push_str(",\"extensionsUsed\":[\"KHR_texture_transform\"]");
     }
     if !cameras.is_empty() {
         write!(json, ",\"cameras\":[{}]", cameras.join(",")).unwrap();

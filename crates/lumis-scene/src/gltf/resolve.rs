@@ -125,14 +125,14 @@ pub(crate) fn resolve_materials(
                     structural: &["type"],
                 })?;
                 if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
-                    match load_texture(asset, &info.texture(), &shape.path) {
-                        Ok(t) => {
+                    match texture_of(asset, &info, &shape.path) {
+                        Ok((t, set)) => {
                             asm.report.texture_bytes += t.byte_size();
                             bsdf = Arc::new(texture::AlbedoTextured {
                                 inner: bsdf,
                                 texture: Arc::new(t),
                             });
-                            uv_set = Some(info.tex_coord());
+                            uv_set = Some(set);
                         }
                         Err(why) => asm.report.warnings.push(format!(
                             "'{}': material {label}: baseColorTexture ignored ({why}); using baseColorFactor",
@@ -147,15 +147,14 @@ pub(crate) fn resolve_materials(
         let emission = material::emission(&material, &label).map_err(err)?;
         let mut emission_texture = None;
         if let (Some(_), Some(info)) = (emission, material.emissive_texture()) {
-            let set = info.tex_coord();
-            let loaded = match uv_set {
-                Some(base) if base != set => Err(format!(
+            let loaded = match (texture_of(asset, &info, &shape.path), uv_set) {
+                (Ok((_, set)), Some(base)) if base != set => Err(format!(
                     "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
                 )),
-                _ => load_texture(asset, &info.texture(), &shape.path),
+                (loaded, _) => loaded,
             };
             match loaded {
-                Ok(t) => {
+                Ok((t, set)) => {
                     asm.report.texture_bytes += t.byte_size();
                     emission_texture = Some(Arc::new(t));
                     uv_set = Some(set);
@@ -186,7 +185,26 @@ pub(crate) fn resolve_materials(
     Ok(out)
 }
 
-/// Decodes a texture's image: PNG from a buffer view, a file or a data URI.
+/// A material's texture with its sampler and `KHR_texture_transform`, and
+/// the TEXCOORD set it reads (the transform's `texCoord` overrides the
+/// texture info's).
+fn texture_of(
+    asset: &buffers::Asset,
+    info: &gltf::texture::Info,
+    asset_path: &Path,
+) -> std::result::Result<(texture::Texture, u32), String> {
+    let t = load_texture(asset, &info.texture(), asset_path)?;
+    Ok(match info.texture_transform() {
+        Some(x) => (
+            t.with_uv_transform(x.offset(), x.rotation(), x.scale()),
+            x.tex_coord().unwrap_or(info.tex_coord()),
+        ),
+        None => (t, info.tex_coord()),
+    })
+}
+
+/// Decodes a texture's image: PNG or JPEG from a buffer view, a file or a
+/// data URI, with the texture's sampler.
 fn load_texture(
     asset: &buffers::Asset,
     texture: &gltf::Texture,

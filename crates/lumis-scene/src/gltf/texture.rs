@@ -49,6 +49,9 @@ pub(crate) struct Texture {
     to_linear: [f32; 256],
     wrap: [Wrap; 2],
     nearest: bool,
+    /// `KHR_texture_transform` as `[a, b, c, d, tx, ty]`:
+    /// `u' = a u + b v + tx`, `v' = c u + d v + ty`.
+    uv_transform: Option<[f32; 6]>,
 }
 
 fn srgb_to_linear(v: f32) -> f32 {
@@ -125,6 +128,35 @@ impl Texture {
             to_linear: std::array::from_fn(|i| srgb_to_linear(i as f32 / 255.0)),
             wrap: [Wrap::Repeat; 2],
             nearest: false,
+            uv_transform: None,
+        }
+    }
+
+    /// Applies `KHR_texture_transform` before every lookup: scale, then
+    /// rotate by `rotation` radians (counter-clockwise in uv, i.e. the image
+    /// turns clockwise), then offset. The extension's GLSL snippet has the
+    /// rotation's sign flipped against its own prose and examples; this
+    /// follows the examples (an offset of [0, 1], rotation pi/2 and scale
+    /// 0.5 selects the image's lower left quadrant).
+    pub fn with_uv_transform(mut self, offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> Self {
+        let (s, c) = rotation.sin_cos();
+        self.uv_transform = Some([
+            c * scale[0],
+            s * scale[1],
+            -s * scale[0],
+            c * scale[1],
+            offset[0],
+            offset[1],
+        ]);
+        self
+    }
+
+    fn transformed(&self, uv: Vec2) -> Vec2 {
+        match self.uv_transform {
+            Some([a, b, c, d, tx, ty]) => {
+                Vec2::new(a * uv.x + b * uv.y + tx, c * uv.x + d * uv.y + ty)
+            }
+            None => uv,
         }
     }
 
@@ -150,6 +182,7 @@ impl Texture {
     /// Linear RGB at `uv` (glTF convention: (0, 0) is the image's top-left
     /// corner), bilinear between texel centres (or the nearest texel).
     pub fn lookup(&self, uv: Vec2) -> Rgb {
+        let uv = self.transformed(uv);
         if !uv.is_finite() {
             return self.texel(0, 0);
         }
@@ -282,6 +315,28 @@ mod tests {
             2,
             vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [255, 255, 255]],
         )
+    }
+
+    #[test]
+    fn texture_transform_follows_the_extension_examples() {
+        // "utilizes only the lower left quadrant of the source image,
+        // rotated clockwise 90 degrees".
+        let t = checker().with_uv_transform([0.0, 1.0], std::f32::consts::FRAC_PI_2, [0.5, 0.5]);
+        for (uv, expected) in [
+            ((0.0, 0.0), (0.0, 1.0)),
+            ((1.0, 0.0), (0.0, 0.5)),
+            ((0.0, 1.0), (0.5, 1.0)),
+            ((1.0, 1.0), (0.5, 0.5)),
+        ] {
+            let got = t.transformed(Vec2::new(uv.0, uv.1));
+            assert!(
+                (got - Vec2::new(expected.0, expected.1)).length() < 1e-6,
+                "{uv:?} -> {got}"
+            );
+        }
+        // "inverts the T axis": offset [0, 1], scale [1, -1].
+        let flip = checker().with_uv_transform([0.0, 1.0], 0.0, [1.0, -1.0]);
+        assert_eq!(flip.lookup(Vec2::new(0.25, 0.25)), Rgb::new(0.0, 0.0, 1.0));
     }
 
     #[test]

@@ -30,7 +30,7 @@ pub(crate) fn unmodelled_features(document: &gltf::Document) -> Vec<String> {
             "{see_through} materials with alphaMode MASK or BLEND rendered opaque (alpha is not modelled)"
         ));
     }
-    const MODELLED: &[&str] = &["KHR_materials_emissive_strength"];
+    const MODELLED: &[&str] = &["KHR_materials_emissive_strength", "KHR_texture_transform"];
     for ext in document.extensions_used() {
         if !MODELLED.contains(&ext) {
             out.push(format!("extension {ext} ignored"));
