@@ -1,6 +1,8 @@
 //! Helpers shared by the end-to-end tests: render a scene given as TOML
 //! text, and compare images with statistics rather than fixed tolerances.
 
+pub mod gltf_writer;
+
 use std::path::Path;
 
 use lumis_core::Registry;

@@ -107,11 +107,12 @@ fn describe(loaded: &LoadedScene) -> String {
     let c = loaded.scene.counts();
     let lights = c.area_lights + c.delta_lights + c.infinite_lights;
     format!(
-        "scene '{}': {} meshes ({} triangles), {} spheres; {} lights ({} area, {} delta, {} infinite); \
+        "scene '{}': {} meshes ({} triangles, {} instances), {} spheres; {} lights ({} area, {} delta, {} infinite); \
          shading normals: {}; MIS: {}",
         loaded.name,
         c.meshes,
         c.triangles,
+        c.instances,
         c.spheres,
         lights,
         c.area_lights,
@@ -132,6 +133,11 @@ pub fn render_scene_file(
     registry: &lumis_core::Registry,
 ) -> Result<RenderReport> {
     let loaded = load(args, registry)?;
+    if !args.quiet {
+        for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
+            eprintln!("{line}");
+        }
+    }
     if args.verbose {
         eprintln!("{}", describe(&loaded));
     }

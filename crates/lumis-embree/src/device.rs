@@ -1,6 +1,7 @@
 //! The Embree device and its error reporting.
 
 use std::ffi::{c_char, c_void, CStr};
+use std::sync::atomic::{AtomicI64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use embree4_sys as sys;
@@ -21,6 +22,9 @@ struct DeviceInner {
     /// Boxed so its address stays fixed: Embree holds it as the callback's
     /// user pointer for the device's lifetime.
     errors: Box<ErrorSlot>,
+    /// Bytes Embree holds (BVHs, its copies of buffers), kept by
+    /// [`memory_callback`]; boxed for the same reason as `errors`.
+    memory: Box<AtomicI64>,
 }
 
 // SAFETY: an Embree device is thread-safe (Embree 4 API: all device functions
@@ -75,6 +79,16 @@ unsafe extern "C" fn error_callback(
     }
 }
 
+unsafe extern "C" fn memory_callback(user: *mut c_void, bytes: isize, _post: bool) -> bool {
+    // SAFETY: `user` is the address of the boxed AtomicI64 owned by the
+    // DeviceInner that registered this callback, alive as long as the device.
+    let counter = unsafe { &*(user as *const AtomicI64) };
+    // Embree reports allocations as positive and frees as negative sizes;
+    // returning true lets every allocation proceed.
+    counter.fetch_add(bytes as i64, Ordering::Relaxed);
+    true
+}
+
 impl Device {
     /// Creates a device with Embree's default configuration.
     pub fn new() -> Result<Self, EmbreeError> {
@@ -109,9 +123,28 @@ impl Device {
                 &*errors as *const ErrorSlot as *mut c_void,
             )
         };
+        let memory = Box::new(AtomicI64::new(0));
+        // SAFETY: as for the error function: the user pointer is the boxed
+        // counter, kept alive and in place by DeviceInner until release.
+        unsafe {
+            sys::rtcSetDeviceMemoryMonitorFunction(
+                raw,
+                Some(memory_callback),
+                &*memory as *const AtomicI64 as *mut c_void,
+            )
+        };
         Ok(Self {
-            inner: Arc::new(DeviceInner { raw, errors }),
+            inner: Arc::new(DeviceInner {
+                raw,
+                errors,
+                memory,
+            }),
         })
+    }
+
+    /// Whether both handles name the same Embree device.
+    pub fn same_as(&self, other: &Device) -> bool {
+        Arc::ptr_eq(&self.inner, &other.inner)
     }
 
     pub(crate) fn raw(&self) -> sys::RTCDevice {
@@ -127,6 +160,12 @@ impl Device {
                 message: "error slot poisoned".into(),
             }),
         }
+    }
+
+    /// Bytes Embree currently holds on this device (its BVHs and internal
+    /// data; shared buffers are not counted, they belong to the caller).
+    pub fn memory_in_use(&self) -> i64 {
+        self.inner.memory.load(Ordering::Relaxed)
     }
 
     /// Embree's version as `major * 10000 + minor * 100 + patch`.

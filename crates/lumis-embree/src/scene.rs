@@ -16,6 +16,16 @@ pub enum BuildQuality {
     High,
 }
 
+impl BuildQuality {
+    fn raw(self) -> sys::RTCBuildQuality {
+        match self {
+            BuildQuality::Low => sys::RTCBuildQuality::LOW,
+            BuildQuality::Medium => sys::RTCBuildQuality::MEDIUM,
+            BuildQuality::High => sys::RTCBuildQuality::HIGH,
+        }
+    }
+}
+
 /// Scene-wide settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct SceneOptions {
@@ -44,8 +54,11 @@ pub struct Hit {
     pub v: f32,
     /// Unnormalized geometric normal (for triangles `(v1 - v0) x (v2 - v0)`).
     pub ng: [f32; 3],
+    /// The geometry within the instanced scene when `inst_id` is set.
     pub geom_id: u32,
     pub prim_id: u32,
+    /// The instance hit ([`crate::INVALID_ID`] for geometry of the top scene).
+    pub inst_id: u32,
 }
 
 /// What the scene keeps alive because Embree reads it in place.
@@ -56,6 +69,9 @@ enum SharedStorage {
     },
     Spheres {
         _points: Arc<PaddedBuffer<SpherePoint>>,
+    },
+    Instance {
+        _scene: Arc<Scene>,
     },
 }
 
@@ -81,6 +97,12 @@ unsafe impl Send for Scene {}
 // SAFETY: as above.
 unsafe impl Sync for Scene {}
 
+// SAFETY: the builder owns its uncommitted scene exclusively (it is neither
+// Clone nor shared), and Embree allows different scenes to be built and
+// committed from different threads; moving it to another thread moves that
+// exclusive ownership. It is not Sync: `&SceneBuilder` gives no access.
+unsafe impl Send for SceneBuilder {}
+
 impl SceneBuilder {
     pub fn new(device: &Device, options: SceneOptions) -> Result<Self, EmbreeError> {
         // SAFETY: the device is alive for the call (and for the scene: it is
@@ -94,11 +116,7 @@ impl SceneBuilder {
         if options.compact {
             flags |= sys::RTCSceneFlags::COMPACT;
         }
-        let quality = match options.quality {
-            BuildQuality::Low => sys::RTCBuildQuality::LOW,
-            BuildQuality::Medium => sys::RTCBuildQuality::MEDIUM,
-            BuildQuality::High => sys::RTCBuildQuality::HIGH,
-        };
+        let quality = options.quality.raw();
         // SAFETY: `raw` is the scene just created.
         unsafe {
             sys::rtcSetSceneFlags(raw, flags);
@@ -114,11 +132,44 @@ impl SceneBuilder {
     }
 
     fn geometry_quality(&self) -> sys::RTCBuildQuality {
-        match self.options.quality {
-            BuildQuality::Low => sys::RTCBuildQuality::LOW,
-            BuildQuality::Medium => sys::RTCBuildQuality::MEDIUM,
-            BuildQuality::High => sys::RTCBuildQuality::HIGH,
+        self.options.quality.raw()
+    }
+
+    /// Adds an instance of a committed `scene` (a prototype), placed by the
+    /// affine `transform` (3x4, column-major: the three basis columns, then
+    /// the translation). The prototype's BVH and buffers are shared by all
+    /// its instances; hits inside it report this instance's id as `inst_id`.
+    pub fn add_instance(
+        &mut self,
+        scene: Arc<Scene>,
+        transform: &[f32; 12],
+    ) -> Result<u32, EmbreeError> {
+        if !scene.device.same_as(&self.device) {
+            return Err(EmbreeError {
+                code: "INVALID_ARGUMENT".into(),
+                message: "an instanced scene must come from the same device".into(),
+            });
         }
+        // SAFETY: the device is alive; the geometry is attached (or released
+        // on error) in `attach`.
+        let geometry =
+            unsafe { sys::rtcNewGeometry(self.device.raw(), sys::RTCGeometryType::INSTANCE) };
+        self.device.take_error()?;
+        // SAFETY: `scene` is committed and kept alive by `storage` as long as
+        // this scene exists; the transform is 12 floats in the format given,
+        // copied by Embree during the call.
+        unsafe {
+            sys::rtcSetGeometryInstancedScene(geometry, scene.raw);
+            sys::rtcSetGeometryTransform(
+                geometry,
+                0,
+                sys::RTCFormat::FLOAT3X4_COLUMN_MAJOR,
+                transform.as_ptr().cast(),
+            );
+        }
+        let id = self.attach_with(geometry, false)?;
+        self.storage.push(SharedStorage::Instance { _scene: scene });
+        Ok(id)
     }
 
     /// Adds a triangle mesh that reads `vertices` and `indices` in place.
@@ -204,11 +255,23 @@ impl SceneBuilder {
 
     /// Commits and attaches a new geometry, then drops our reference to it.
     fn attach(&mut self, geometry: sys::RTCGeometry) -> Result<u32, EmbreeError> {
+        self.attach_with(geometry, true)
+    }
+
+    /// As [`Self::attach`]; `with_quality` sets the geometry's own build
+    /// quality (meaningful for primitives, not for instances).
+    fn attach_with(
+        &mut self,
+        geometry: sys::RTCGeometry,
+        with_quality: bool,
+    ) -> Result<u32, EmbreeError> {
         // SAFETY: `geometry` is live and its buffers are set; after
         // rtcAttachGeometry the scene holds a reference, so releasing ours is
         // the documented ownership pattern.
         let id = unsafe {
-            sys::rtcSetGeometryBuildQuality(geometry, self.geometry_quality());
+            if with_quality {
+                sys::rtcSetGeometryBuildQuality(geometry, self.geometry_quality());
+            }
             sys::rtcCommitGeometry(geometry);
             let id = sys::rtcAttachGeometry(self.raw, geometry);
             sys::rtcReleaseGeometry(geometry);
@@ -313,6 +376,7 @@ impl Scene {
             ng: [rayhit.hit.Ng_x, rayhit.hit.Ng_y, rayhit.hit.Ng_z],
             geom_id: rayhit.hit.geomID,
             prim_id: rayhit.hit.primID,
+            inst_id: rayhit.hit.instID[0],
         })
     }
 
@@ -386,6 +450,7 @@ mod tests {
         assert!((hit.t - 2.0).abs() < 1e-6);
         assert_eq!(hit.geom_id, 0);
         assert_eq!(hit.prim_id, 0);
+        assert_eq!(hit.inst_id, crate::INVALID_ID);
         // p = (1-u-v) v0 + u v1 + v v2 = (0.5, -0.5): u = 0.5, v = 0.25.
         assert!(
             (hit.u - 0.5).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6,
@@ -434,6 +499,46 @@ mod tests {
             )
             .unwrap_err();
         assert!(err.message.contains("out of range"), "{err}");
+    }
+
+    #[test]
+    fn instances_share_one_prototype_and_report_their_id() {
+        let device = Device::new().unwrap();
+        let prototype = Arc::new(unit_quad(&device));
+        let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        let mut moved = identity;
+        moved[9] = 10.0; // translate by +10 in x
+        let a = builder.add_instance(prototype.clone(), &identity).unwrap();
+        let b = builder.add_instance(prototype, &moved).unwrap();
+        let scene = builder.commit().unwrap();
+        let down = [0.0, 0.0, -1.0];
+        let hit_a = scene
+            .intersect1(&ray([0.5, -0.5, 2.0], down, f32::INFINITY))
+            .unwrap();
+        let hit_b = scene
+            .intersect1(&ray([10.5, -0.5, 2.0], down, f32::INFINITY))
+            .unwrap();
+        assert_eq!((hit_a.inst_id, hit_b.inst_id), (a, b));
+        assert_eq!((hit_a.geom_id, hit_b.geom_id), (0, 0));
+        // Same object-space point, so the same primitive and barycentrics.
+        assert_eq!(
+            (hit_a.prim_id, hit_a.u, hit_a.v),
+            (hit_b.prim_id, hit_b.u, hit_b.v)
+        );
+        assert!(scene
+            .intersect1(&ray([5.0, 0.0, 2.0], down, f32::INFINITY))
+            .is_none());
+        assert!(scene.occluded1(&ray([10.0, 0.0, 1.0], down, 2.0)));
+    }
+
+    #[test]
+    fn memory_monitor_counts_the_bvh() {
+        let device = Device::new().unwrap();
+        let before = device.memory_in_use();
+        let scene = unit_quad(&device);
+        assert!(device.memory_in_use() > before);
+        drop(scene);
     }
 
     #[test]

@@ -5,8 +5,11 @@
 //! the [`Registry`], loads geometry into Embree, and creates an area light
 //! for every emissive shape.
 
+mod gltf;
 mod render_scene;
+mod report;
 mod shapes;
+mod transform;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -17,12 +20,13 @@ use lumis_core::{
     Bsdf, Error, Integrator, Light, LightKind, LightSampler, LightShape, Location, ParamSpec,
     ParamType, Params, Registry, Result, Sampler, UVec2, Vec3,
 };
-use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
+use lumis_embree::{BuildQuality, Device, PaddedBuffer, SceneBuilder, SceneOptions};
 use lumis_render::PerspectiveCamera;
 
-pub use render_scene::{RenderScene, SceneCounts};
+pub use render_scene::{LoadReport, RenderScene, SceneCounts};
 
-use render_scene::{Geometry, NO_LIGHT};
+use render_scene::{Geometry, MeshData, Prototype, NO_LIGHT};
+use report::Phase;
 use shapes::{ShapeDesc, ShapeGeometry, SHAPE_TYPES};
 
 /// Everything `lumis render` needs.
@@ -49,7 +53,46 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "light",
     "seed",
     "plugins",
+    "accel",
 ];
+
+const ACCEL_PARAMS: &[ParamSpec] = &[
+    ParamSpec::with_default(
+        "quality",
+        ParamType::String,
+        "\"medium\"",
+        "Embree BVH build quality: \"low\" (fastest build, Morton), \"medium\" (binned SAH), \"high\" (SAH with spatial splits: slower build, faster rays)",
+    )
+    .one_of(&["low", "medium", "high"]),
+    ParamSpec::with_default(
+        "robust",
+        ParamType::Bool,
+        "false",
+        "RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping through shared edges) at some cost in speed",
+    ),
+    ParamSpec::with_default(
+        "compact",
+        ParamType::Bool,
+        "false",
+        "RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed",
+    ),
+];
+
+/// A scene under construction: the Embree builder and everything shading
+/// will index by the geometry ids Embree hands out.
+pub(crate) struct Assembly<'r> {
+    pub registry: &'r Registry,
+    pub device: Device,
+    pub options: SceneOptions,
+    pub builder: SceneBuilder,
+    /// Indexed by top-level geometry id: one entry per `builder.add_*`.
+    pub geometries: Vec<Geometry>,
+    pub prototypes: Vec<Prototype>,
+    pub lights: Vec<Box<dyn Light>>,
+    pub bsdfs: Vec<(String, Arc<dyn Bsdf>)>,
+    pub counts: SceneCounts,
+    pub report: LoadReport,
+}
 
 const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
     "load",
@@ -117,7 +160,9 @@ pub fn load_str(
     overrides: &[String],
     registry: &Registry,
 ) -> Result<LoadedScene> {
+    let parse_start = std::time::Instant::now();
     let mut root = doc::parse(text, label)?;
+    let parse_time = parse_start.elapsed();
     for assignment in overrides {
         doc::apply_override(&mut root, assignment)?;
     }
@@ -135,11 +180,24 @@ pub fn load_str(
 
     let (camera, output) = film_and_camera(&root, &file_location, dir)?;
     let bsdfs = named_bsdfs(&root, registry)?;
-    let mut builder =
-        SceneBuilder::new(&device()?, SceneOptions::default()).map_err(embree_error)?;
-    let mut geometries = Vec::new();
-    let mut lights: Vec<Box<dyn Light>> = Vec::new();
-    let mut counts = SceneCounts::default();
+    let device = device()?;
+    let options = accel_options(&root)?;
+    let mut asm = Assembly {
+        registry,
+        builder: SceneBuilder::new(&device, options).map_err(embree_error)?,
+        device,
+        options,
+        geometries: Vec::new(),
+        prototypes: Vec::new(),
+        lights: Vec::new(),
+        bsdfs,
+        counts: SceneCounts::default(),
+        report: LoadReport {
+            parse: parse_time,
+            ..LoadReport::default()
+        },
+    };
+    let memory_before = asm.device.memory_in_use();
 
     for (i, (table, location)) in tables_in(&root, "shape")?.into_iter().enumerate() {
         let owner = format!("[[shape]] #{}", i + 1);
@@ -151,26 +209,40 @@ pub fn load_str(
             .ok_or_else(|| shapes::unknown_shape_type(kind, &kind_location))?;
         let owner = format!("{owner} (type = \"{kind}\")");
         let params = Params::new(owner.clone(), table, location.clone(), spec, &["type"])?;
-        let desc = shapes::parse_shape(kind, &params, table, dir)?;
+        if kind == "gltf" {
+            let shape = gltf::parse(&owner, &params, table, dir)?;
+            params.finish()?;
+            gltf::add(&owner, shape, &mut asm)?;
+            continue;
+        }
+        let desc = asm.report.time(Phase::Parse, || {
+            shapes::parse_shape(kind, &params, table, dir)
+        })?;
         params.finish()?;
-        let geometry = add_shape(
-            &owner,
-            desc,
-            &bsdfs,
-            registry,
-            &mut builder,
-            &mut lights,
-            &mut counts,
-        )?;
-        geometries.push(geometry);
+        let geometry = add_shape(&owner, desc, &mut asm)?;
+        asm.geometries.push(geometry);
     }
+    let Assembly {
+        builder,
+        device,
+        mut geometries,
+        prototypes,
+        mut lights,
+        bsdfs,
+        mut counts,
+        mut report,
+        ..
+    } = asm;
 
     for (i, (table, location)) in tables_in(&root, "light")?.into_iter().enumerate() {
         let light = PluginTable::new(format!("[[light]] #{}", i + 1), table, location)?;
         lights.push(registry.create_light(&light.as_ref(), &LightShape::None)?);
     }
 
-    let embree = builder.commit().map_err(embree_error)?;
+    let embree = report.time(Phase::Bvh, || builder.commit().map_err(embree_error))?;
+    report.bvh_bytes = (device.memory_in_use() - memory_before).max(0) as usize;
+    report.geometry_bytes = geometry_bytes(&geometries, &prototypes);
+    geometries.shrink_to_fit();
     let (center, radius) = render_scene::bounding_sphere(&embree);
     let infinite_lights = classify_lights(&mut lights, center, radius, &mut counts);
     let light_sampler = light_sampler_of(&root, registry, &lights)?;
@@ -182,11 +254,13 @@ pub fn load_str(
     let scene = RenderScene {
         embree,
         geometries,
+        prototypes,
         bsdfs: bsdfs.into_iter().map(|(_, b)| b).collect(),
         lights,
         infinite_lights,
         light_sampler,
         counts,
+        report,
     };
     Ok(LoadedScene {
         name: name.to_string(),
@@ -197,6 +271,47 @@ pub fn load_str(
         seed,
         output,
     })
+}
+
+/// Bytes of geometry data held for shading and shared with Embree.
+fn geometry_bytes(geometries: &[Geometry], prototypes: &[Prototype]) -> usize {
+    let own: usize = geometries
+        .iter()
+        .map(|g| match g {
+            Geometry::Mesh(m) => m.byte_size(),
+            Geometry::Instance { lights, .. } => {
+                lights.iter().map(|l| l.capacity() * 4).sum::<usize>()
+                    + std::mem::size_of::<Geometry>()
+            }
+            Geometry::Sphere { .. } => std::mem::size_of::<Geometry>(),
+        })
+        .sum();
+    own + prototypes
+        .iter()
+        .flat_map(|p| &p.meshes)
+        .map(MeshData::byte_size)
+        .sum::<usize>()
+}
+
+/// The `[accel]` table: Embree build quality and scene flags.
+fn accel_options(root: &Table) -> Result<SceneOptions> {
+    let Some(node) = root.get("accel") else {
+        return Ok(SceneOptions::default());
+    };
+    let table = as_table(node, "accel")?;
+    let params = Params::new("[accel]", table, node.location.clone(), ACCEL_PARAMS, &[])?;
+    let quality = match params.get_choice("quality")?.as_str() {
+        "low" => BuildQuality::Low,
+        "high" => BuildQuality::High,
+        _ => BuildQuality::Medium,
+    };
+    let options = SceneOptions {
+        quality,
+        robust: params.get("robust")?,
+        compact: params.get("compact")?,
+    };
+    params.finish()?;
+    Ok(options)
 }
 
 fn check_top_level_keys(root: &Table) -> Result<()> {
@@ -451,10 +566,14 @@ fn film_and_camera(
 
     let (table, location) = required_table(root, "camera", file)?;
     let (kind, kind_location) = type_of(table, &location, "[camera]")?;
+    if kind == "gltf" {
+        let camera = gltf::camera::from_table(table, location, dir, resolution)?;
+        return Ok((camera, output));
+    }
     if kind != "perspective" {
         return Err(Error::at(
             &kind_location,
-            format!("unknown camera type \"{kind}\"; available: perspective"),
+            format!("unknown camera type \"{kind}\"; available: perspective, gltf"),
         ));
     }
     let cam = Params::new(
@@ -523,15 +642,16 @@ fn named_bsdfs(root: &Table, registry: &Registry) -> Result<Vec<(String, Arc<dyn
 }
 
 /// Adds one shape to Embree and creates its area lights.
-fn add_shape(
-    owner: &str,
-    desc: ShapeDesc,
-    bsdfs: &[(String, Arc<dyn Bsdf>)],
-    registry: &Registry,
-    builder: &mut SceneBuilder,
-    lights: &mut Vec<Box<dyn Light>>,
-    counts: &mut SceneCounts,
-) -> Result<Geometry> {
+fn add_shape(owner: &str, desc: ShapeDesc, asm: &mut Assembly) -> Result<Geometry> {
+    let Assembly {
+        registry,
+        builder,
+        lights,
+        bsdfs,
+        counts,
+        ..
+    } = asm;
+    let registry: &Registry = registry;
     let bsdf = bsdfs
         .iter()
         .position(|(n, _)| *n == desc.bsdf)
@@ -628,20 +748,22 @@ fn add_shape(
             };
             counts.meshes += 1;
             counts.triangles += indices.len();
+            counts.unique_triangles += indices.len();
             counts.shading_normals |= normals.is_some();
             let vertices = Arc::new(PaddedBuffer::new(positions));
             let indices = Arc::new(PaddedBuffer::new(indices));
             builder
                 .add_triangle_mesh(vertices.clone(), indices.clone())
                 .map_err(|e| Error::msg(format!("{owner}: {e}")))?;
-            Ok(Geometry::Mesh {
+            Ok(Geometry::Mesh(MeshData {
                 vertices,
                 indices,
                 normals,
+                uvs: None,
                 bsdf,
                 lights: light_indices,
                 orientation,
-            })
+            }))
         }
         ShapeGeometry::Sphere { center, radius } => {
             let light = make_light(

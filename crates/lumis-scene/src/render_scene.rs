@@ -2,29 +2,102 @@
 
 use std::sync::Arc;
 
+use lumis_core::glam::Mat3;
 use lumis_core::interaction::HitLight;
 use lumis_core::math::{gamma, Frame};
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{Bsdf, Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3};
-use lumis_embree::{PaddedBuffer, Triangle, Vertex};
+use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID};
 
-/// Marks a triangle without an area light in [`Geometry::Mesh::lights`].
+pub use crate::report::LoadReport;
+
+/// Marks a triangle without an area light in [`MeshData::lights`].
 pub(crate) const NO_LIGHT: u32 = u32::MAX;
+
+/// A triangle mesh as shading sees it; its buffers are the ones Embree reads.
+pub(crate) struct MeshData {
+    pub vertices: Arc<PaddedBuffer<Vertex>>,
+    pub indices: Arc<PaddedBuffer<Triangle>>,
+    /// Per-vertex shading normals; `None` means flat shading (and no
+    /// interpolation cost).
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, stored only when the material reads
+    /// them; without them a hit's uv is its barycentric coordinates.
+    pub uvs: Option<Vec<Vec2>>,
+    pub bsdf: u32,
+    /// Light index per triangle (`NO_LIGHT` if none); empty when the
+    /// mesh does not emit. Always empty in a [`Prototype`], whose lights
+    /// differ per instance.
+    pub lights: Vec<u32>,
+    /// -1 flips the geometric normal (and so the front side).
+    pub orientation: f32,
+}
+
+impl MeshData {
+    /// Bytes of per-vertex and per-triangle data this mesh holds.
+    pub fn byte_size(&self) -> usize {
+        self.vertices.byte_size()
+            + self.indices.byte_size()
+            + self
+                .normals
+                .as_ref()
+                .map_or(0, |n| n.capacity() * std::mem::size_of::<Vec3>())
+            + self
+                .uvs
+                .as_ref()
+                .map_or(0, |n| n.capacity() * std::mem::size_of::<Vec2>())
+            + self.lights.capacity() * std::mem::size_of::<u32>()
+    }
+}
+
+/// A mesh built once in its own Embree scene and placed by instances; its
+/// meshes are indexed by the geometry id within that scene.
+pub(crate) struct Prototype {
+    pub meshes: Vec<MeshData>,
+}
+
+/// An affine placement of a prototype, with what shading needs to bring
+/// object-space hits into world space.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Placement {
+    pub linear: Mat3,
+    pub translation: Vec3,
+    /// Inverse transpose of `linear`, for normals.
+    pub normal: Mat3,
+}
+
+impl Placement {
+    /// pbrt-v4 `Transform::operator()(Point3fi)`: the transformed point
+    /// and a bound on its rounding error, given the error of `p`.
+    #[inline]
+    fn point(&self, p: Vec3, error: Vec3) -> (Vec3, Vec3) {
+        let abs = Mat3::from_cols(
+            self.linear.x_axis.abs(),
+            self.linear.y_axis.abs(),
+            self.linear.z_axis.abs(),
+        );
+        let q = self.linear * p + self.translation;
+        let e =
+            (gamma(3) + 1.0) * (abs * error) + gamma(3) * (abs * p.abs() + self.translation.abs());
+        (q, e)
+    }
+
+    #[inline]
+    fn normal(&self, n: Vec3) -> Vec3 {
+        (self.normal * n).normalize()
+    }
+}
 
 /// Per-geometry shading data, indexed by Embree geometry id.
 pub(crate) enum Geometry {
-    Mesh {
-        vertices: Arc<PaddedBuffer<Vertex>>,
-        indices: Arc<PaddedBuffer<Triangle>>,
-        /// Per-vertex shading normals; `None` means flat shading (and no
-        /// interpolation cost).
-        normals: Option<Vec<Vec3>>,
-        bsdf: u32,
-        /// Light index per triangle (`NO_LIGHT` if none); empty when the
-        /// mesh does not emit.
-        lights: Vec<u32>,
-        /// -1 flips the geometric normal (and so the front side).
-        orientation: f32,
+    Mesh(MeshData),
+    /// An Embree instance of `prototypes[prototype]`.
+    Instance {
+        prototype: u32,
+        placement: Placement,
+        /// Per prototype mesh, the light index per triangle of this
+        /// instance (world-space triangle lights); empty when none emits.
+        lights: Vec<Vec<u32>>,
     },
     Sphere {
         center: Vec3,
@@ -45,21 +118,35 @@ pub struct SceneCounts {
     pub delta_lights: usize,
     pub infinite_lights: usize,
     pub shading_normals: bool,
+    /// Embree instances (glTF meshes referenced by several nodes).
+    pub instances: usize,
+    /// Meshes built once and instanced.
+    pub prototypes: usize,
+    /// Triangles stored (each instanced mesh once); `triangles` counts
+    /// every instance.
+    pub unique_triangles: usize,
 }
 
 pub struct RenderScene {
     pub(crate) embree: lumis_embree::Scene,
     pub(crate) geometries: Vec<Geometry>,
+    pub(crate) prototypes: Vec<Prototype>,
     pub(crate) bsdfs: Vec<Arc<dyn Bsdf>>,
     pub(crate) lights: Vec<Box<dyn Light>>,
     pub(crate) infinite_lights: Vec<u32>,
     pub(crate) light_sampler: Box<dyn LightSampler>,
     pub(crate) counts: SceneCounts,
+    pub(crate) report: LoadReport,
 }
 
 impl RenderScene {
     pub fn counts(&self) -> &SceneCounts {
         &self.counts
+    }
+
+    /// Load times and memory, for the start-up report.
+    pub fn load_report(&self) -> &LoadReport {
+        &self.report
     }
 
     /// The Embree scene, for benchmarks that trace the same rays bare.
@@ -101,6 +188,81 @@ fn to_embree(ray: &Ray) -> lumis_embree::Ray {
     }
 }
 
+impl RenderScene {
+    /// A hit inside an instance: shaded in object space, then placed.
+    #[inline]
+    fn instance_hit(&self, hit: &Hit, wo: Vec3) -> SurfaceInteraction<'_> {
+        let Geometry::Instance {
+            prototype,
+            placement,
+            lights,
+        } = &self.geometries[hit.inst_id as usize]
+        else {
+            unreachable!("inst_id names an instance geometry")
+        };
+        let mesh = &self.prototypes[*prototype as usize].meshes[hit.geom_id as usize];
+        let (local, ns, uv) = mesh_hit(mesh, hit);
+        let (p, p_error) = placement.point(local.p, local.p_error);
+        let n = placement.normal(local.n);
+        let ns = placement.normal(ns);
+        let ns = if ns.dot(n) < 0.0 { -ns } else { ns };
+        let light = lights
+            .get(hit.geom_id as usize)
+            .and_then(|l| l.get(hit.prim_id as usize))
+            .and_then(|&i| self.light_ref(i));
+        SurfaceInteraction {
+            point: SurfacePoint { p, p_error, n },
+            t: hit.t,
+            shading: Frame::from_z(ns),
+            uv,
+            wo,
+            bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
+            light,
+        }
+    }
+}
+
+/// The hit point (recomputed from barycentrics, with its error bound), the
+/// shading normal on a mesh, in the mesh's own space, and the uv.
+#[inline]
+fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3, Vec2) {
+    let tri = mesh.indices[hit.prim_id as usize];
+    let vertices: &[Vertex] = &mesh.vertices;
+    let [p0, p1, p2] = tri.map(|i| Vec3::from(vertices[i as usize]));
+    let (b1, b2) = (hit.u, hit.v);
+    let b0 = 1.0 - b1 - b2;
+    // Recompute the hit from barycentrics and bound its error
+    // (pbrt-v4 Triangle::InteractionFromIntersection, eq. 6.37):
+    // the ray origin offset then needs no scene-scale epsilon.
+    let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
+    let p = q0 + q1 + q2;
+    let p_error = gamma(7) * (q0.abs() + q1.abs() + q2.abs());
+    let n = (p1 - p0).cross(p2 - p0).normalize() * mesh.orientation;
+    let ns = match &mesh.normals {
+        Some(ns) => {
+            let [n0, n1, n2] = tri.map(|i| ns[i as usize]);
+            let s = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
+            // Keep the shading normal on the geometric side.
+            if s == Vec3::ZERO {
+                n
+            } else if s.dot(n) < 0.0 {
+                -s
+            } else {
+                s
+            }
+        }
+        None => n,
+    };
+    let uv = match &mesh.uvs {
+        Some(uvs) => {
+            let [t0, t1, t2] = tri.map(|i| uvs[i as usize]);
+            t0 * b0 + t1 * b1 + t2 * b2
+        }
+        None => Vec2::new(b1, b2),
+    };
+    (SurfacePoint { p, p_error, n }, ns, uv)
+}
+
 impl Scene for RenderScene {
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
@@ -110,55 +272,27 @@ impl Scene for RenderScene {
         );
         let hit = self.embree.intersect1(&to_embree(ray))?;
         let wo = -ray.d;
+        if hit.inst_id != INVALID_ID {
+            return Some(self.instance_hit(&hit, wo));
+        }
         match &self.geometries[hit.geom_id as usize] {
-            Geometry::Mesh {
-                vertices,
-                indices,
-                normals,
-                bsdf,
-                lights,
-                orientation,
-            } => {
-                let tri = indices[hit.prim_id as usize];
-                let vertices: &[Vertex] = vertices;
-                let [p0, p1, p2] = tri.map(|i| Vec3::from(vertices[i as usize]));
-                let (b1, b2) = (hit.u, hit.v);
-                let b0 = 1.0 - b1 - b2;
-                // Recompute the hit from barycentrics and bound its error
-                // (pbrt-v4 Triangle::InteractionFromIntersection, eq. 6.37):
-                // the ray origin offset then needs no scene-scale epsilon.
-                let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
-                let p = q0 + q1 + q2;
-                let p_error = gamma(7) * (q0.abs() + q1.abs() + q2.abs());
-                let n = (p1 - p0).cross(p2 - p0).normalize() * *orientation;
-                let ns = match normals {
-                    Some(ns) => {
-                        let [n0, n1, n2] = tri.map(|i| ns[i as usize]);
-                        let s = (n0 * b0 + n1 * b1 + n2 * b2).normalize_or_zero();
-                        // Keep the shading normal on the geometric side.
-                        if s == Vec3::ZERO {
-                            n
-                        } else if s.dot(n) < 0.0 {
-                            -s
-                        } else {
-                            s
-                        }
-                    }
-                    None => n,
-                };
-                let light = lights
+            Geometry::Mesh(mesh) => {
+                let (point, ns, uv) = mesh_hit(mesh, &hit);
+                let light = mesh
+                    .lights
                     .get(hit.prim_id as usize)
                     .and_then(|&i| self.light_ref(i));
                 Some(SurfaceInteraction {
-                    point: SurfacePoint { p, p_error, n },
+                    point,
                     t: hit.t,
                     shading: Frame::from_z(ns),
-                    uv: Vec2::new(b1, b2),
+                    uv,
                     wo,
-                    bsdf: self.bsdfs[*bsdf as usize].as_ref(),
+                    bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
                     light,
                 })
             }
+            Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
             Geometry::Sphere {
                 center,
                 radius,

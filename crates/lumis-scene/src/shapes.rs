@@ -1,4 +1,5 @@
-//! `[[shape]]` tables: quads, inline meshes, OBJ files and spheres.
+//! `[[shape]]` tables: quads, inline meshes, OBJ files and spheres (glTF
+//! assets have their own module, [`crate::gltf`]).
 
 use std::path::Path;
 
@@ -87,6 +88,7 @@ pub(crate) const SHAPE_TYPES: &[(&str, &[ParamSpec])] = &[
     ("mesh", MESH_PARAMS),
     ("obj", OBJ_PARAMS),
     ("sphere", SPHERE_PARAMS),
+    ("gltf", crate::gltf::GLTF_PARAMS),
 ];
 
 /// Parses one shape table whose `type` is `kind`.

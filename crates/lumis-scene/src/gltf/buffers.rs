@@ -1,0 +1,118 @@
+//! Reading a glTF asset: the JSON (or GLB container) and its buffers.
+//!
+//! The `gltf` crate's `import` feature would do this but pulls in image
+//! decoding; lumis reads the three buffer sources itself (the GLB binary
+//! chunk, files next to the asset, base64 data URIs) and checks each
+//! buffer's length against its declaration, so a truncated `.bin` is an
+//! error naming the file and the buffer instead of a short read later.
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use gltf::buffer::Source;
+
+/// A parsed and validated glTF document with its buffer data.
+pub(crate) struct Asset {
+    pub document: gltf::Document,
+    /// Buffer `i`'s bytes, at least as long as it declares.
+    pub buffers: Vec<Vec<u8>>,
+    /// The asset's path as the user wrote it, for messages.
+    pub label: String,
+}
+
+impl Asset {
+    /// The bytes of buffer `index`.
+    pub fn buffer(&self, index: usize) -> &[u8] {
+        &self.buffers[index]
+    }
+}
+
+/// Reads and validates the JSON part only (cameras need no buffers).
+pub(crate) fn document(
+    path: &Path,
+    label: &str,
+) -> Result<(gltf::Document, Option<Vec<u8>>), String> {
+    let bytes =
+        std::fs::read(path).map_err(|e| format!("cannot read glTF '{}': {e}", path.display()))?;
+    let gltf = gltf::Gltf::from_slice(&bytes)
+        .map_err(|e| format!("'{label}' is not a valid glTF 2.0 file: {e}"))?;
+    Ok((gltf.document, gltf.blob))
+}
+
+/// Reads the asset and every buffer it declares.
+pub(crate) fn load(path: &Path, label: &str) -> Result<Asset, String> {
+    let (document, mut blob) = document(path, label)?;
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut buffers = Vec::with_capacity(document.buffers().len());
+    for buffer in document.buffers() {
+        let what = match buffer.name() {
+            Some(name) => format!("'{label}': buffer #{} (\"{name}\")", buffer.index()),
+            None => format!("'{label}': buffer #{}", buffer.index()),
+        };
+        let data = match buffer.source() {
+            Source::Bin => blob.take().ok_or_else(|| {
+                format!("{what} refers to the GLB binary chunk, which is missing")
+            })?,
+            Source::Uri(uri) => read_uri(uri, &dir).map_err(|e| format!("{what}: {e}"))?,
+        };
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "{what} declares {} bytes but holds only {} (truncated?)",
+                buffer.length(),
+                data.len()
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(Asset {
+        document,
+        buffers,
+        label: label.to_string(),
+    })
+}
+
+/// A buffer's bytes from a `data:` URI or a file relative to the asset.
+pub(crate) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, payload) = rest
+            .split_once(";base64,")
+            .ok_or("a data URI must be base64 encoded (data:...;base64,...)")?;
+        return base64::engine::general_purpose::STANDARD
+            .decode(payload)
+            .map_err(|e| format!("bad base64 in data URI: {e}"));
+    }
+    let path: PathBuf = dir.join(percent_decode(uri));
+    std::fs::read(&path).map_err(|e| format!("cannot read '{}': {e}", path.display()))
+}
+
+/// URIs in glTF are percent-encoded (`my%20mesh.bin`).
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%' && i + 2 < bytes.len() {
+            if let (Some(h), Some(l)) = (hex(bytes[i + 1]), hex(bytes[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn percent_decoding() {
+        assert_eq!(percent_decode("my%20mesh.bin"), "my mesh.bin");
+        assert_eq!(percent_decode("plain.bin"), "plain.bin");
+        assert_eq!(percent_decode("odd%2"), "odd%2");
+    }
+}
