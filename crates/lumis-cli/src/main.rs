@@ -6,9 +6,9 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, plugin_listing, registry_with_search_path,
-    render_reference, render_scene_file, AnalyzeArgs, ConvergeArgs, DiffArgs, ReferenceArgs,
-    RenderArgs,
+    analyze_samplers, converge, diff_images, plugin_listing, precompute_table,
+    registry_with_search_path, render_reference, render_scene_file, tabulate_bsdf, AnalyzeArgs,
+    ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
 };
 use lumis_core::{Error, PluginKind, Result};
 
@@ -69,6 +69,21 @@ enum Command {
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
+    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling.
+    #[command(subcommand)]
+    Brdf(BrdfCommand),
+}
+
+#[derive(Subcommand)]
+enum BrdfCommand {
+    /// Write an isotropic, reciprocal lumis BSDF as a MERL table (90 x 90 x
+    /// 180 samples of f over theta_h, theta_d, phi_d), e.g.
+    /// `lumis brdf tabulate --bsdf conductor --set roughness=0.2 -o metal.binary`.
+    Tabulate(TabulateArgs),
+    /// Run the precomputation of a sampling strategy of the `measured` BSDF
+    /// for a table (ignoring and replacing its cache); print its time and
+    /// memory.
+    Precompute(PrecomputeArgs),
 }
 
 #[derive(Subcommand)]
@@ -123,6 +138,16 @@ fn main() -> ExitCode {
             }),
         Command::Diff(args) => diff_images(&args).map(|report| {
             print!("{report}");
+            true
+        }),
+        Command::Brdf(BrdfCommand::Tabulate(args)) => registry_with_search_path()
+            .and_then(|registry| tabulate_bsdf(&args, &registry))
+            .map(|line| {
+                println!("{line}");
+                true
+            }),
+        Command::Brdf(BrdfCommand::Precompute(args)) => precompute_table(&args).map(|line| {
+            println!("{line}");
             true
         }),
         Command::Samplers(SamplersCommand::Analyze(args)) => registry_with_search_path()

@@ -7,10 +7,13 @@
 //! bin. Sampling inverts the CDF with a binary search; the density is
 //! `value / (integral * width)` inside a bin.
 
+use std::sync::Arc;
+
 /// A piecewise-constant density over `[edges[0], edges[n]]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Distribution1D {
-    edges: Vec<f32>,
+    /// Shared between distributions over the same bins (tables of them).
+    edges: Arc<[f32]>,
     /// Probability of each bin (sums to 1).
     mass: Vec<f32>,
     /// `cdf[i]` = probability of bins `< i`; `cdf[n] = 1`.
@@ -28,7 +31,8 @@ impl Distribution1D {
     ///
     /// Panics if `edges` is not increasing or has not `mass.len() + 1`
     /// entries (a programming error, not an input error).
-    pub fn new(edges: Vec<f32>, mass: &[f32]) -> Self {
+    pub fn new(edges: impl Into<Arc<[f32]>>, mass: &[f32]) -> Self {
+        let edges: Arc<[f32]> = edges.into();
         assert!(
             edges.len() == mass.len() + 1 && !mass.is_empty(),
             "Distribution1D: {} edges for {} bins",
@@ -41,7 +45,13 @@ impl Distribution1D {
         );
         let clean: Vec<f64> = mass
             .iter()
-            .map(|&m| if m.is_finite() && m > 0.0 { m as f64 } else { 0.0 })
+            .map(|&m| {
+                if m.is_finite() && m > 0.0 {
+                    m as f64
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let integral: f64 = clean.iter().sum();
         let n = mass.len();
@@ -145,9 +155,14 @@ impl Distribution1D {
         (x, self.bin_pdf(i), i)
     }
 
-    /// Bytes held (for memory reports).
+    /// Bytes held, not counting the (shareable) edges: for memory reports.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>() + 4 * (self.edges.len() + self.mass.len() + self.cdf.len())
+        std::mem::size_of::<Self>() + 4 * (self.mass.len() + self.cdf.len())
+    }
+
+    /// The masses it was built from, normalised (bin probabilities).
+    pub fn probabilities(&self) -> &[f32] {
+        &self.mass
     }
 }
 
@@ -167,7 +182,11 @@ mod tests {
         for _ in 0..n {
             let (x, pdf, i) = d.sample(rng.next_f32());
             assert_eq!(d.bin(x), Some(i), "x {x} in bin {i}");
-            assert!((pdf - d.pdf(x)).abs() <= 1e-5 * pdf, "{pdf} vs {}", d.pdf(x));
+            assert!(
+                (pdf - d.pdf(x)).abs() <= 1e-5 * pdf,
+                "{pdf} vs {}",
+                d.pdf(x)
+            );
             counts[i] += 1;
         }
         assert_eq!(counts[1], 0, "a bin of zero mass is never drawn");
