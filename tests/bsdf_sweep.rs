@@ -11,7 +11,9 @@
 //!   and from inside the medium (cos theta_o < 0, relative IOR inverted);
 //! - cos theta_o = 1e-4, 0.01, 0.1, 0.5, 1 and -1e-4, -0.5, -1.
 
-use lumis_check::bsdf_suite::{check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant};
+use lumis_check::bsdf_suite::{
+    check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
+};
 
 const ROUGHNESS: [f64; 6] = [1e-4, 1e-3, 0.01, 0.1, 0.5, 1.0];
 
@@ -88,7 +90,9 @@ fn dielectric_sweep() {
             for r in ROUGHNESS {
                 variants.push(v(
                     format!("eta {eta} {distribution} alpha {r}"),
-                    format!("int_ior = {eta:?}\ndistribution = \"{distribution}\"\nroughness = {r:?}\n"),
+                    format!(
+                        "int_ior = {eta:?}\ndistribution = \"{distribution}\"\nroughness = {r:?}\n"
+                    ),
                 ));
             }
         }

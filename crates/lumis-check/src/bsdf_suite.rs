@@ -28,8 +28,8 @@ use rayon::prelude::*;
 
 use crate::adapters::bsdf_pair;
 use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
-use crate::lobe_zoom::chi_square_zoomed;
 use crate::corrected_significance;
+use crate::lobe_zoom::chi_square_zoomed;
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]

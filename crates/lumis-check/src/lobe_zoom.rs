@@ -69,11 +69,7 @@ impl LobeZoom {
         } else {
             (-1.0, 0.0)
         };
-        (
-            DVec3::new(v.x / sin * sin2, v.y / sin * sin2, z),
-            r,
-            r2,
-        )
+        (DVec3::new(v.x / sin * sin2, v.y / sin * sin2, z), r, r2)
     }
 
     /// Local frame (pole = centre) -> the grid's frame (pole on the equator).

@@ -76,7 +76,11 @@ mod tests {
         for i in -999..=999 {
             let y = i as f64 / 1000.0;
             let x = erf_inv(y);
-            assert!((erf(x) - y).abs() < 1e-14, "y = {y}: erf(erf_inv) = {}", erf(x));
+            assert!(
+                (erf(x) - y).abs() < 1e-14,
+                "y = {y}: erf(erf_inv) = {}",
+                erf(x)
+            );
         }
         for y in [1.0 - 1e-12, -1.0 + 1e-12, 1e-300] {
             assert!((erf(erf_inv(y)) - y).abs() <= 1e-15 * y.abs().max(1e-3));

@@ -20,8 +20,8 @@ use lumis_core::{
 };
 
 use crate::fresnel::reflect;
-use crate::microfacet::half_vector;
 use crate::lobe_sampling::LobeSampling;
+use crate::microfacet::half_vector;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,

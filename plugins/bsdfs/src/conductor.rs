@@ -16,7 +16,9 @@ use lumis_core::{
 
 use crate::fresnel;
 use crate::lobe_sampling::LobeSampling;
-use crate::microfacet::{half_vector, Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_PARAM, ROUGHNESS_V_PARAM};
+use crate::microfacet::{
+    half_vector, Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_PARAM, ROUGHNESS_V_PARAM,
+};
 
 const METAL_CHOICES: &[&str] = &["none", "Ag", "Al", "Au", "Cr", "Cu", "Fe", "Pt"];
 
@@ -78,7 +80,10 @@ pub const MIRROR_SPEC: PluginSpec = PluginSpec {
 pub enum ConductorFresnel {
     /// Reflects everything at every angle (Fresnel = 1).
     Perfect,
-    Complex { eta: Rgb, k: Rgb },
+    Complex {
+        eta: Rgb,
+        k: Rgb,
+    },
 }
 
 impl ConductorFresnel {
@@ -105,10 +110,9 @@ impl ConductorFresnel {
             }),
             (Some(eta), Some(k)) => {
                 if params.is_given("material") {
-                    return Err(params.error(
-                        "material",
-                        "give either material or eta and k, not both",
-                    ));
+                    return Err(
+                        params.error("material", "give either material or eta and k, not both")
+                    );
                 }
                 if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
                     return Err(params.error(

@@ -311,7 +311,9 @@ mod tests {
         let g = Dielectric::new(1.0001, Microfacet::new(Distribution::Ggx, 0.5, 0.5));
         assert!(g.flags().is_specular());
         let wo = Vec3::new(0.0, 0.6, 0.8);
-        let s = g.sample_f(&BsdfContext::default(), wo, 0.5, Vec2::splat(0.5)).unwrap();
+        let s = g
+            .sample_f(&BsdfContext::default(), wo, 0.5, Vec2::splat(0.5))
+            .unwrap();
         assert!((s.wi + wo).length() < 1e-3, "passes straight through");
     }
 

@@ -174,7 +174,8 @@ impl Microfacet {
                     return 0.0;
                 }
                 let a = 1.0 / (a2t2 as f64).sqrt();
-                let l = 0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
+                let l =
+                    0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
                 l.max(0.0) as f32
             }
         }
@@ -359,7 +360,11 @@ mod tests {
     }
 
     fn direction(theta: f32, phi: f32) -> Vec3 {
-        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
     }
 
     /// Midpoint quadrature over the hemisphere in (theta, phi) with theta
@@ -439,7 +444,10 @@ mod tests {
         for u in [1e-6, 0.3, 0.999999] {
             let c = 0.01f64;
             let (x, _) = beckmann_visible_slopes(c, u, 0.5);
-            assert!(x.is_finite() && x <= c / (1.0 - c * c).sqrt() + 1e-9, "{u}: {x}");
+            assert!(
+                x.is_finite() && x <= c / (1.0 - c * c).sqrt() + 1e-9,
+                "{u}: {x}"
+            );
         }
     }
 }

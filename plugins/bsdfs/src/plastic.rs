@@ -35,15 +35,41 @@ pub const SPEC: PluginSpec = PluginSpec {
     name: "plastic",
     doc: "diffuse base under a smooth or rough dielectric coat; lobe choice by albedo; one-sided",
     params: &[
-        ParamSpec::with_default("diffuse_reflectance", ParamType::Rgb, "0.5", "albedo rho of the base, each channel in [0, 1]"),
-        ParamSpec::with_default("specular_reflectance", ParamType::Rgb, "1.0", "scale of the coat's reflection (1 is physical), in [0, 1]"),
-        ParamSpec::with_default("int_ior", ParamType::Float, "1.49", "index of refraction of the coat (polypropylene 1.49)")
-            .in_range(1.0, 5.0),
-        ParamSpec::with_default("ext_ior", ParamType::Float, "1.0", "index of refraction outside").in_range(1.0, 5.0),
+        ParamSpec::with_default(
+            "diffuse_reflectance",
+            ParamType::Rgb,
+            "0.5",
+            "albedo rho of the base, each channel in [0, 1]",
+        ),
+        ParamSpec::with_default(
+            "specular_reflectance",
+            ParamType::Rgb,
+            "1.0",
+            "scale of the coat's reflection (1 is physical), in [0, 1]",
+        ),
+        ParamSpec::with_default(
+            "int_ior",
+            ParamType::Float,
+            "1.49",
+            "index of refraction of the coat (polypropylene 1.49)",
+        )
+        .in_range(1.0, 5.0),
+        ParamSpec::with_default(
+            "ext_ior",
+            ParamType::Float,
+            "1.0",
+            "index of refraction outside",
+        )
+        .in_range(1.0, 5.0),
         DISTRIBUTION_PARAM,
         SMOOTH_ROUGHNESS_PARAM,
         ROUGHNESS_V_PARAM,
-        ParamSpec::with_default("nonlinear", ParamType::Bool, "false", "account for the colour shift of internal scattering (see the module docs)"),
+        ParamSpec::with_default(
+            "nonlinear",
+            ParamType::Bool,
+            "false",
+            "account for the colour shift of internal scattering (see the module docs)",
+        ),
     ],
 };
 
@@ -62,13 +88,7 @@ pub struct Plastic {
 }
 
 impl Plastic {
-    pub fn new(
-        diffuse: Rgb,
-        specular: Rgb,
-        eta: f32,
-        coat: Microfacet,
-        nonlinear: bool,
-    ) -> Self {
+    pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, coat: Microfacet, nonlinear: bool) -> Self {
         // Light inside the coat meets it from the side of index 1/eta.
         let fdr_int = fresnel::diffuse_reflectance(1.0 / eta);
         let rho = if nonlinear {
@@ -94,12 +114,20 @@ impl Plastic {
             ("specular_reflectance", specular),
         ] {
             if !(v.min_component() >= 0.0 && v.max_component() <= 1.0) {
-                return Err(params.error(name, format!("each channel must be in [0, 1], got {v:?}")));
+                return Err(
+                    params.error(name, format!("each channel must be in [0, 1], got {v:?}"))
+                );
             }
         }
         let eta = relative_ior(params)?;
         let coat = Microfacet::from_params(params)?;
-        Ok(Self::new(diffuse, specular, eta, coat, params.get("nonlinear")?))
+        Ok(Self::new(
+            diffuse,
+            specular,
+            eta,
+            coat,
+            params.get("nonlinear")?,
+        ))
     }
 
     /// Probability of sampling the coat from `wo`, which has Fresnel `fo`.
