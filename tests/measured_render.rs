@@ -17,7 +17,6 @@ use indicatif::ProgressBar;
 use lumis_analysis::image_error::error_metrics;
 use lumis_cli::{tabulate_bsdf, TabulateArgs};
 use lumis_core::{Bsdf, BsdfContext, Vec2, Vec3};
-use lumis_image::Image;
 use lumis_measured::grid::Grid;
 use lumis_measured::merl::MerlTable;
 use lumis_measured::precompute::{prepare, Plan};
@@ -132,7 +131,7 @@ fn tables_match_the_analytic_bsdfs_they_were_made_from() {
         for _ in 0..2000 {
             let dir = |rng: &mut Pcg32| {
                 let z = 0.2 + 0.8 * rng.next_f32();
-                let phi = 6.283 * rng.next_f32();
+                let phi = std::f32::consts::TAU * rng.next_f32();
                 let s = (1.0 - z * z).sqrt();
                 Vec3::new(s * phi.cos(), s * phi.sin(), z)
             };
@@ -158,6 +157,41 @@ fn tables_match_the_analytic_bsdfs_they_were_made_from() {
                 (am - ar).abs() < tol,
                 "{name} at cos {cos_o}: albedo {am} (table) vs {ar} (analytic)"
             );
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn every_strategy_estimates_the_same_albedo() {
+    // Unbiasedness where it can be measured sharply: the directional
+    // albedo of one table by each strategy, against the tabulated one.
+    let dir = temp_dir("albedo");
+    for (name, plugin, set, _) in MATERIALS {
+        let file = tabulated(&dir, name, plugin, set);
+        let make = |s: &str| {
+            bsdf(&format!(
+                "type = \"measured\"\nfile = \"{}\"\n{s}",
+                file.display()
+            ))
+        };
+        let reference = make("sampling = \"tabulated\"\n");
+        for s in [
+            "sampling = \"cosine\"\n",
+            "sampling = \"factored\"\nterms = 1\n",
+            "sampling = \"factored\"\nterms = 2\n",
+            "sampling = \"factored\"\nterms = 4\n",
+        ] {
+            let b = make(s);
+            for cos_o in [0.1f32, 0.5, 1.0] {
+                let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+                let (a, sa) = albedo(b.as_ref(), wo, 1_000_000);
+                let (r, sr) = albedo(reference.as_ref(), wo, 1_000_000);
+                assert!(
+                    (a - r).abs() < 6.0 * (sa * sa + sr * sr).sqrt() + 2e-3 * r,
+                    "{name} {s:?} at cos {cos_o}: albedo {a} +- {sa} vs tabulated {r} +- {sr}"
+                );
+            }
         }
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -261,23 +295,17 @@ fn scene_errors_name_the_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-fn mean_luminance(image: &Image) -> f64 {
-    let m = image.mean();
-    0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2]
-}
-
 /// One row of the results table.
 struct Row {
     strategy: String,
     rel_mse: Vec<f64>,
     psnr: Vec<f64>,
-    mean: Vec<f64>,
     seconds: f64,
     memory: usize,
 }
 
 const SPP: u32 = 64;
-const SEEDS: u64 = 4;
+const SEEDS: u64 = 8;
 const REFERENCE_SPP: u32 = 4096;
 
 #[test]
@@ -289,7 +317,8 @@ fn measured_results_table() {
         "scenes/measured-sphere.toml, {SPP} spp x {SEEDS} seeds, BSDF sampling only; reference {REFERENCE_SPP} spp (tabulated sampling for the tables, the model's own for the analytic BSDFs)\n"
     ));
     out.push_str("| material | strategy | relMSE | PSNR dB | precompute s | sampler memory |\n| --- | --- | --- | --- | --- | --- |\n");
-    let mut worst_cosine_over_factored = f64::INFINITY;
+    let mut glossy_cosine_over_factored = 0.0;
+    let mut worst_factored_over_analytic = 0.0f64;
     for (name, plugin, set, analytic) in MATERIALS {
         let file = tabulated(&dir, name, plugin, set);
         let table = MerlTable::read(&file).unwrap();
@@ -364,7 +393,6 @@ fn measured_results_table() {
                 strategy: label.clone(),
                 rel_mse: Vec::new(),
                 psnr: Vec::new(),
-                mean: Vec::new(),
                 seconds,
                 memory,
             };
@@ -373,7 +401,6 @@ fn measured_results_table() {
                 let m = error_metrics(&image, reference, None);
                 row.rel_mse.push(m.rel_mse);
                 row.psnr.push(m.psnr_db);
-                row.mean.push(mean_luminance(&image));
             }
             rows.push(row);
         }
@@ -403,30 +430,33 @@ fn measured_results_table() {
                 }
             ));
         }
-        // Every strategy of the table estimates the same image: its mean
-        // luminance agrees with the reference's within 5 standard errors
-        // of the seeds (plus the reference's own noise, bounded by 1%).
-        let ref_mean = mean_luminance(&measured_ref);
-        for r in rows.iter().filter(|r| r.strategy != "analytic model") {
-            let (m, s) = (avg(&r.mean), se(&r.mean));
-            assert!(
-                (m - ref_mean).abs() < 5.0 * s + 0.01 * ref_mean,
-                "{name} {}: mean {m} +- {s} vs reference {ref_mean}",
-                r.strategy
-            );
+        let rel = |label: &str| {
+            avg(&rows
+                .iter()
+                .find(|r| r.strategy == label)
+                .expect("row")
+                .rel_mse)
+        };
+        let factored = rel("factored L=2");
+        if name == "conductor-0.05" {
+            glossy_cosine_over_factored = rel("cosine") / factored;
         }
-        let cosine = avg(&rows[0].rel_mse);
-        let factored = avg(&rows[2].rel_mse);
-        if name.starts_with("conductor") {
-            worst_cosine_over_factored = worst_cosine_over_factored.min(cosine / factored);
-        }
+        worst_factored_over_analytic =
+            worst_factored_over_analytic.max(factored / rel("analytic model"));
     }
     println!("{out}");
     std::fs::remove_dir_all(&dir).unwrap();
-    // The point of the factorization: on the glossy tables, factored
-    // sampling (L = 2) beats cosine sampling by a wide margin.
+    // The point of the factorization, and the published claim (Lawrence et
+    // al. 2004, section 6): on the glossiest table factored sampling beats
+    // cosine sampling by a wide margin (measured: 12x), and on every table
+    // it comes within 1.3x of the analytic model's own sampling (measured:
+    // 1.02-1.13x; the standard errors are about 2%).
     assert!(
-        worst_cosine_over_factored > 3.0,
-        "cosine / factored relMSE only {worst_cosine_over_factored} on a conductor\n{out}"
+        glossy_cosine_over_factored > 4.0,
+        "cosine / factored relMSE only {glossy_cosine_over_factored} on conductor-0.05\n{out}"
+    );
+    assert!(
+        worst_factored_over_analytic < 1.3,
+        "factored / analytic relMSE up to {worst_factored_over_analytic}\n{out}"
     );
 }

@@ -204,8 +204,8 @@ mod tests {
     fn half_diff_round_trips() {
         let mut rng = Pcg32::new(7, 1);
         for _ in 0..1000 {
-            let wi = spherical_direction(rng.next_f32() * 1.5, rng.next_f32() * 6.28);
-            let wo = spherical_direction(rng.next_f32() * 1.5, rng.next_f32() * 6.28);
+            let wi = spherical_direction(rng.next_f32() * 1.5, rng.next_f32() * 2.0 * PI);
+            let wo = spherical_direction(rng.next_f32() * 1.5, rng.next_f32() * 2.0 * PI);
             let hd = HalfDiff::from_directions(wi, wo).unwrap();
             let (wi2, wo2) = hd.to_directions();
             assert!((wi - wi2).length() < 1e-4, "{wi} {wi2}");
@@ -313,9 +313,9 @@ mod tests {
         let e = 1e-3f32;
         let mut checked = 0;
         for _ in 0..500 {
-            let wo = spherical_direction(rng.next_f32() * 1.55, rng.next_f32() * 6.28);
+            let wo = spherical_direction(rng.next_f32() * 1.55, rng.next_f32() * 2.0 * PI);
             let z = 0.02 + 0.96 * rng.next_f32();
-            let phi = rng.next_f32() * 6.28;
+            let phi = rng.next_f32() * 2.0 * PI;
             let at = |z: f32, phi: f32| wi_from_half_coords(wo, z, phi).map(|(w, _)| w);
             let (Some((wi, wo_h)), Some(zp), Some(zm), Some(pp), Some(pm)) = (
                 wi_from_half_coords(wo, z, phi),

@@ -40,12 +40,12 @@ pub fn check_representable(bsdf: &dyn Bsdf, name: &str) -> Result<()> {
     for _ in 0..CHECK_PAIRS {
         let mut dir = || {
             let z: f32 = 0.05 + 0.95 * rng.next_f32();
-            spherical_direction(z.acos(), 6.283_185 * rng.next_f32())
+            spherical_direction(z.acos(), std::f32::consts::TAU * rng.next_f32())
         };
         let (wo, wi) = (dir(), dir());
         let f = bsdf.f(&ctx, wo, wi);
         any |= !f.is_black();
-        let angle = 6.283_185 * rng.next_f32();
+        let angle = std::f32::consts::TAU * rng.next_f32();
         let rot = |v: Vec3| {
             let (s, c) = angle.sin_cos();
             Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
