@@ -65,6 +65,26 @@ pub fn parameter_table(assignments: &[String]) -> Result<doc::Table> {
     doc::parse(&text, "--set")
 }
 
+/// `key=value` strings as `(key, TOML value)` pairs (a bare word becomes a
+/// string), for `check-plugin --set`.
+pub fn fixed_parameters(assignments: &[String]) -> Result<Vec<(String, String)>> {
+    // Parsing them as one table checks the syntax and rejects repeated keys.
+    parameter_table(assignments)?;
+    Ok(assignments
+        .iter()
+        .filter_map(|a| a.split_once('='))
+        .map(|(key, value)| {
+            let value = value.trim();
+            let toml = if doc::parse(&format!("v = {value}\n"), "--set").is_ok() {
+                value.to_string()
+            } else {
+                format!("{value:?}")
+            };
+            (key.trim().to_string(), toml)
+        })
+        .collect())
+}
+
 /// `lumis brdf tabulate`: returns the summary line.
 pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String> {
     let table = parameter_table(&args.set)?;

@@ -10,7 +10,10 @@ mod reference;
 mod render;
 mod samplers_analyze;
 
-pub use brdf::{parameter_table, precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
+pub use brdf::{
+    fixed_parameters, parameter_table, precompute_table, tabulate_bsdf, PrecomputeArgs,
+    TabulateArgs,
+};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;

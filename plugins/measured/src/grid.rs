@@ -18,7 +18,7 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 
 use indicatif::ProgressBar;
-use lumis_core::{Result, Rgb, Vec3};
+use lumis_core::{Rgb, Vec3};
 use lumis_sampling::halfdiff::{half_coords_jacobian, spherical_direction, wi_from_half_coords};
 use rayon::prelude::*;
 
@@ -111,15 +111,15 @@ impl Grid {
         &self,
         f: &(dyn Fn(Vec3, Vec3) -> Rgb + Sync),
         progress: &ProgressBar,
-    ) -> Result<Vec<Vec<f32>>> {
-        Ok((0..self.n_o)
+    ) -> Vec<Vec<f32>> {
+        (0..self.n_o)
             .into_par_iter()
             .map(|k| {
                 let row = self.row(k, f);
                 progress.inc(1);
                 row
             })
-            .collect())
+            .collect()
     }
 }
 

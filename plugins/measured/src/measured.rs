@@ -49,6 +49,29 @@ pub const SPEC: PluginSpec = PluginSpec {
 
 /// Midpoints per cell and axis of the precomputation grid.
 const SUPERSAMPLES: usize = 4;
+/// The largest grid accepted: 64 MB of f32 for the tabulated strategy.
+const MAX_GRID_CELLS: i64 = 1 << 24;
+
+fn grid_from_params(params: &Params) -> Result<Grid> {
+    let grid: Vec<i64> = params.get("grid")?;
+    match grid.as_slice() {
+        &[n_o, n_w, n_phi]
+            if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n))
+                && n_o * n_w * n_phi <= MAX_GRID_CELLS =>
+        {
+            Ok(Grid {
+                n_o: n_o as usize,
+                n_w: n_w as usize,
+                n_phi: n_phi as usize,
+                supersamples: SUPERSAMPLES,
+            })
+        }
+        _ => Err(params.error(
+            "grid",
+            format!("expected three integers in [2, 1024] with a product of at most {MAX_GRID_CELLS}, got {grid:?}"),
+        )),
+    }
+}
 
 #[derive(Debug, Clone)]
 enum Strategy {
@@ -88,29 +111,20 @@ impl Measured {
                 terms: params.get_in_range("terms")? as usize,
             }),
         };
+        let setup = match plan {
+            Some(plan) => Some((
+                plan,
+                grid_from_params(params)?,
+                params.get::<bool>("cache")?,
+            )),
+            None => None,
+        };
         let path = params.get_path("file")?;
         let table = Arc::new(MerlTable::read(&path).map_err(|e| params.error("file", e))?);
-        let Some(plan) = plan else {
+        let Some((plan, grid, use_cache)) = setup else {
             return Ok((Self::cosine(table), None));
         };
-        let grid: Vec<i64> = params.get("grid")?;
-        let grid = match grid.as_slice() {
-            &[n_o, n_w, n_phi] if [n_o, n_w, n_phi].iter().all(|&n| (2..=1024).contains(&n)) => {
-                Grid {
-                    n_o: n_o as usize,
-                    n_w: n_w as usize,
-                    n_phi: n_phi as usize,
-                    supersamples: SUPERSAMPLES,
-                }
-            }
-            _ => {
-                return Err(params.error(
-                    "grid",
-                    format!("expected three integers in [2, 1024], got {grid:?}"),
-                ))
-            }
-        };
-        let (prepared, report) = prepare(&table, &path, plan, grid, params.get("cache")?)?;
+        let (prepared, report) = prepare(&table, &path, plan, grid, use_cache)?;
         Ok((Self::with_sampler(table, prepared), Some(report)))
     }
 

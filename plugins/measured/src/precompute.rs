@@ -105,15 +105,15 @@ pub fn compute(
     progress: &ProgressBar,
 ) -> Result<Vec<f32>> {
     let f = |wo, wi| table.eval(wi, wo);
-    let mut rows = grid.rows_of(&f, progress)?;
+    let mut rows = grid.rows_of(&f, progress);
     normalize_rows(&mut rows);
-    Ok(match plan {
+    match plan {
         Plan::Factored { terms } => {
             let factors = factorize(&rows, &grid, terms, progress);
             [factors.f, factors.u, factors.v].concat()
         }
         Plan::Tabulated => rows.concat(),
-    })
+    }
 }
 
 /// The sampler for `plan`, from the cache next to `table_path` if it holds
@@ -182,7 +182,7 @@ pub fn prepare(
         progress.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
-    let data = compute(table, plan, grid, &progress)?;
+    let data = compute(table, plan, grid, &progress);
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
     if use_cache {
