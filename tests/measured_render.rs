@@ -285,8 +285,14 @@ fn scene_errors_name_the_file() {
     std::fs::write(&bad, [90u8, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0, 1, 2, 3]).unwrap();
     let e = load(&[format!("bsdf.sample.file={}", bad.display())]);
     assert!(e.contains("short.binary") && e.contains("truncated"), "{e}");
-    let e = load(&["bsdf.sample.grid=[1024, 1024, 64]".into(), "bsdf.sample.file=/no/such".into()]);
-    assert!(e.contains("'grid'") && e.contains("at most"), "settings are checked before the file: {e}");
+    let e = load(&[
+        "bsdf.sample.grid=[1024, 1024, 64]".into(),
+        "bsdf.sample.file=/no/such".into(),
+    ]);
+    assert!(
+        e.contains("'grid'") && e.contains("at most"),
+        "settings are checked before the file: {e}"
+    );
     let e = load(&["bsdf.sample.sampling=lobes".into()]);
     assert!(e.contains("\"cosine\", \"factored\", \"tabulated\""), "{e}");
     let e = load(&[

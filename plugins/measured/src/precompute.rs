@@ -98,12 +98,7 @@ fn from_payload(plan: Plan, grid: Grid, data: &[f32]) -> Prepared {
 }
 
 /// Computes the payload of `plan` for `table` (no cache).
-pub fn compute(
-    table: &MerlTable,
-    plan: Plan,
-    grid: Grid,
-    progress: &ProgressBar,
-) -> Result<Vec<f32>> {
+pub fn compute(table: &MerlTable, plan: Plan, grid: Grid, progress: &ProgressBar) -> Vec<f32> {
     let f = |wo, wi| table.eval(wi, wo);
     let mut rows = grid.rows_of(&f, progress);
     normalize_rows(&mut rows);
