@@ -293,6 +293,10 @@ fn scene_errors_name_the_file() {
         e.contains("'grid'") && e.contains("at most"),
         "settings are checked before the file: {e}"
     );
+    let e = load(&["bsdf.sample.terms=2.5".into()]);
+    assert!(e.contains("'terms'") && e.contains("integer"), "{e}");
+    let e = load(&["bsdf.sample.terms=17".into()]);
+    assert!(e.contains("'terms'") && e.contains("[1, 16]"), "{e}");
     let e = load(&["bsdf.sample.sampling=lobes".into()]);
     assert!(e.contains("\"cosine\", \"factored\", \"tabulated\""), "{e}");
     let e = load(&[

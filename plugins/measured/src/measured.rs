@@ -107,9 +107,16 @@ impl Measured {
         let plan = match params.get_choice("sampling")?.as_str() {
             "cosine" => None,
             "tabulated" => Some(Plan::Tabulated),
-            _ => Some(Plan::Factored {
-                terms: params.get_in_range("terms")? as usize,
-            }),
+            _ => {
+                // An integer (get_in_range would accept and truncate 2.5).
+                let terms: i64 = params.get("terms")?;
+                if !(1..=16).contains(&terms) {
+                    return Err(params.error("terms", format!("must be in [1, 16], got {terms}")));
+                }
+                Some(Plan::Factored {
+                    terms: terms as usize,
+                })
+            }
         };
         let setup = match plan {
             Some(plan) => Some((
