@@ -3,8 +3,8 @@
 //! scene (paths, errors, cache); and the README's measured-results table:
 //! `scenes/measured-sphere.toml` (direct lighting, BSDF sampling only) for
 //! three tabulated BSDFs of increasing glossiness, rendered at equal spp
-//! with every strategy, relMSE and PSNR against a converged render,
-//! precomputation time and memory. Regenerate the table with
+//! with every strategy, relMSE and PSNR against a converged render, render
+//! time, precomputation time and memory. Regenerate the table with
 //!
 //! ```sh
 //! cargo test -p lumis-tests --test measured_render measured_results_table -- --nocapture
@@ -311,6 +311,7 @@ fn scene_errors_name_the_file() {
 struct Row {
     strategy: String,
     rel_mse: Vec<f64>,
+    render_seconds: Vec<f64>,
     psnr: Vec<f64>,
     seconds: f64,
     memory: usize,
@@ -328,7 +329,7 @@ fn measured_results_table() {
     out.push_str(&format!(
         "scenes/measured-sphere.toml, {SPP} spp x {SEEDS} seeds, BSDF sampling only; reference {REFERENCE_SPP} spp (tabulated sampling for the tables, the model's own for the analytic BSDFs)\n"
     ));
-    out.push_str("| material | strategy | relMSE | PSNR dB | precompute s | sampler memory |\n| --- | --- | --- | --- | --- | --- |\n");
+    out.push_str("| material | strategy | relMSE | PSNR dB | render s | precompute s | sampler memory |\n| --- | --- | --- | --- | --- | --- | --- |\n");
     let mut glossy_cosine_over_factored = 0.0;
     let mut worst_factored_over_analytic = 0.0f64;
     for (name, plugin, set, analytic) in MATERIALS {
@@ -344,14 +345,15 @@ fn measured_results_table() {
             ];
             o.extend_from_slice(extra);
             let refs: Vec<&str> = o.iter().map(String::as_str).collect();
-            render_toml_with(&registry, &scene, &refs, 0).image
+            let output = render_toml_with(&registry, &scene, &refs, 0);
+            (output.image, output.seconds)
         };
-        let measured_ref = render(
+        let (measured_ref, _) = render(
             &["bsdf.sample.sampling=tabulated".into()],
             REFERENCE_SPP,
             1000,
         );
-        let analytic_ref = render(&["shape.0.bsdf=analytic".into()], REFERENCE_SPP, 1000);
+        let (analytic_ref, _) = render(&["shape.0.bsdf=analytic".into()], REFERENCE_SPP, 1000);
         let mut strategies: Vec<(String, Vec<String>, Option<Plan>)> = vec![(
             "cosine".into(),
             vec!["bsdf.sample.sampling=cosine".into()],
@@ -403,12 +405,14 @@ fn measured_results_table() {
             let mut row = Row {
                 strategy: label.clone(),
                 rel_mse: Vec::new(),
+                render_seconds: Vec::new(),
                 psnr: Vec::new(),
                 seconds,
                 memory,
             };
             for seed in 0..SEEDS {
-                let image = render(&overrides, SPP, seed);
+                let (image, seconds) = render(&overrides, SPP, seed);
+                row.render_seconds.push(seconds);
                 let m = error_metrics(&image, reference, None);
                 row.rel_mse.push(m.rel_mse);
                 row.psnr.push(m.psnr_db);
@@ -424,11 +428,12 @@ fn measured_results_table() {
         };
         for r in &rows {
             out.push_str(&format!(
-                "| {name} | {} | {:.4e} ± {:.1e} | {:.2} | {} | {} |\n",
+                "| {name} | {} | {:.4e} ± {:.1e} | {:.2} | {:.3} | {} | {} |\n",
                 r.strategy,
                 avg(&r.rel_mse),
                 se(&r.rel_mse),
                 avg(&r.psnr),
+                avg(&r.render_seconds),
                 if r.memory == 0 {
                     "-".into()
                 } else {
