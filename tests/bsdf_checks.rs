@@ -14,6 +14,9 @@ fn every_builtin_bsdf_passes_the_check_suite() {
         .into_iter()
         .filter(|p| p.spec.kind == PluginKind::Bsdf)
         .map(|p| p.spec.name)
+        // `measured` needs a table file, which a parameter sweep cannot
+        // invent: tests/measured_sweep.rs checks it on tabulated BSDFs.
+        .filter(|&name| name != "measured")
         .collect();
     assert!(!names.is_empty());
     for name in names {

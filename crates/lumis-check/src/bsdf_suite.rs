@@ -126,8 +126,32 @@ pub fn variant(label: impl Into<String>, toml: &str) -> Result<Variant> {
 /// required parameters), then one parameter at a time at each end of its
 /// range, at each declared choice and at each boolean value.
 pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
-    let mut base: Vec<(String, String)> = Vec::new();
+    parameter_sweep_with(spec, &[])
+}
+
+/// [`parameter_sweep`] with some parameters held at given values (TOML
+/// text, e.g. `("file", "\"table.binary\"")`) in every variant: for
+/// plugins with a required parameter no stand-in can supply, such as a
+/// file.
+pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Result<Vec<Variant>> {
+    let mut base: Vec<(String, String)> = fixed.to_vec();
+    for (name, _) in fixed {
+        if !spec.params.iter().any(|p| p.name == name) {
+            return Err(Error::msg(format!(
+                "bsdf \"{}\" has no parameter '{name}'; it has: {}",
+                spec.name,
+                spec.params
+                    .iter()
+                    .map(|p| p.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )));
+        }
+    }
     for p in spec.params {
+        if fixed.iter().any(|(k, _)| k == p.name) {
+            continue;
+        }
         if p.default == ParamDefault::Required {
             base.push((
                 p.name.to_string(),
@@ -136,7 +160,11 @@ pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
         }
     }
     let mut settings: Vec<(String, Vec<(String, String)>)> = vec![("base".into(), base.clone())];
-    for p in spec.params {
+    for p in spec
+        .params
+        .iter()
+        .filter(|p| !fixed.iter().any(|(k, _)| k == p.name))
+    {
         let mut values: Vec<String> = Vec::new();
         match p.ty {
             ParamType::Float | ParamType::Int => {
@@ -286,6 +314,24 @@ pub fn check_bsdf(
     check_bsdf_variants(registry, name, &parameter_sweep(&plugin.spec)?, cfg)
 }
 
+/// [`check_bsdf`] with parameters held fixed (see [`parameter_sweep_with`]).
+pub fn check_bsdf_with(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+    cfg: &BsdfCheckConfig,
+) -> Result<Vec<CaseResult>> {
+    let plugin = registry
+        .find(PluginKind::Bsdf, name)
+        .ok_or_else(|| Error::msg(format!("no bsdf plugin named \"{name}\"")))?;
+    check_bsdf_variants(
+        registry,
+        name,
+        &parameter_sweep_with(&plugin.spec, fixed)?,
+        cfg,
+    )
+}
+
 /// Runs every check for each of `variants` of the BSDF plugin `name` and
 /// each incident direction of `cfg`, the cases in parallel; the chi-square
 /// significance is corrected for the number of cases.
@@ -428,6 +474,18 @@ mod tests {
             ParamSpec::with_default("two_sided", ParamType::Bool, "false", ""),
         ],
     };
+
+    #[test]
+    fn fixed_parameters_are_in_every_variant_and_not_swept() {
+        let fixed = [("roughness".to_string(), "0.25".to_string())];
+        let sweep = parameter_sweep_with(&SPEC, &fixed).unwrap();
+        assert!(sweep.iter().all(|v| !v.label.starts_with("roughness")));
+        assert!(sweep.iter().all(|v| v.table.get("roughness").is_some()));
+        assert!(sweep.iter().any(|v| v.label == "mode = \"b\""));
+        let bad = [("roughnes".to_string(), "0.25".to_string())];
+        let err = parameter_sweep_with(&SPEC, &bad).unwrap_err().to_string();
+        assert!(err.contains("no parameter 'roughnes'"), "{err}");
+    }
 
     #[test]
     fn sweep_covers_range_ends_choices_and_booleans() {

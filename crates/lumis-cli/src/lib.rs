@@ -2,6 +2,7 @@
 //! `samplers analyze` commands, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
+mod brdf;
 mod converge;
 mod diff;
 mod listing;
@@ -9,6 +10,10 @@ mod reference;
 mod render;
 mod samplers_analyze;
 
+pub use brdf::{
+    fixed_parameters, parameter_table, precompute_table, tabulate_bsdf, PrecomputeArgs,
+    TabulateArgs,
+};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;
@@ -23,6 +28,7 @@ pub fn builtin_registry() -> Result<Registry> {
     let mut registry = Registry::new();
     lumis_samplers::register(&mut registry)?;
     lumis_bsdfs::register(&mut registry)?;
+    lumis_measured::register(&mut registry)?;
     lumis_lights::register(&mut registry)?;
     lumis_light_samplers::register(&mut registry)?;
     lumis_integrators::register(&mut registry)?;

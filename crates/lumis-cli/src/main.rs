@@ -4,11 +4,13 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use lumis_check::bsdf_suite::{check_bsdf, format_results, write_histogram_png, BsdfCheckConfig};
+use lumis_check::bsdf_suite::{
+    check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
+};
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, plugin_listing, registry_with_search_path,
-    render_reference, render_scene_file, AnalyzeArgs, ConvergeArgs, DiffArgs, ReferenceArgs,
-    RenderArgs,
+    analyze_samplers, converge, diff_images, plugin_listing, precompute_table,
+    registry_with_search_path, render_reference, render_scene_file, tabulate_bsdf, AnalyzeArgs,
+    ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
 };
 use lumis_core::{Error, PluginKind, Result};
 
@@ -54,6 +56,10 @@ enum Command {
         /// Where failure pictures go.
         #[arg(long, default_value = ".")]
         out: PathBuf,
+        /// Hold a parameter at this value in every case instead of sweeping
+        /// it, e.g. `--bsdf measured --set file=table.binary` (repeatable).
+        #[arg(long = "set", value_name = "key=value")]
+        set: Vec<String>,
     },
     /// Render a high-spp reference with the scene's own settings, saved
     /// after every pass with its metadata (PATH.json); rerun to resume.
@@ -69,6 +75,21 @@ enum Command {
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
+    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling.
+    #[command(subcommand)]
+    Brdf(BrdfCommand),
+}
+
+#[derive(Subcommand)]
+enum BrdfCommand {
+    /// Write an isotropic, reciprocal lumis BSDF as a MERL table (90 x 90 x
+    /// 180 samples of f over theta_h, theta_d, phi_d), e.g.
+    /// `lumis brdf tabulate --bsdf conductor --set roughness=0.2 -o metal.binary`.
+    Tabulate(TabulateArgs),
+    /// Run the precomputation of a sampling strategy of the `measured` BSDF
+    /// for a table (ignoring and replacing its cache); print its time and
+    /// memory.
+    Precompute(PrecomputeArgs),
 }
 
 #[derive(Subcommand)]
@@ -101,7 +122,8 @@ fn main() -> ExitCode {
             samples,
             bins,
             out,
-        } => check_plugin(library, bsdf, samples, bins, &out),
+            set,
+        } => check_plugin(library, bsdf, samples, bins, &out, &set),
         Command::Reference(args) => registry_with_search_path().and_then(|registry| {
             let stop = stop_on_ctrl_c()?;
             let (path, meta) = render_reference(&args, &registry, &stop)?;
@@ -123,6 +145,16 @@ fn main() -> ExitCode {
             }),
         Command::Diff(args) => diff_images(&args).map(|report| {
             print!("{report}");
+            true
+        }),
+        Command::Brdf(BrdfCommand::Tabulate(args)) => registry_with_search_path()
+            .and_then(|registry| tabulate_bsdf(&args, &registry))
+            .map(|line| {
+                println!("{line}");
+                true
+            }),
+        Command::Brdf(BrdfCommand::Precompute(args)) => precompute_table(&args).map(|line| {
+            println!("{line}");
             true
         }),
         Command::Samplers(SamplersCommand::Analyze(args)) => registry_with_search_path()
@@ -160,7 +192,9 @@ fn check_plugin(
     samples: usize,
     bins: usize,
     out: &std::path::Path,
+    set: &[String],
 ) -> Result<bool> {
+    let fixed = lumis_cli::fixed_parameters(set)?;
     let mut registry = registry_with_search_path()?;
     if let Some(library) = &library {
         lumis_loader::load_library(library, &mut registry)?;
@@ -184,7 +218,7 @@ fn check_plugin(
     cfg.chi_square.phi_bins = bins;
     let mut all_passed = true;
     for name in &names {
-        let results = check_bsdf(&registry, name, &cfg)?;
+        let results = check_bsdf_with(&registry, name, &fixed, &cfg)?;
         print!("{}", format_results(&results));
         for (i, r) in results
             .iter()

@@ -419,6 +419,29 @@ impl<'a> Params<'a> {
         }
     }
 
+    /// A file path. A relative path is resolved against the directory of
+    /// the scene file that wrote it, so a scene and its assets move
+    /// together; given with `--set` (or built in), it is relative to the
+    /// working directory.
+    pub fn get_path(&self, name: &str) -> Result<std::path::PathBuf> {
+        let Some(node) = self.node(name)? else {
+            return Err(self.error(name, "plugin bug: optional path read with get_path()"));
+        };
+        let text: String = self.convert(name, &node)?;
+        if text.is_empty() {
+            return Err(self.error(name, "expected a file path, found an empty string"));
+        }
+        let path = std::path::PathBuf::from(&text);
+        Ok(match &node.location {
+            Location::File { path: scene, .. } if path.is_relative() => {
+                std::path::Path::new(&**scene)
+                    .parent()
+                    .map_or(path.clone(), |dir| dir.join(&path))
+            }
+            _ => path,
+        })
+    }
+
     /// Whether the scene gave `name` explicitly (marks it read).
     pub fn is_given(&self, name: &str) -> bool {
         let i = self.spec_index(name);
@@ -599,6 +622,23 @@ mod tests {
         p.get::<Rgb>("reflectance").unwrap();
         let err = p.finish().unwrap_err().to_string();
         assert!(err.contains("'beta' is not used"), "{err}");
+    }
+
+    #[test]
+    fn paths_are_relative_to_the_scene_file() {
+        const FILE: &[ParamSpec] = &[ParamSpec::required("file", ParamType::String, "a file")];
+        let t = crate::doc::parse("file = \"tables/a.binary\"\n", "/scenes/s.toml").unwrap();
+        let p = Params::new("bsdf", &t, Location::Builtin, FILE, &[]).unwrap();
+        assert_eq!(
+            p.get_path("file").unwrap(),
+            std::path::Path::new("/scenes/tables/a.binary")
+        );
+        let t = crate::doc::parse("file = \"/abs/a.binary\"\n", "/scenes/s.toml").unwrap();
+        let p = Params::new("bsdf", &t, Location::Builtin, FILE, &[]).unwrap();
+        assert_eq!(
+            p.get_path("file").unwrap(),
+            std::path::Path::new("/abs/a.binary")
+        );
     }
 
     #[test]

@@ -1,8 +1,11 @@
 //! Sampling building blocks: warps from the unit square to shapes and
 //! directions, each with its density; random number generation; the
 //! low-discrepancy sequences and their randomisations; and the multiple
-//! importance sampling heuristics.
+//! importance sampling heuristics; piecewise-constant distributions; the
+//! half/difference parameterizations of direction pairs and their Jacobians.
 
+pub mod distribution;
+pub mod halfdiff;
 pub mod mis;
 pub mod permutation;
 pub mod poisson_disk;
@@ -16,6 +19,7 @@ pub mod spherical_rectangle;
 pub mod spherical_triangle;
 pub mod warp;
 
+pub use distribution::Distribution1D;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use permutation::permutation_element;
 pub use radical_inverse::{

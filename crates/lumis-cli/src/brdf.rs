@@ -1,0 +1,174 @@
+//! `lumis brdf`: measured-BRDF tools. `tabulate` writes any lumis BSDF as
+//! a MERL table (a measured material with a known ground truth);
+//! `precompute` runs a sampling precomputation of a table, reports its
+//! time and memory and refreshes its cache.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use lumis_core::doc;
+use lumis_core::registry::TableRef;
+use lumis_core::{Error, Location, Registry, Result};
+use lumis_measured::grid::Grid;
+use lumis_measured::merl::{write_atomic, MerlTable, THETA_H_RES};
+use lumis_measured::precompute::{prepare, Plan};
+use lumis_measured::tabulate::tabulate;
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct TabulateArgs {
+    /// The BSDF plugin to tabulate (built-in or loaded), e.g. conductor.
+    #[arg(long)]
+    pub bsdf: String,
+    /// Its parameters, e.g. `--set roughness=0.2 --set material=Au`.
+    #[arg(long = "set", value_name = "key=value")]
+    pub set: Vec<String>,
+    /// The MERL file to write (written to a temporary file, then renamed).
+    #[arg(short, long, value_name = "OUT.binary")]
+    pub output: PathBuf,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct PrecomputeArgs {
+    /// The MERL table.
+    pub table: PathBuf,
+    /// factored or tabulated.
+    #[arg(long, default_value = "factored")]
+    pub sampling: String,
+    /// Terms of the factorization (factored).
+    #[arg(long, default_value_t = 2)]
+    pub terms: usize,
+    /// Outgoing elevations, half-angle bins, azimuth bins.
+    #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
+    pub grid: Vec<usize>,
+}
+
+/// A table of plugin parameters from `key=value` strings (a TOML value, or
+/// else a bare string).
+pub fn parameter_table(assignments: &[String]) -> Result<doc::Table> {
+    let mut text = String::new();
+    for assignment in assignments {
+        let (key, value) = assignment
+            .split_once('=')
+            .ok_or_else(|| Error::msg(format!("--set {assignment}: expected key=value")))?;
+        let (key, value) = (key.trim(), value.trim());
+        let line = format!("{key} = {value}\n");
+        text += &if doc::parse(&line, "--set").is_ok() {
+            line
+        } else {
+            format!("{key} = {value:?}\n")
+        };
+    }
+    doc::parse(&text, "--set")
+}
+
+/// `key=value` strings as `(key, TOML value)` pairs (a bare word becomes a
+/// string), for `check-plugin --set`.
+pub fn fixed_parameters(assignments: &[String]) -> Result<Vec<(String, String)>> {
+    // Parsing them as one table checks the syntax and rejects repeated keys.
+    parameter_table(assignments)?;
+    Ok(assignments
+        .iter()
+        .filter_map(|a| a.split_once('='))
+        .map(|(key, value)| {
+            let value = value.trim();
+            let toml = if doc::parse(&format!("v = {value}\n"), "--set").is_ok() {
+                value.to_string()
+            } else {
+                format!("{value:?}")
+            };
+            (key.trim().to_string(), toml)
+        })
+        .collect())
+}
+
+/// `lumis brdf tabulate`: returns the summary line.
+pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String> {
+    let table = parameter_table(&args.set)?;
+    let owner = format!("bsdf \"{}\"", args.bsdf);
+    let bsdf = registry.create_bsdf(&TableRef {
+        owner: &owner,
+        table: &table,
+        location: &Location::Builtin,
+        type_name: &args.bsdf,
+        type_location: &Location::Builtin,
+        structural: &[],
+    })?;
+    let progress = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(THETA_H_RES as u64)
+    };
+    if let Ok(style) = ProgressStyle::with_template(
+        "tabulating {msg} [{bar:30}] {pos}/{len} theta_h rows {elapsed}",
+    ) {
+        progress.set_style(style.progress_chars("=> "));
+    }
+    progress.set_message(args.bsdf.clone());
+    let start = Instant::now();
+    let label = if args.set.is_empty() {
+        args.bsdf.clone()
+    } else {
+        format!("{} ({})", args.bsdf, args.set.join(", "))
+    };
+    let bytes = tabulate(bsdf.as_ref(), &label, &progress)?;
+    progress.finish_and_clear();
+    write_atomic(&args.output, &bytes)?;
+    // Read back what was written: the file is checked like any other.
+    let check = MerlTable::read(&args.output)?;
+    Ok(format!(
+        "{label} -> {} ({} bytes, content hash {:016x}) in {:.2} s",
+        args.output.display(),
+        bytes.len(),
+        check.hash(),
+        start.elapsed().as_secs_f64()
+    ))
+}
+
+/// `lumis brdf precompute`: returns the report line.
+pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
+    let plan = match args.sampling.as_str() {
+        "factored" if (1..=16).contains(&args.terms) => Plan::Factored { terms: args.terms },
+        "factored" => return Err(Error::msg(format!("--terms must be in [1, 16], got {}", args.terms))),
+        "tabulated" => Plan::Tabulated,
+        other => {
+            return Err(Error::msg(format!(
+                "--sampling must be factored or tabulated (cosine needs no precomputation), got \"{other}\""
+            )))
+        }
+    };
+    let grid = match args.grid.as_slice() {
+        &[n_o, n_w, n_phi] if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n)) => Grid {
+            n_o,
+            n_w,
+            n_phi,
+            supersamples: 4,
+        },
+        g => {
+            return Err(Error::msg(format!(
+                "--grid expects three integers in [2, 1024], got {g:?}"
+            )))
+        }
+    };
+    let table = MerlTable::read(&args.table)?;
+    // Remove the cache first so that the time is the computation's.
+    let cache = lumis_measured::cache::CacheKey {
+        table_hash: table.hash(),
+        strategy: match plan {
+            Plan::Factored { .. } => "factored",
+            Plan::Tabulated => "tabulated",
+        },
+        terms: match plan {
+            Plan::Factored { terms } => terms,
+            Plan::Tabulated => 0,
+        },
+        grid,
+    }
+    .path(&args.table);
+    let _ = std::fs::remove_file(&cache);
+    let (_, report) = prepare(&table, &args.table, plan, grid, true)?;
+    Ok(report.message)
+}

@@ -1,0 +1,121 @@
+//! `lumis brdf tabulate`, `lumis brdf precompute` and `lumis check-plugin
+//! --set` on a measured table, as a user runs them.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn lumis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lumis"))
+        .args(args)
+        .output()
+        .expect("lumis runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("lumis-cli-brdf-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+#[test]
+fn tabulate_precompute_and_check_a_measured_table() {
+    let dir = scratch("flow");
+    let table = dir.join("gold.binary");
+    let table_arg = table.display().to_string();
+    let run = lumis(&[
+        "brdf",
+        "tabulate",
+        "--bsdf",
+        "conductor",
+        "--set",
+        "roughness=0.3",
+        "--set",
+        "material=Au",
+        "-o",
+        &table_arg,
+        "--quiet",
+    ]);
+    assert!(run.status.success(), "{}", text(&run));
+    assert!(text(&run).contains("34992012 bytes"), "{}", text(&run));
+    assert_eq!(std::fs::metadata(&table).unwrap().len(), 34_992_012);
+
+    let run = lumis(&[
+        "brdf",
+        "precompute",
+        &table_arg,
+        "--sampling",
+        "factored",
+        "--terms",
+        "2",
+    ]);
+    assert!(run.status.success(), "{}", text(&run));
+    assert!(text(&run).contains("precomputed in"), "{}", text(&run));
+    assert!(dir
+        .join("gold.binary.factored-L2-32x64x64s4.lumis-cache")
+        .exists());
+
+    // The check kit over the plugin's own parameters, the table held fixed.
+    let file = format!("file={table_arg}");
+    let run = lumis(&[
+        "check-plugin",
+        "--bsdf",
+        "measured",
+        "--set",
+        &file,
+        "--samples",
+        "20000",
+        "--bins",
+        "16",
+    ]);
+    let out = text(&run);
+    assert!(run.status.success(), "{out}");
+    for want in [
+        "sampling = \"cosine\"",
+        "sampling = \"tabulated\"",
+        "terms = 16",
+        "passed, 0 failed",
+    ] {
+        assert!(out.contains(want), "missing {want}:\n{out}");
+    }
+    // Without the table the sweep cannot run, and says why.
+    let run = lumis(&["check-plugin", "--bsdf", "measured", "--samples", "1000"]);
+    assert!(!run.status.success());
+    assert!(text(&run).contains("'file' is required"), "{}", text(&run));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bad_requests_fail_with_the_reason() {
+    let dir = scratch("bad");
+    let out = dir.join("x.binary").display().to_string();
+    let run = lumis(&[
+        "brdf",
+        "tabulate",
+        "--bsdf",
+        "dielectric",
+        "-o",
+        &out,
+        "--quiet",
+    ]);
+    assert!(!run.status.success());
+    assert!(text(&run).contains("transmits"), "{}", text(&run));
+    let run = lumis(&["brdf", "precompute", "/no/such.binary"]);
+    assert!(!run.status.success());
+    assert!(text(&run).contains("/no/such.binary"), "{}", text(&run));
+    let run = lumis(&["brdf", "precompute", &out, "--sampling", "cosine"]);
+    assert!(
+        text(&run).contains("needs no precomputation"),
+        "{}",
+        text(&run)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

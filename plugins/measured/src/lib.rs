@@ -1,0 +1,27 @@
+//! Measured BRDFs: the MERL table format (reader, writer, trilinear
+//! lookup), the `measured` BSDF plugin and its importance sampling
+//! strategies (cosine, the factored representation of Lawrence,
+//! Rusinkiewicz and Ramamoorthi 2004, a tabulated 2D distribution per
+//! outgoing elevation), the cache of their precomputation, and the
+//! tabulation of any lumis BSDF as a MERL table.
+
+pub mod cache;
+pub mod factored;
+pub mod grid;
+mod measured;
+pub mod merl;
+pub mod precompute;
+pub mod tabulate;
+pub mod tabulated;
+
+pub use measured::{Measured, SPEC};
+pub use merl::MerlTable;
+
+use std::sync::Arc;
+
+use lumis_core::{Registry, Result};
+
+/// Registers the `measured` BSDF.
+pub fn register(registry: &mut Registry) -> Result<()> {
+    registry.add_bsdf(SPEC, |p| Ok(Arc::new(Measured::from_params(p)?)))
+}

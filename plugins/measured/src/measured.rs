@@ -1,0 +1,208 @@
+//! `measured`: an isotropic BRDF tabulated in the MERL format, with a
+//! choice of importance sampling.
+
+use std::sync::Arc;
+
+use lumis_core::{
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
+};
+use lumis_sampling::warp;
+
+use crate::grid::Grid;
+use crate::merl::MerlTable;
+use crate::precompute::{prepare, Plan, PrecomputeReport, Prepared};
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Bsdf,
+    name: "measured",
+    doc: "isotropic BRDF tabulated in the MERL format (trilinear f); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
+    params: &[
+        ParamSpec::required(
+            "file",
+            ParamType::String,
+            "MERL .binary table, relative to the scene file (make one with `lumis brdf tabulate`)",
+        ),
+        ParamSpec::with_default(
+            "sampling",
+            ParamType::String,
+            "\"factored\"",
+            "cosine (the baseline), factored (L separable terms in half-vector coordinates), tabulated (a 2D table per outgoing elevation, the memory-hungry reference)",
+        )
+        .one_of(&["cosine", "factored", "tabulated"]),
+        ParamSpec::with_default("terms", ParamType::Int, "2", "L, the terms of the factorization (factored only)")
+            .in_range(1.0, 16.0),
+        ParamSpec::with_default(
+            "grid",
+            ParamType::IntArray,
+            "[32, 64, 64]",
+            "[outgoing elevations, half-angle bins, azimuth bins] of the precomputation (factored, tabulated)",
+        ),
+        ParamSpec::with_default(
+            "cache",
+            ParamType::Bool,
+            "true",
+            "keep the precomputation next to the table (TABLE.STRATEGY-....lumis-cache), reused while the table is unchanged",
+        ),
+    ],
+};
+
+/// Midpoints per cell and axis of the precomputation grid.
+const SUPERSAMPLES: usize = 4;
+/// The largest grid accepted: 64 MB of f32 for the tabulated strategy.
+const MAX_GRID_CELLS: i64 = 1 << 24;
+
+fn grid_from_params(params: &Params) -> Result<Grid> {
+    let grid: Vec<i64> = params.get("grid")?;
+    match grid.as_slice() {
+        &[n_o, n_w, n_phi]
+            if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n))
+                && n_o * n_w * n_phi <= MAX_GRID_CELLS =>
+        {
+            Ok(Grid {
+                n_o: n_o as usize,
+                n_w: n_w as usize,
+                n_phi: n_phi as usize,
+                supersamples: SUPERSAMPLES,
+            })
+        }
+        _ => Err(params.error(
+            "grid",
+            format!("expected three integers in [2, 1024] with a product of at most {MAX_GRID_CELLS}, got {grid:?}"),
+        )),
+    }
+}
+
+#[derive(Debug, Clone)]
+enum Strategy {
+    Cosine,
+    Prepared(Prepared),
+}
+
+#[derive(Debug, Clone)]
+pub struct Measured {
+    table: Arc<MerlTable>,
+    strategy: Strategy,
+}
+
+impl Measured {
+    pub fn cosine(table: Arc<MerlTable>) -> Self {
+        Self {
+            table,
+            strategy: Strategy::Cosine,
+        }
+    }
+
+    pub fn with_sampler(table: Arc<MerlTable>, prepared: Prepared) -> Self {
+        Self {
+            table,
+            strategy: Strategy::Prepared(prepared),
+        }
+    }
+
+    /// The BSDF and, for the precomputed strategies, how the precomputation
+    /// went (also printed to stderr by [`Self::from_params`]).
+    pub fn from_params_with_report(params: &Params) -> Result<(Self, Option<PrecomputeReport>)> {
+        // Settings first: a typo is reported before a 35 MB read.
+        let plan = match params.get_choice("sampling")?.as_str() {
+            "cosine" => None,
+            "tabulated" => Some(Plan::Tabulated),
+            _ => {
+                // An integer (get_in_range would accept and truncate 2.5).
+                let terms: i64 = params.get("terms")?;
+                if !(1..=16).contains(&terms) {
+                    return Err(params.error("terms", format!("must be in [1, 16], got {terms}")));
+                }
+                Some(Plan::Factored {
+                    terms: terms as usize,
+                })
+            }
+        };
+        let setup = match plan {
+            Some(plan) => Some((
+                plan,
+                grid_from_params(params)?,
+                params.get::<bool>("cache")?,
+            )),
+            None => None,
+        };
+        let path = params.get_path("file")?;
+        let table = Arc::new(MerlTable::read(&path).map_err(|e| params.error("file", e))?);
+        let Some((plan, grid, use_cache)) = setup else {
+            return Ok((Self::cosine(table), None));
+        };
+        let (prepared, report) = prepare(&table, &path, plan, grid, use_cache)?;
+        Ok((Self::with_sampler(table, prepared), Some(report)))
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let (bsdf, report) = Self::from_params_with_report(params)?;
+        if let Some(report) = report {
+            eprintln!("{}", report.message);
+        }
+        Ok(bsdf)
+    }
+
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return Rgb::BLACK;
+        }
+        self.table.eval(wi, wo)
+    }
+
+    #[inline]
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        match &self.strategy {
+            Strategy::Cosine => warp::cosine_hemisphere_pdf(wi.z),
+            Strategy::Prepared(Prepared::Factored(f)) => f.pdf(wo, wi),
+            Strategy::Prepared(Prepared::Tabulated(t)) => t.pdf(wo, wi),
+        }
+    }
+}
+
+impl Bsdf for Measured {
+    fn flags(&self) -> BsdfFlags {
+        BsdfFlags::GLOSSY | BsdfFlags::REFLECTION
+    }
+
+    #[inline]
+    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        self.eval(wo, wi)
+    }
+
+    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let wi = match &self.strategy {
+            Strategy::Cosine => warp::square_to_cosine_hemisphere(u2),
+            Strategy::Prepared(Prepared::Factored(f)) => f.sample(wo, u1, u2)?,
+            Strategy::Prepared(Prepared::Tabulated(t)) => t.sample(wo, u1, u2)?,
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        // The density from the direction, as pdf() computes it, so that the
+        // two agree to the last bit even at bin boundaries.
+        let pdf = self.eval_pdf(wo, wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(BsdfSample {
+            f: self.eval(wo, wi),
+            wi,
+            pdf,
+            flags: BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            eta: 1.0,
+        })
+    }
+
+    #[inline]
+    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval_pdf(wo, wi)
+    }
+}

@@ -1,0 +1,209 @@
+//! Runs (or loads from the cache) the precomputation a sampling strategy
+//! needs, once per table and setting: the grid of `f cos theta_i` in
+//! parallel, then the factorization, behind one progress bar.
+
+use std::path::Path;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use lumis_core::Result;
+
+use crate::cache::{self, CacheKey, Miss};
+use crate::factored::{factorize, Factored, Factors, NMF_ITERATIONS, REFINE_ITERATIONS};
+use crate::grid::{normalize_rows, Grid};
+use crate::merl::MerlTable;
+use crate::tabulated::Tabulated;
+
+/// What the strategy needs precomputed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Plan {
+    Factored { terms: usize },
+    Tabulated,
+}
+
+impl Plan {
+    fn name(self) -> &'static str {
+        match self {
+            Plan::Factored { .. } => "factored",
+            Plan::Tabulated => "tabulated",
+        }
+    }
+
+    fn terms(self) -> usize {
+        match self {
+            Plan::Factored { terms } => terms,
+            Plan::Tabulated => 0,
+        }
+    }
+
+    /// Numbers in the cache payload.
+    fn count(self, grid: &Grid) -> usize {
+        match self {
+            Plan::Factored { terms } => terms * (grid.n_o + grid.n_w + grid.n_phi),
+            Plan::Tabulated => grid.n_o * grid.columns(),
+        }
+    }
+}
+
+/// A ready sampler.
+#[derive(Debug, Clone)]
+pub enum Prepared {
+    Factored(Factored),
+    Tabulated(Tabulated),
+}
+
+impl Prepared {
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Prepared::Factored(f) => f.memory_bytes(),
+            Prepared::Tabulated(t) => t.memory_bytes(),
+        }
+    }
+}
+
+/// How the sampler came to be.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrecomputeReport {
+    /// Seconds spent computing (0 when loaded from the cache).
+    pub seconds: f64,
+    pub from_cache: bool,
+    pub memory_bytes: usize,
+    /// The line printed to stderr.
+    pub message: String,
+}
+
+fn from_payload(plan: Plan, grid: Grid, data: &[f32]) -> Prepared {
+    match plan {
+        Plan::Factored { terms } => {
+            let (f, rest) = data.split_at(grid.n_o * terms);
+            let (u, v) = rest.split_at(terms * grid.n_w);
+            Prepared::Factored(Factored::new(
+                grid,
+                &Factors {
+                    terms,
+                    f: f.to_vec(),
+                    u: u.to_vec(),
+                    v: v.to_vec(),
+                },
+            ))
+        }
+        Plan::Tabulated => {
+            let rows: Vec<Vec<f32>> = data
+                .chunks_exact(grid.columns())
+                .map(<[f32]>::to_vec)
+                .collect();
+            Prepared::Tabulated(Tabulated::new(grid, &rows))
+        }
+    }
+}
+
+/// Computes the payload of `plan` for `table` (no cache).
+pub fn compute(table: &MerlTable, plan: Plan, grid: Grid, progress: &ProgressBar) -> Vec<f32> {
+    let f = |wo, wi| table.eval(wi, wo);
+    let mut rows = grid.rows_of(&f, progress);
+    normalize_rows(&mut rows);
+    match plan {
+        Plan::Factored { terms } => {
+            let factors = factorize(&rows, &grid, terms, progress);
+            [factors.f, factors.u, factors.v].concat()
+        }
+        Plan::Tabulated => rows.concat(),
+    }
+}
+
+/// The sampler for `plan`, from the cache next to `table_path` if it holds
+/// this table's, else computed (and cached when `use_cache`).
+pub fn prepare(
+    table: &MerlTable,
+    table_path: &Path,
+    plan: Plan,
+    grid: Grid,
+    use_cache: bool,
+) -> Result<(Prepared, PrecomputeReport)> {
+    let key = CacheKey {
+        table_hash: table.hash(),
+        strategy: plan.name(),
+        terms: plan.terms(),
+        grid,
+    };
+    let path = key.path(table_path);
+    let count = plan.count(&grid);
+    let label = match plan {
+        Plan::Factored { terms } => format!("factored L = {terms}"),
+        Plan::Tabulated => "tabulated".to_string(),
+    };
+    let mut note = String::new();
+    if use_cache {
+        match cache::load(&path, &key, count) {
+            Ok(data) => {
+                let prepared = from_payload(plan, grid, &data);
+                let memory_bytes = prepared.memory_bytes();
+                let message = format!(
+                    "{}: {label} sampling loaded from {} ({} KiB)",
+                    table_path.display(),
+                    path.display(),
+                    memory_bytes / 1024
+                );
+                return Ok((
+                    prepared,
+                    PrecomputeReport {
+                        seconds: 0.0,
+                        from_cache: true,
+                        memory_bytes,
+                        message,
+                    },
+                ));
+            }
+            Err(Miss::Absent) => {}
+            Err(Miss::Stale) => {
+                note = " (the cache was for another version of the table; replaced)".into()
+            }
+            Err(Miss::Damaged(why)) => {
+                note = format!(
+                    " (the cache {} was damaged: {why}; replaced)",
+                    path.display()
+                )
+            }
+        }
+    }
+    let total = grid.n_o as u64
+        + match plan {
+            Plan::Factored { .. } => (NMF_ITERATIONS + REFINE_ITERATIONS) as u64,
+            Plan::Tabulated => 0,
+        };
+    let progress = ProgressBar::new(total)
+        .with_message(format!("{label} sampling of {}", table_path.display()));
+    if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {elapsed}") {
+        progress.set_style(style.progress_chars("=> "));
+    }
+    let start = Instant::now();
+    let data = compute(table, plan, grid, &progress);
+    let seconds = start.elapsed().as_secs_f64();
+    progress.finish_and_clear();
+    if use_cache {
+        if let Err(e) = cache::store(&path, &key, &data) {
+            note.push_str(&format!(" (not cached: {e})"));
+        } else {
+            note.push_str(&format!(", cached in {}", path.display()));
+        }
+    }
+    let prepared = from_payload(plan, grid, &data);
+    let memory_bytes = prepared.memory_bytes();
+    let message = format!(
+        "{}: {label} sampling on a {} x {} x {} grid precomputed in {seconds:.2} s, {} KiB{note}",
+        table_path.display(),
+        grid.n_o,
+        grid.n_w,
+        grid.n_phi,
+        memory_bytes / 1024
+    );
+    Ok((
+        prepared,
+        PrecomputeReport {
+            seconds,
+            from_cache: false,
+            memory_bytes,
+            message,
+        },
+    ))
+}
