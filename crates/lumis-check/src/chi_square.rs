@@ -89,33 +89,50 @@ const GAUSS_LEGENDRE_5: [(f64, f64); 5] = [
     (0.906_179_845_938_664, 0.236_926_885_056_189_1),
 ];
 
-/// 5x5-point Gauss-Legendre over the cell `[z0, z0+hz] x [phi0, phi0+hphi]`.
-fn cell_integral(pdf: &dyn Fn(Vec3) -> f32, z0: f64, hz: f64, phi0: f64, hphi: f64) -> f64 {
+/// 5x5-point Gauss-Legendre over the cell `[z0, z0+hz] x [phi0, phi0+hphi]`,
+/// and whether the cell holds an edge of the support (some nodes zero,
+/// some not).
+fn cell_integral(pdf: &dyn Fn(Vec3) -> f32, z0: f64, hz: f64, phi0: f64, hphi: f64) -> (f64, bool) {
     let mut sum = 0.0;
+    let (mut zero, mut positive) = (false, false);
     for (xa, wa) in GAUSS_LEGENDRE_5 {
         for (xb, wb) in GAUSS_LEGENDRE_5 {
             let d = direction(z0 + 0.5 * hz * (1.0 + xa), phi0 + 0.5 * hphi * (1.0 + xb));
-            sum += wa * wb * pdf(d) as f64;
+            let p = pdf(d) as f64;
+            zero |= p == 0.0;
+            positive |= p > 0.0;
+            sum += wa * wb * p;
         }
     }
-    sum * 0.25 * hz * hphi
+    (sum * 0.25 * hz * hphi, zero && positive)
+}
+
+/// Absolute tolerances (in probability) of [`adaptive_integral`]: one for
+/// smooth cells, a stricter one for cells that an edge of the support
+/// crosses.
+#[derive(Debug, Clone, Copy)]
+struct Tolerance {
+    smooth: f64,
+    edge: f64,
 }
 
 /// Adaptive quadrature: a cell is split in four until the four quarters
-/// agree with the whole to `tolerance` (absolute, in probability), so
-/// peaked pdfs (area lights seen at grazing angles) are integrated
-/// accurately where they need it and cheaply elsewhere. Each quarter gets
-/// half the tolerance: what keeps refining is a jump along a curve (a
-/// horizon seen through the lobe zoom), whose error sits in about two of
-/// the four quarters and halves with each level, so a quarter of the
-/// tolerance would never be met and every such cell would go to the
-/// maximum depth. The nodes are interior, so pdfs that jump at a cell edge
-/// (a hemisphere's rim) are handled too.
+/// agree with the whole to the tolerance, so peaked pdfs (area lights seen
+/// at grazing angles) are integrated accurately where they need it and
+/// cheaply elsewhere. Each quarter gets half the tolerance: what keeps
+/// refining is a jump along a curve (a horizon seen through the lobe
+/// zoom), whose error sits in about two of the four quarters and halves
+/// with each level, so a quarter of the tolerance would never be met and
+/// every such cell would go to the maximum depth. Cells crossed by an edge
+/// of the support use the strict tolerance: their errors share a sign
+/// along the whole edge, and their sum decides the expected count of the
+/// "no sample" cell. The nodes are interior, so pdfs that jump at a cell
+/// edge (a hemisphere's rim) are handled too.
 fn adaptive_integral(
     pdf: &dyn Fn(Vec3) -> f32,
     (z0, hz, phi0, hphi): (f64, f64, f64, f64),
     whole: f64,
-    tolerance: f64,
+    tolerance: Tolerance,
     depth: u32,
     forced: u32,
 ) -> f64 {
@@ -127,18 +144,28 @@ fn adaptive_integral(
         (z0 + qz, phi0 + qphi),
     ]
     .map(|(z, phi)| (z, phi, cell_integral(pdf, z, qz, phi, qphi)));
-    let refined: f64 = quarters.iter().map(|q| q.2).sum();
-    if depth == 0 || (forced == 0 && (refined - whole).abs() <= tolerance) {
+    let refined: f64 = quarters.iter().map(|q| q.2 .0).sum();
+    let edge = quarters.iter().any(|q| q.2 .1);
+    let allowed = if edge {
+        tolerance.edge
+    } else {
+        tolerance.smooth
+    };
+    if depth == 0 || (forced == 0 && (refined - whole).abs() <= allowed) {
         return refined;
     }
+    let half = Tolerance {
+        smooth: 0.5 * tolerance.smooth,
+        edge: 0.5 * tolerance.edge,
+    };
     quarters
         .iter()
-        .map(|&(z, phi, part)| {
+        .map(|&(z, phi, (part, _))| {
             adaptive_integral(
                 pdf,
                 (z, qz, phi, qphi),
                 part,
-                0.5 * tolerance,
+                half,
                 depth - 1,
                 forced.saturating_sub(1),
             )
@@ -165,12 +192,19 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
     // Bins of (almost) no mass keep an absolute floor, a total well below
     // one expected sample over the whole grid.
     let floor = 0.01 / (cfg.samples as f64 * (cfg.z_bins * cfg.phi_bins) as f64).sqrt();
-    let tolerance = |whole: f64| floor.max(0.05 * (whole.max(0.0) / cfg.samples as f64).sqrt());
+    let tolerance = |whole: f64| Tolerance {
+        smooth: floor.max(0.05 * (whole.max(0.0) / cfg.samples as f64).sqrt()),
+        edge: floor,
+    };
+    let strict = Tolerance {
+        smooth: floor,
+        edge: floor,
+    };
     let mut mass = vec![0.0; cfg.z_bins * cfg.phi_bins];
     for zi in 0..cfg.z_bins {
         for pi in 0..cfg.phi_bins {
             let cell = (-1.0 + zi as f64 * dz, dz, pi as f64 * dphi, dphi);
-            let whole = cell_integral(pdf, cell.0, cell.1, cell.2, cell.3);
+            let (whole, _) = cell_integral(pdf, cell.0, cell.1, cell.2, cell.3);
             let i = zi * cfg.phi_bins + pi;
             // The first levels are always refined: a feature narrower than
             // the coarse nodes' spacing would otherwise go unseen.
@@ -180,7 +214,7 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
                     pdf,
                     cell,
                     whole,
-                    floor,
+                    strict,
                     cfg.max_refinement,
                     cfg.max_refinement,
                 );

@@ -2,19 +2,29 @@
 //!
 //! The mapping is one function, [`bsdf_table`], that writes the TOML table
 //! of a BSDF plugin, which the registry then instantiates like any
-//! `[[bsdf]]`; a conductor or plastic plugin for metallic and rough
-//! materials only has to change that function.
+//! `[[bsdf]]`.
 
 use lumis_core::Rgb;
+
+/// Materials at least this metallic are rendered as metal; glTF's blend
+/// of a metal and a dielectric lobe by `metallic` has no lumis BSDF.
+const METALLIC_THRESHOLD: f32 = 0.5;
 
 /// A BSDF plugin table (`type = ...` and its parameters) for `material`,
 /// and what the mapping had to leave out.
 ///
-/// Today every material maps to `diffuse` with its base colour factor (a
-/// base colour texture multiplies it; the caller wraps the BSDF):
-/// lumis has no conductor or rough dielectric yet, so `metallic` and
-/// `roughness` are not modelled (said in the warnings when they would
-/// matter). `doubleSided` maps to `two_sided`.
+/// - Metals (`metallicFactor >= 0.5`): `conductor` with GGX normals of
+///   `alpha = roughness^2` (the glTF specification's remapping), Fresnel 1
+///   scaled by the base colour, the glTF metal's reflectance at normal
+///   incidence (its Schlick rise towards white at grazing angles is not
+///   modelled). One-sided.
+/// - Dielectrics: `diffuse` with the base colour; the specular coat of
+///   glTF's dielectric (IOR 1.5, `roughness`) is left out, since most
+///   assets' dielectrics are meant matte, and `doubleSided` maps to
+///   `two_sided`.
+///
+/// A base colour texture multiplies either (the caller wraps the BSDF).
+/// What is approximated is said in the warnings.
 pub(crate) fn bsdf_table(
     material: &gltf::Material,
     label: &str,
@@ -29,13 +39,37 @@ pub(crate) fn bsdf_table(
     }
     let mut warnings = Vec::new();
     // The default material (no index) is metallic 1 by the spec's defaults
-    // but means "untextured grey"; only declared materials are reported.
-    let metallic = pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some();
-    if material.index().is_some() && metallic {
+    // but means "untextured grey": it stays diffuse, and only declared
+    // materials are reported.
+    let declared = material.index().is_some();
+    let metallic = pbr.metallic_factor();
+    let roughness = pbr.roughness_factor();
+    if declared && pbr.metallic_roughness_texture().is_some() {
         warnings.push(format!(
-            "material {label}: metallic {} / roughness {} not modelled (no conductor BSDF yet); rendered as diffuse",
-            pbr.metallic_factor(),
-            pbr.roughness_factor()
+            "material {label}: metallicRoughnessTexture not modelled; metallic {metallic} and roughness {roughness} used everywhere"
+        ));
+    }
+    if declared && metallic > 0.0 && metallic < 1.0 {
+        warnings.push(format!(
+            "material {label}: metallic {metallic} rendered as {} (no blend of metal and dielectric)",
+            if metallic >= METALLIC_THRESHOLD { "metal" } else { "dielectric" }
+        ));
+    }
+    if declared && metallic >= METALLIC_THRESHOLD {
+        if material.double_sided() {
+            warnings.push(format!(
+                "material {label}: doubleSided metal rendered one-sided (the conductor is black from behind)"
+            ));
+        }
+        let alpha = (roughness * roughness).clamp(0.0, 1.0);
+        let table = format!(
+            "type = \"conductor\"\ndistribution = \"ggx\"\nroughness = {alpha:?}\nspecular_reflectance = [{r:?}, {g:?}, {b:?}]\n"
+        );
+        return Ok((table, warnings));
+    }
+    if declared && roughness < 1.0 {
+        warnings.push(format!(
+            "material {label}: dielectric with roughness {roughness} rendered as diffuse (its specular coat is not modelled)"
         ));
     }
     let table = format!(
