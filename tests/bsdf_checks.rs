@@ -19,19 +19,33 @@ fn every_builtin_bsdf_passes_the_check_suite() {
         .filter(|&name| name != "measured")
         .collect();
     assert!(!names.is_empty());
+    let mut failures = Vec::new();
     for name in names {
         let results = check_bsdf(&registry, name, &BsdfCheckConfig::default()).unwrap();
         let ok = |r: &CaseResult| {
-            let beyond_f32 = BEYOND_F32
-                .iter()
-                .any(|&(b, v, c)| r.bsdf == b && r.variant == v && r.cos_theta_o == c);
-            r.problems.is_empty() && (beyond_f32 || r.chi_square.passed)
+            let unresolvable = UNRESOLVABLE.iter().any(|&(b, v, c)| {
+                r.bsdf == b && r.variant == v && c.is_none_or(|c| r.cos_theta_o == c)
+            });
+            r.problems.is_empty() && (unresolvable || r.chi_square.passed)
         };
-        assert!(results.iter().all(ok), "{}", format_results(&results));
+        if !results.iter().all(ok) {
+            failures.push(format_results(&results));
+        }
     }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// Cases whose lobe is narrower than f32 directions resolve, checked for
-/// everything but the chi-square (tests/bsdf_sweep.rs and the README's
-/// BSDF section say why): Blinn's declared maximum exponent at grazing.
-const BEYOND_F32: &[(&str, &str, f32)] = &[("blinn", "exponent = 1000000.0", 1e-4)];
+/// Declared extremes whose lobes the chi-square cannot resolve, checked for
+/// everything else (finiteness, sample_f/f/pdf consistency, energy,
+/// reciprocity); `None` for every incident angle. The README's BSDF section
+/// says why:
+/// - Blinn's maximum exponent at grazing is narrower than f32 directions;
+/// - one roughness axis at its floor (1e-3) with the other at 0.1 or 1 is
+///   a 1:100 or 1:1000 sliver, beyond the isotropic lobe zoom (the sweep
+///   of tests/bsdf_sweep.rs tests 1:10 both ways).
+const UNRESOLVABLE: &[(&str, &str, Option<f32>)] = &[
+    ("blinn", "exponent = 1000000.0", Some(1e-4)),
+    ("conductor", "roughness_v = 0.0", None),
+    ("dielectric", "roughness_v = 1.0", None),
+    ("plastic", "roughness_v = 1.0", None),
+];

@@ -59,7 +59,7 @@ pub const ROUGHNESS_PARAM: ParamSpec = ParamSpec::with_default(
 pub const ROUGHNESS_V_PARAM: ParamSpec = ParamSpec::optional(
     "roughness_v",
     ParamType::Float,
-    "alpha along the surface's second tangent (anisotropy); default: roughness",
+    "alpha along the surface's second tangent (anisotropy); default: roughness; each axis is at least 1e-3 once the other is",
 )
 .in_range(0.0, 1.0);
 
@@ -89,7 +89,17 @@ pub struct Microfacet {
 }
 
 impl Microfacet {
+    /// A distribution of widths `alpha_x`, `alpha_y`. Once either is above
+    /// [`SMOOTH_THRESHOLD`] (a glossy lobe), the other is raised to at least
+    /// the threshold, as pbrt-v4's `TrowbridgeReitzDistribution` clamps
+    /// alpha: `D` divides by each alpha, and an anisotropic lobe cannot be
+    /// a delta along one axis only.
     pub fn new(distribution: Distribution, alpha_x: f32, alpha_y: f32) -> Self {
+        let (alpha_x, alpha_y) = if alpha_x.max(alpha_y) >= SMOOTH_THRESHOLD {
+            (alpha_x.max(SMOOTH_THRESHOLD), alpha_y.max(SMOOTH_THRESHOLD))
+        } else {
+            (alpha_x, alpha_y)
+        };
         Self {
             distribution,
             alpha_x,
