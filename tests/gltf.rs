@@ -538,7 +538,10 @@ fn metals_render_as_the_conductor_they_map_to() {
     );
     let a = render_image(&from_gltf);
     let b = render_image(&inline);
-    assert!(a.iter().filter(|&&v| v > 0.0).count() > 50, "the metal is lit");
+    assert!(
+        a.iter().filter(|&&v| v > 0.0).count() > 50,
+        "the metal is lit"
+    );
     assert_eq!(a, b, "same image bit for bit");
 }
 
@@ -909,10 +912,9 @@ fn what_is_not_modelled_is_reported() {
     let scene = load(&dir, &gltf_shape(&file, ""));
     let report = scene.scene.load_report();
     assert!(
-        report
-            .warnings
-            .iter()
-            .any(|w| w.contains("gold.glb") && w.contains("\"gold\"") && w.contains("metallic 0.7")),
+        report.warnings.iter().any(|w| w.contains("gold.glb")
+            && w.contains("\"gold\"")
+            && w.contains("metallic 0.7")),
         "{:?}",
         report.warnings
     );
