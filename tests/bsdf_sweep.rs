@@ -21,8 +21,19 @@ fn run(name: &str, variants: Vec<Variant>) {
     run_except(name, variants, &[]);
 }
 
+/// Roughness 1e-3 seen at cos theta_o = +-1e-4: the reflected lobe is at
+/// most 2 <wo, m> alpha ~ 2e-6 rad wide across the plane of incidence,
+/// some 30 f32 ulps, and the rounded directions miss the pdf's mass by
+/// ~0.05% (0.15% inside glass), which a million samples detect. The sweep
+/// tests roughness 1e-3 from cos theta_o = 0.01 and grazing angles from
+/// roughness 0.01 by chi-square; these cases by every other check.
+fn beyond_f32_at_grazing(r: &CaseResult) -> bool {
+    r.variant.contains("alpha 0.001") && r.cos_theta_o.abs() == 1e-4
+}
+
 /// [`run`], with the chi-square of the cases `(variant label, cos theta_o)`
-/// in `beyond_f32` left out (every other check still applies to them).
+/// in `beyond_f32` (and those of [`beyond_f32_at_grazing`]) left out;
+/// every other check still applies to them.
 fn run_except(name: &str, variants: Vec<Variant>, beyond_f32: &[(&str, f32)]) {
     let registry = lumis_cli::builtin_registry().unwrap();
     let results =
@@ -30,9 +41,10 @@ fn run_except(name: &str, variants: Vec<Variant>, beyond_f32: &[(&str, f32)]) {
     let report = format_results(&results);
     println!("{report}");
     let ok = |r: &CaseResult| {
-        let exempt = beyond_f32
-            .iter()
-            .any(|&(label, c)| r.variant == label && r.cos_theta_o == c);
+        let exempt = beyond_f32_at_grazing(r)
+            || beyond_f32
+                .iter()
+                .any(|&(label, c)| r.variant == label && r.cos_theta_o == c);
         if exempt {
             r.problems.is_empty()
         } else {
@@ -71,19 +83,7 @@ fn conductor_sweep() {
             format!("sampling = \"{sampling}\"\nroughness = 0.1\nmaterial = \"Cu\"\n"),
         ));
     }
-    // Sampling the full distribution of a lobe 1e-3 wide seen at cos
-    // theta_o = 1e-4 puts the half vectors around the normal, where <wo, m>
-    // is ~1e-4: the reflected lobe is then 2e-7 rad wide across the plane of
-    // incidence, beyond f32 directions, as for Blinn below. Visible-normal
-    // sampling tilts the normals towards wo and passes there.
-    run_except(
-        "conductor",
-        variants,
-        &[
-            ("ggx full alpha 0.001", 1e-4),
-            ("beckmann full alpha 0.001", 1e-4),
-        ],
-    );
+    run("conductor", variants);
 }
 
 #[test]

@@ -40,8 +40,11 @@ const RELAXED_WIDTHS: f64 = 6.0;
 const MIN_ZOOM: f64 = 4.0;
 const PILOT_SAMPLES: usize = 20_000;
 /// A peak holding less than this share of the pilot samples is not a lobe
-/// to magnify (the `1 / <wo, h>` spike of a wide lobe at grazing angles).
+/// to magnify (the `1 / <wo, h>` spike of a wide lobe at grazing angles),
+/// nor one of fewer samples than `MIN_PEAK_SAMPLES` (too few to measure a
+/// width: a hemisphere that receives almost nothing).
 const MIN_PEAK_SHARE: f64 = 0.02;
+const MIN_PEAK_SAMPLES: usize = 100;
 
 /// The map `d -> d'` for one lobe.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -220,7 +223,9 @@ impl LobeZoom {
             .filter(|&&(_, p)| p >= 1e-2 * peak)
             .map(|&(d, _)| d.dot(centre).clamp(-1.0, 1.0).acos())
             .collect();
-        if (angles.len() as f64) < MIN_PEAK_SHARE * pilot.len() as f64 {
+        if angles.len() < MIN_PEAK_SAMPLES
+            || (angles.len() as f64) < MIN_PEAK_SHARE * pilot.len() as f64
+        {
             return None;
         }
         angles.sort_by(f64::total_cmp);
