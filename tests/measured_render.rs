@@ -10,7 +10,7 @@
 //! cargo test -p lumis-tests --test measured_render measured_results_table -- --nocapture
 //! ```
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::ProgressBar;
@@ -21,7 +21,7 @@ use lumis_measured::grid::Grid;
 use lumis_measured::merl::MerlTable;
 use lumis_measured::precompute::{prepare, Plan};
 use lumis_sampling::Pcg32;
-use lumis_tests::{read_scene, render_toml_with, scenes_dir};
+use lumis_tests::{read_scene, render_toml_with, scenes_dir, tabulated};
 
 /// Name, plugin, parameters of the tabulated BSDF, and the same as a
 /// `[[bsdf]]` table for the analytic render.
@@ -57,22 +57,6 @@ fn temp_dir(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("lumis-measured-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> PathBuf {
-    let output = dir.join(format!("{name}.binary"));
-    let registry = lumis_cli::builtin_registry().unwrap();
-    tabulate_bsdf(
-        &TabulateArgs {
-            bsdf: bsdf.into(),
-            set: set.iter().map(|s| s.to_string()).collect(),
-            output: output.clone(),
-            quiet: true,
-        },
-        &registry,
-    )
-    .unwrap();
-    output
 }
 
 fn bsdf(toml: &str) -> std::sync::Arc<dyn Bsdf> {

@@ -7,12 +7,10 @@
 //! 1e-4, 0.01, 0.1, 0.5, 1 and -1e-4, -0.5, -1 (one-sided: no samples from
 //! behind).
 
-use std::path::{Path, PathBuf};
-
 use lumis_check::bsdf_suite::{
     check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
 };
-use lumis_cli::{tabulate_bsdf, TabulateArgs};
+use lumis_tests::tabulated;
 
 /// The three materials of the measured-results table.
 pub const MATERIALS: [(&str, &str, &[&str]); 3] = [
@@ -32,22 +30,6 @@ pub const MATERIALS: [(&str, &str, &[&str]); 3] = [
         &["roughness=0.05", "material=Cu"],
     ),
 ];
-
-fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> PathBuf {
-    let output = dir.join(format!("{name}.binary"));
-    let registry = lumis_cli::builtin_registry().unwrap();
-    tabulate_bsdf(
-        &TabulateArgs {
-            bsdf: bsdf.into(),
-            set: set.iter().map(|s| s.to_string()).collect(),
-            output: output.clone(),
-            quiet: true,
-        },
-        &registry,
-    )
-    .unwrap();
-    output
-}
 
 #[test]
 fn every_strategy_passes_the_check_kit_down_to_grazing() {

@@ -143,6 +143,24 @@ fn two_sided_tail(z: f64) -> f64 {
         .exp()
 }
 
+/// Writes the BSDF plugin `bsdf` with the `set` overrides as the MERL
+/// table `dir/name.binary`, as `lumis brdf tabulate` does.
+pub fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> std::path::PathBuf {
+    let output = dir.join(format!("{name}.binary"));
+    let registry = lumis_cli::builtin_registry().unwrap();
+    lumis_cli::tabulate_bsdf(
+        &lumis_cli::TabulateArgs {
+            bsdf: bsdf.into(),
+            set: set.iter().map(|s| s.to_string()).collect(),
+            output: output.clone(),
+            quiet: true,
+        },
+        &registry,
+    )
+    .unwrap();
+    output
+}
+
 /// Pixelwise mean of images.
 pub fn mean_image(images: &[Image]) -> Image {
     let mut out = Image::new(images[0].width, images[0].height);

@@ -7,13 +7,14 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use lumis_core::doc;
 use lumis_core::registry::TableRef;
 use lumis_core::{Error, Location, Registry, Result};
 use lumis_measured::grid::Grid;
 use lumis_measured::merl::{write_atomic, MerlTable, THETA_H_RES};
 use lumis_measured::precompute::{prepare, Plan};
 use lumis_measured::tabulate::tabulate;
+
+use crate::assignments::parameter_table;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct TabulateArgs {
@@ -44,45 +45,6 @@ pub struct PrecomputeArgs {
     /// Outgoing elevations, half-angle bins, azimuth bins.
     #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
     pub grid: Vec<usize>,
-}
-
-/// A table of plugin parameters from `key=value` strings (a TOML value, or
-/// else a bare string).
-pub fn parameter_table(assignments: &[String]) -> Result<doc::Table> {
-    let mut text = String::new();
-    for assignment in assignments {
-        let (key, value) = assignment
-            .split_once('=')
-            .ok_or_else(|| Error::msg(format!("--set {assignment}: expected key=value")))?;
-        let (key, value) = (key.trim(), value.trim());
-        let line = format!("{key} = {value}\n");
-        text += &if doc::parse(&line, "--set").is_ok() {
-            line
-        } else {
-            format!("{key} = {value:?}\n")
-        };
-    }
-    doc::parse(&text, "--set")
-}
-
-/// `key=value` strings as `(key, TOML value)` pairs (a bare word becomes a
-/// string), for `check-plugin --set`.
-pub fn fixed_parameters(assignments: &[String]) -> Result<Vec<(String, String)>> {
-    // Parsing them as one table checks the syntax and rejects repeated keys.
-    parameter_table(assignments)?;
-    Ok(assignments
-        .iter()
-        .filter_map(|a| a.split_once('='))
-        .map(|(key, value)| {
-            let value = value.trim();
-            let toml = if doc::parse(&format!("v = {value}\n"), "--set").is_ok() {
-                value.to_string()
-            } else {
-                format!("{value:?}")
-            };
-            (key.trim().to_string(), toml)
-        })
-        .collect())
 }
 
 /// `lumis brdf tabulate`: returns the summary line.

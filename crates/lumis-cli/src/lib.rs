@@ -2,6 +2,7 @@
 //! `samplers analyze` commands, as a library so end-to-end tests and benchmarks drive exactly
 //! what users run.
 
+mod assignments;
 mod brdf;
 mod converge;
 mod diff;
@@ -10,10 +11,8 @@ mod reference;
 mod render;
 mod samplers_analyze;
 
-pub use brdf::{
-    fixed_parameters, parameter_table, precompute_table, tabulate_bsdf, PrecomputeArgs,
-    TabulateArgs,
-};
+pub use assignments::{fixed_parameters, parameter_table};
+pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use listing::plugin_listing;

@@ -15,6 +15,8 @@ use lumis_core::doc;
 use lumis_core::registry::TableRef;
 use lumis_core::{Error, Location, PluginKind, Registry, Result, Sampler, UVec2};
 
+use crate::assignments::parameter_text;
+
 #[derive(clap::Args, Debug, Clone)]
 pub struct AnalyzeArgs {
     /// Sampler plugin to analyse, or `all` for every registered sampler.
@@ -67,20 +69,7 @@ fn make_sampler(
     params: &[String],
     count: u32,
 ) -> Result<Box<dyn Sampler>> {
-    let mut text = format!("spp = {count}\n");
-    for assignment in params {
-        let (key, value) = assignment
-            .split_once('=')
-            .ok_or_else(|| Error::msg(format!("--set {assignment}: expected key=value")))?;
-        let (key, value) = (key.trim(), value.trim());
-        // A TOML value, or else a bare string.
-        let line = format!("{key} = {value}\n");
-        text += &if doc::parse(&line, "--set").is_ok() {
-            line
-        } else {
-            format!("{key} = {value:?}\n")
-        };
-    }
+    let text = format!("spp = {count}\n{}", parameter_text(params)?);
     let table = doc::parse(&text, "--set")?;
     registry.create_sampler(&TableRef {
         owner: "sampler",

@@ -78,6 +78,36 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
+impl BsdfSample {
+    /// The sample of a non-delta reflection lobe at `wi`, with the density
+    /// and value that the BSDF's own `pdf` and `f` give there, so that
+    /// `sample_f` agrees with them to the last bit; `None` below the
+    /// horizon or where the density is not positive and finite, since such
+    /// a sample could not be weighted.
+    #[inline]
+    pub fn reflection(
+        wi: Vec3,
+        flags: BsdfFlags,
+        pdf: impl FnOnce(Vec3) -> f32,
+        f: impl FnOnce(Vec3) -> Rgb,
+    ) -> Option<Self> {
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = pdf(wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(Self {
+            f: f(wi),
+            wi,
+            pdf,
+            flags,
+            eta: 1.0,
+        })
+    }
+}
+
 /// A BSDF in its local shading frame (`z` = shading normal).
 ///
 /// Directions point away from the surface. `f` excludes the cosine factor;

@@ -162,20 +162,12 @@ impl Bsdf for Blinn {
             }
             baseline => baseline.sample_baseline(u2)?,
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(BsdfSample {
-            f: self.eval(wo, wi),
+        BsdfSample::reflection(
             wi,
-            pdf,
-            flags: BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            eta: 1.0,
-        })
+            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            |wi| self.eval_pdf(wo, wi),
+            |wi| self.eval(wo, wi),
+        )
     }
 
     #[inline]

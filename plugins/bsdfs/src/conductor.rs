@@ -264,20 +264,12 @@ impl Bsdf for Conductor {
             }
             baseline => baseline.sample_baseline(u2)?,
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.rough_pdf(mf, wo, wi);
-        if pdf <= 0.0 || !pdf.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            f: self.rough_f(mf, wo, wi),
+        BsdfSample::reflection(
             wi,
-            pdf,
-            flags: BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            eta: 1.0,
-        })
+            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            |wi| self.rough_pdf(mf, wo, wi),
+            |wi| self.rough_f(mf, wo, wi),
+        )
     }
 
     #[inline]

@@ -235,25 +235,17 @@ impl Bsdf for Plastic {
         } else {
             warp::square_to_cosine_hemisphere(u2)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
         let flags = if self.coat.is_some() && u1 < p {
             BsdfFlags::GLOSSY | BsdfFlags::REFLECTION
         } else {
             BsdfFlags::DIFFUSE_REFLECTION
         };
-        Some(BsdfSample {
-            f: self.eval(wo, wi),
+        BsdfSample::reflection(
             wi,
-            pdf,
             flags,
-            eta: 1.0,
-        })
+            |wi| self.eval_pdf(wo, wi),
+            |wi| self.eval(wo, wi),
+        )
     }
 
     #[inline]

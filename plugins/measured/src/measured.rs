@@ -183,22 +183,14 @@ impl Bsdf for Measured {
             Strategy::Prepared(Prepared::Factored(f)) => f.sample(wo, u1, u2)?,
             Strategy::Prepared(Prepared::Tabulated(t)) => t.sample(wo, u1, u2)?,
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
         // The density from the direction, as pdf() computes it, so that the
         // two agree to the last bit even at bin boundaries.
-        let pdf = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(BsdfSample {
-            f: self.eval(wo, wi),
+        BsdfSample::reflection(
             wi,
-            pdf,
-            flags: BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            eta: 1.0,
-        })
+            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            |wi| self.eval_pdf(wo, wi),
+            |wi| self.eval(wo, wi),
+        )
     }
 
     #[inline]
