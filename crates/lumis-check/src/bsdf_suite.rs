@@ -5,7 +5,8 @@
 //!
 //! - chi-square goodness of fit of `sample_f` against `pdf`;
 //! - `pdf` integrates to at most 1 (and to the fraction of samples returned);
-//! - `sample_f` returns the `f` and `pdf` that `f()` and `pdf()` give;
+//! - `sample_f` returns the `f` and `pdf` that `f()` and `pdf()` give, and
+//!   `eval()` returns both exactly;
 //! - energy: the directional albedo is at most 1 (a white furnace per lobe),
 //!   measured in importance transport so that the `1/eta^2` radiance
 //!   scaling of refraction (a change of units, not of energy) is left out;
@@ -286,6 +287,12 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
         let wi = warp::square_to_uniform_sphere(u2);
         let radiance = BsdfContext::default();
         let (f, pdf) = (bsdf.f(&radiance, wo, wi), bsdf.pdf(&radiance, wo, wi));
+        let (eval_f, eval_pdf) = bsdf.eval(&radiance, wo, wi);
+        if eval_f != f || eval_pdf.to_bits() != pdf.to_bits() {
+            note(format!(
+                "eval() = ({eval_f:?}, {eval_pdf}) but (f(), pdf()) = ({f:?}, {pdf}) at wi = {wi:?}"
+            ));
+        }
         if !f.is_finite() || f.min_component() < 0.0 || !pdf.is_finite() || pdf < 0.0 {
             note(format!("f() = {f:?}, pdf() = {pdf} at wi = {wi:?}"));
         }

@@ -122,4 +122,13 @@ pub trait Bsdf: Send + Sync {
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample>;
 
     fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32;
+
+    /// `(f, pdf)` of one pair of directions in one call (Mitsuba 3's
+    /// `eval_pdf`): light sampling needs both, and a model that overrides
+    /// this shares their work (orientation tests, half vector, `D`). Must
+    /// return exactly what `f` and `pdf` return; the check kit compares.
+    #[inline]
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        (self.f(ctx, wo, wi), self.pdf(ctx, wo, wi))
+    }
 }

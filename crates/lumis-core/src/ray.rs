@@ -40,36 +40,54 @@ impl Ray {
 #[inline]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     let d = n.abs().dot(p_error);
-    let mut offset = n * d;
-    if w.dot(n) < 0.0 {
-        offset = -offset;
-    }
+    // A select, not a branch: which side `w` leaves on is data-dependent.
+    let side = if w.dot(n) < 0.0 { -1.0 } else { 1.0 };
+    let offset = n * (d * side);
     let po = p + offset;
-    Vec3::new(
-        step_toward(po.x, offset.x),
-        step_toward(po.y, offset.y),
-        step_toward(po.z, offset.z),
-    )
+    let bits = [po.x, po.y, po.z].map(f32::to_bits);
+    // The common case (every component finite and non-zero) is one integer
+    // step per component without branches; zeros and infinities take the
+    // exact next_float path.
+    if bits
+        .iter()
+        .any(|&b| (b & 0x7fff_ffff).wrapping_sub(1) >= 0x7f7f_ffff)
+    {
+        return Vec3::new(
+            step_toward(po.x, offset.x),
+            step_toward(po.y, offset.y),
+            step_toward(po.z, offset.z),
+        );
+    }
+    let [x, y, z] = [
+        (bits[0], offset.x),
+        (bits[1], offset.y),
+        (bits[2], offset.z),
+    ]
+    .map(|(b, o)| f32::from_bits(step_bits(b, o)));
+    Vec3::new(x, y, z)
+}
+
+/// The bits of a finite, non-zero `v` moved one ulp toward the sign of
+/// `direction` (unchanged for a zero direction): moving away from zero
+/// increments the bits, toward zero decrements them.
+#[inline(always)]
+fn step_bits(bits: u32, direction: f32) -> u32 {
+    let toward_zero = (bits ^ direction.to_bits()) >> 31;
+    let step = 1u32.wrapping_sub(toward_zero << 1);
+    bits.wrapping_add(if direction == 0.0 { 0 } else { step })
 }
 
 /// `next_float_up(v)` if `direction > 0`, `next_float_down(v)` if `< 0`,
-/// else `v`; the common finite, non-zero case is one integer add on the
-/// bits (moving away from zero increments them, toward zero decrements).
-#[inline(always)]
+/// else `v`.
+#[inline]
 fn step_toward(v: f32, direction: f32) -> f32 {
-    if direction == 0.0 {
-        return v;
+    if direction > 0.0 {
+        next_float_up(v)
+    } else if direction < 0.0 {
+        next_float_down(v)
+    } else {
+        v
     }
-    if v == 0.0 || !v.is_finite() {
-        return if direction > 0.0 {
-            next_float_up(v)
-        } else {
-            next_float_down(v)
-        };
-    }
-    let away_from_zero = (v > 0.0) == (direction > 0.0);
-    let bits = v.to_bits();
-    f32::from_bits(if away_from_zero { bits + 1 } else { bits - 1 })
 }
 
 /// A point on a surface with its rounding-error bound and geometric normal,
@@ -127,29 +145,41 @@ mod tests {
     }
 
     #[test]
-    fn step_matches_next_float() {
-        for v in [
-            1.0f32,
-            -1.0,
-            0.0,
-            -0.0,
-            3.5e-38,
-            -7.25e12,
-            f32::MAX,
-            f32::INFINITY,
-        ] {
-            assert_eq!(
-                step_toward(v, 1.0).to_bits(),
-                next_float_up(v).to_bits(),
-                "{v}"
-            );
-            assert_eq!(
-                step_toward(v, -2.0).to_bits(),
-                next_float_down(v).to_bits(),
-                "{v}"
-            );
-            assert_eq!(step_toward(v, 0.0).to_bits(), v.to_bits());
+    fn integer_step_matches_next_float() {
+        for v in [1.0f32, -1.0, 3.5e-38, -1e-45, -7.25e12, f32::MAX, f32::MIN] {
+            let bits = v.to_bits();
+            assert_eq!(step_bits(bits, 1.0), next_float_up(v).to_bits(), "{v}");
+            assert_eq!(step_bits(bits, -2.0), next_float_down(v).to_bits(), "{v}");
+            assert_eq!(step_bits(bits, 0.0), bits);
+            assert_eq!(step_bits(bits, -0.0), bits);
         }
+    }
+
+    #[test]
+    fn zeros_and_infinities_take_the_exact_path() {
+        // A component at exactly zero must step to the smallest subnormal
+        // of the offset's sign, not wrap its bits around.
+        let o = offset_ray_origin(Vec3::ZERO, Vec3::ZERO, Vec3::Z, Vec3::Z);
+        assert_eq!(o, Vec3::ZERO, "no error, no move");
+        let p = Vec3::new(0.0, -0.0, 1.0);
+        let up = offset_ray_origin(p, Vec3::splat(1e-30), Vec3::new(0.0, 0.0, 1.0), Vec3::Z);
+        assert_eq!(up.x.to_bits(), 0.0f32.to_bits());
+        assert!(up.z > 1.0);
+        // p + offset rounds to exactly zero: one step below it.
+        let cancelled = offset_ray_origin(
+            Vec3::new(1e-30, 1.0, 1.0),
+            Vec3::new(1e-30, 0.0, 0.0),
+            -Vec3::X,
+            -Vec3::X,
+        );
+        assert_eq!(cancelled.x.to_bits(), next_float_down(0.0).to_bits());
+        let far = offset_ray_origin(
+            Vec3::new(f32::INFINITY, 1.0, 1.0),
+            Vec3::ONE,
+            Vec3::X,
+            Vec3::X,
+        );
+        assert_eq!(far.x, f32::INFINITY);
     }
 
     #[test]

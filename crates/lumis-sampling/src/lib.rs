@@ -28,7 +28,7 @@ pub use radical_inverse::{
 };
 pub use rng::{hash_u64, hash_with, pixel_key, Pcg32};
 pub use scramble::{fixed_to_unit_f32, owen_scramble, owen_scramble_reversed, xor_scramble};
-pub use sobol::{sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};
+pub use sobol::{sobol_reversed_pair, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};
 pub use spherical_rectangle::SphericalRectangle;
 pub use spherical_triangle::{
     SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,

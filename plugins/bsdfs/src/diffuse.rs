@@ -139,6 +139,14 @@ impl Bsdf for Diffuse {
             None => 0.0,
         }
     }
+
+    #[inline]
+    fn eval(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        match self.oriented(wo, wi) {
+            Some((_, wi)) => (self.reflectance * FRAC_1_PI, self.pdf_upper(wi.z)),
+            None => (Rgb::BLACK, 0.0),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -308,7 +308,9 @@ impl Estimator {
             uv: hit.uv,
             ..Default::default()
         };
-        let f = hit.bsdf.f(&bsdf_ctx, wo, wi) * wi.z.abs();
+        // One call for both: the pdf is only unused for delta lights.
+        let (f, p_bsdf) = hit.bsdf.eval(&bsdf_ctx, wo, wi);
+        let f = f * wi.z.abs();
         if f.is_black() {
             return Rgb::BLACK;
         }
@@ -319,11 +321,7 @@ impl Estimator {
         stats.light_samples += 1;
         let p_light = chosen.pmf * ls.pdf;
         let delta = light.kind() == LightKind::DeltaPosition;
-        let p_bsdf = if delta {
-            0.0
-        } else {
-            hit.bsdf.pdf(&bsdf_ctx, wo, wi)
-        };
+        let p_bsdf = if delta { 0.0 } else { p_bsdf };
         f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
     }
 

@@ -5,7 +5,7 @@ use lumis_core::{
 };
 use lumis_sampling::{
     fixed_to_unit_f32, hash_with, owen_scramble, owen_scramble_reversed, pixel_key,
-    sobol_reversed_u32, xor_scramble, SOBOL_DIMENSIONS,
+    sobol_reversed_pair, sobol_reversed_u32, xor_scramble, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -105,18 +105,30 @@ impl SobolSampler {
         hash_with(self.key, ((dimension as u64) << 2) | salt) as u32
     }
 
+    /// The scramble seed of sampler dimension `dimension`, hashed once per
+    /// pixel: the cached fast path stays small enough to inline.
+    #[inline(always)]
     fn scramble_seed(&mut self, dimension: u32) -> u32 {
-        let d = dimension as usize;
-        while self.seeds.len() <= d {
+        match self.seeds.get(dimension as usize) {
+            Some(&seed) => seed,
+            None => self.fill_seeds(dimension),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn fill_seeds(&mut self, dimension: u32) -> u32 {
+        while self.seeds.len() <= dimension as usize {
             let seed = self.seed(self.seeds.len() as u32, 0);
             self.seeds.push(seed);
         }
-        self.seeds[d]
+        self.seeds[dimension as usize]
     }
 
     /// The sample index a request starting at `dimension` uses: shuffled per
     /// request in padded mode (an Owen scramble of the index is a nested
     /// permutation, so aligned power-of-two blocks map onto themselves).
+    #[inline(always)]
     fn index_for(&self, dimension: u32) -> u32 {
         match (self.dimensions, self.randomize) {
             (Dimensions::Padded, Randomize::Owen | Randomize::Xor) if dimension >= 2 => {
@@ -128,6 +140,7 @@ impl SobolSampler {
 
     /// The Sobol' dimension behind sampler dimension `d` (component `c` of
     /// a request that started at `start`).
+    #[inline(always)]
     fn sobol_dimension(&self, start: u32, component: u32) -> usize {
         match self.dimensions {
             Dimensions::Sobol => (start + component) as usize % SOBOL_DIMENSIONS,
@@ -135,15 +148,36 @@ impl SobolSampler {
         }
     }
 
-    fn sample(&mut self, start: u32, component: u32) -> f32 {
-        let index = self.index_for(start);
-        let reversed = sobol_reversed_u32(index, self.sobol_dimension(start, component));
-        let seed = self.scramble_seed(start + component);
+    /// A bit-reversed Sobol' coordinate, randomised with `seed`, as a float.
+    #[inline(always)]
+    fn randomized(&self, reversed: u32, seed: u32) -> f32 {
         fixed_to_unit_f32(match self.randomize {
             Randomize::Owen => owen_scramble_reversed(reversed, seed),
             Randomize::Xor => xor_scramble(reversed.reverse_bits(), seed),
             Randomize::None => reversed.reverse_bits(),
         })
+    }
+
+    #[inline(always)]
+    fn sample_1d(&mut self, start: u32) -> f32 {
+        let index = self.index_for(start);
+        let reversed = sobol_reversed_u32(index, self.sobol_dimension(start, 0));
+        let seed = self.scramble_seed(start);
+        self.randomized(reversed, seed)
+    }
+
+    /// Both components of a 2D request: one index, one pass over its bits.
+    #[inline(always)]
+    fn sample_2d(&mut self, start: u32) -> Vec2 {
+        let index = self.index_for(start);
+        let dims = [
+            self.sobol_dimension(start, 0),
+            self.sobol_dimension(start, 1),
+        ];
+        let [r0, r1] = sobol_reversed_pair(index, dims);
+        let seed1 = self.scramble_seed(start + 1);
+        let seed0 = self.seeds[start as usize];
+        Vec2::new(self.randomized(r0, seed0), self.randomized(r1, seed1))
     }
 }
 
@@ -165,17 +199,17 @@ impl Sampler for SobolSampler {
     fn get_1d(&mut self) -> f32 {
         let d = self.dimension;
         self.dimension += 1;
-        self.sample(d, 0)
+        self.sample_1d(d)
     }
 
     fn get_2d(&mut self) -> Vec2 {
         let d = self.dimension;
         self.dimension += 2;
-        Vec2::new(self.sample(d, 0), self.sample(d, 1))
+        self.sample_2d(d)
     }
 
     fn get_pixel_2d(&mut self) -> Vec2 {
-        Vec2::new(self.sample(0, 0), self.sample(0, 1))
+        self.sample_2d(0)
     }
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
