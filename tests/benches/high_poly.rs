@@ -359,7 +359,9 @@ fn one_mesh(positions: &[[f32; 3]], indices: &[u32]) -> Asset {
 /// memory per triangle (with and without the process baseline) and rays
 /// per second, one line each.
 fn sweep(dir: &Path) {
-    println!("triangles, compact: peak B/triangle (above baseline); lumis primary, diffuse Mrays/s");
+    println!(
+        "triangles, compact: peak B/triangle (above baseline); lumis primary, diffuse Mrays/s"
+    );
     for levels in 5..=8 {
         let (positions, indices) = displaced_sphere(levels);
         let asset = one_mesh(&positions, &indices);

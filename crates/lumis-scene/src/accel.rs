@@ -11,14 +11,15 @@ use crate::as_table;
 /// `compact = "auto"` builds a compact BVH from this many unique triangles.
 ///
 /// The target is a peak of at most 120 bytes per unique triangle, BVH
-/// included. Measured with `cargo bench -p lumis-tests --bench high_poly --
-/// --sweep` (README, "High-poly assets"), a compact BVH costs about 90 B
-/// per triangle at peak and an uncompacted one about 150 B (Embree's leaves
-/// copy the vertices), on top of a 7 MB process baseline. So below about
-/// 250k triangles no setting meets the target (the baseline alone is 28 B
-/// per triangle there) and the BVH is too small to matter (under 16 MB),
-/// while compaction costs 16-33% of the rays per second: small scenes keep
-/// the fast BVH. From 250k on, compaction is what meets the target.
+/// included. Measured on single meshes (`cargo bench -p lumis-tests --bench
+/// high_poly -- --sweep`, README "High-poly assets"), peak bytes per
+/// triangle above the ~7 MB process baseline, uncompacted / compact:
+/// 179.7 / 147.9 at 82k triangles, 142.5 / 110.5 at 328k, 152.6 / 91.8 at
+/// 1.3M (Embree's uncompacted leaves copy the vertices). An uncompacted
+/// BVH never meets the target; a compact one does from about 250k
+/// triangles on. Below that, compaction saves under 3 MB (82k: 2.6 MB)
+/// and still costs 16-29% of the rays per second, so small scenes keep the
+/// fast BVH.
 pub const AUTO_COMPACT_TRIANGLES: usize = 250_000;
 
 /// The `compact` setting.
@@ -49,9 +50,7 @@ impl FromParam for Compaction {
             Value::Bool(true) => Ok(Compaction::Always),
             Value::Bool(false) => Ok(Compaction::Never),
             Value::String(s) if s == "auto" => Ok(Compaction::Auto),
-            Value::String(s) => Err(format!(
-                "expected true, false or \"auto\", found \"{s}\""
-            )),
+            Value::String(s) => Err(format!("expected true, false or \"auto\", found \"{s}\"")),
             v => Err(format!(
                 "expected true, false or \"auto\", found {}",
                 v.type_name()

@@ -63,8 +63,8 @@ const TOP_LEVEL_KEYS: &[&str] = &[
 pub(crate) struct Assembly<'r> {
     pub registry: &'r Registry,
     pub device: Device,
-    /// Quality and robustness for every BVH; compaction is decided by
-    /// [`build_bvhs`] once every shape is counted.
+    /// Quality and robustness for every BVH; `compaction` is decided once
+    /// every shape is counted, and applied by [`build_bvhs`].
     pub options: SceneOptions,
     pub compaction: Compaction,
     pub builder: SceneBuilder,

@@ -68,7 +68,11 @@ impl LoadReport {
 impl LoadReport {
     /// Whether the BVH is compact, and why.
     fn compaction_line(&self, counts: &SceneCounts) -> String {
-        let built = if self.compact { "compact" } else { "not compact" };
+        let built = if self.compact {
+            "compact"
+        } else {
+            "not compact"
+        };
         let why = match self.compaction {
             Compaction::Auto => format!(
                 "compact = \"auto\": {} unique triangles, {} the {AUTO_COMPACT_TRIANGLES} threshold",

@@ -18,6 +18,7 @@ mod normals;
 mod resolve;
 mod scene_graph;
 mod texture;
+mod two_sided;
 mod unmodelled;
 
 use std::path::{Path, PathBuf};
