@@ -5,7 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use lumis_core::{BsdfContext, Ray, Scene, Vec3};
+use lumis_core::registry::TableRef;
+use lumis_core::{BsdfContext, Location, Ray, Scene, Vec2, Vec3};
 use lumis_render::{render, RenderSettings};
 use lumis_scene::LoadedScene;
 use lumis_tests::gltf_writer::{self, Asset, Camera, Container, Material, Mesh, Node, Primitive};
@@ -319,6 +320,36 @@ fn reflectance_at(scene: &LoadedScene, x: f32, y: f32) -> [f32; 3] {
     [f.r * pi, f.g * pi, f.b * pi]
 }
 
+/// The parameters of the `plastic` a glTF dielectric of base colour `rgb`
+/// and GGX `alpha` (= roughness^2) maps to.
+fn plastic_params(rgb: [f32; 3], alpha: f32) -> String {
+    format!(
+        "diffuse_reflectance = [{:?}, {:?}, {:?}]\nint_ior = 1.5\ndistribution = \"ggx\"\nroughness = {alpha:?}\n",
+        rgb[0], rgb[1], rgb[2]
+    )
+}
+
+/// What [`reflectance_at`] reads on a glTF dielectric of base colour `rgb`
+/// and roughness 1: pi f(z, z) of that plastic, made from a TOML table.
+fn dielectric(rgb: [f32; 3]) -> [f32; 3] {
+    let text = format!("type = \"plastic\"\n{}", plastic_params(rgb, 1.0));
+    let table = lumis_core::doc::parse(&text, "expected").unwrap();
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let bsdf = registry
+        .create_bsdf(&TableRef {
+            owner: "expected",
+            table: &table,
+            location: &Location::Builtin,
+            type_name: "plastic",
+            type_location: &Location::Builtin,
+            structural: &["type"],
+        })
+        .unwrap();
+    let f = bsdf.f(&BsdfContext::default(), Vec3::Z, Vec3::Z);
+    let pi = std::f32::consts::PI;
+    [f.r * pi, f.g * pi, f.b * pi]
+}
+
 fn near(a: [f32; 3], b: [f32; 3]) -> bool {
     a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5)
 }
@@ -342,8 +373,8 @@ fn two_primitives() -> Asset {
             primitives: vec![red, green],
         }],
         materials: vec![
-            Material::diffuse("red", [0.8, 0.1, 0.1]),
-            Material::diffuse("green", [0.1, 0.7, 0.2]),
+            Material::dielectric("red", [0.8, 0.1, 0.1]),
+            Material::dielectric("green", [0.1, 0.7, 0.2]),
         ],
         nodes: vec![mesh_node(0)],
         roots: vec![0],
@@ -357,15 +388,24 @@ fn primitives_materials_and_overrides() {
     let file = gltf_writer::write(&dir, "two", &two_primitives(), Container::External);
     let scene = load(&dir, &gltf_shape(&file, ""));
     assert_eq!(scene.scene.counts().meshes, 2);
-    assert!(near(reflectance_at(&scene, 0.2, 0.2), [0.8, 0.1, 0.1]));
-    assert!(near(reflectance_at(&scene, 2.2, 0.2), [0.1, 0.7, 0.2]));
+    assert!(near(
+        reflectance_at(&scene, 0.2, 0.2),
+        dielectric([0.8, 0.1, 0.1])
+    ));
+    assert!(near(
+        reflectance_at(&scene, 2.2, 0.2),
+        dielectric([0.1, 0.7, 0.2])
+    ));
 
     let scene = load(
         &dir,
         &gltf_shape(&file, "bsdf_overrides = { red = \"white\" }"),
     );
     assert!(near(reflectance_at(&scene, 0.2, 0.2), [0.5; 3]));
-    assert!(near(reflectance_at(&scene, 2.2, 0.2), [0.1, 0.7, 0.2]));
+    assert!(near(
+        reflectance_at(&scene, 2.2, 0.2),
+        dielectric([0.1, 0.7, 0.2])
+    ));
 
     let scene = load(&dir, &gltf_shape(&file, "bsdf = \"white\""));
     assert!(near(reflectance_at(&scene, 2.2, 0.2), [0.5; 3]));
@@ -424,7 +464,10 @@ fn glb_data_uri_and_external_buffers_load_the_same() {
             + "[[light]]\ntype = \"point\"\nposition = [1.0, 0.5, 2.0]\nintensity = [4.0, 4.0, 4.0]\n";
         let scene = load(&dir, &toml);
         assert!(
-            near(reflectance_at(&scene, 2.2, 0.2), [0.1, 0.7, 0.2]),
+            near(
+                reflectance_at(&scene, 2.2, 0.2),
+                dielectric([0.1, 0.7, 0.2])
+            ),
             "{name}"
         );
         images.push(render_image(&scene));
@@ -457,8 +500,8 @@ type = "path"
 max_depth = 3
 [[bsdf]]
 name = "grey"
-type = "diffuse"
-reflectance = [0.8, 0.6, 0.4]
+type = "plastic"
+{grey}
 [[bsdf]]
 name = "white"
 type = "diffuse"
@@ -471,7 +514,8 @@ edge_v = [3.0, 0.0, 0.0]
 bsdf = "white"
 emission = {{ radiance = [3.0, 3.0, 3.0] }}
 {shape}
-"#
+"#,
+        grey = plastic_params([0.8, 0.6, 0.4], 1.0)
     )
 }
 
@@ -482,7 +526,7 @@ fn a_gltf_triangle_renders_bit_for_bit_like_the_inline_one() {
     tri.material = Some(0);
     tri.normals = Some(vec![[0.0, 0.0, 1.0], [0.0, 0.6, 0.8], [0.6, 0.0, 0.8]]);
     let asset = Asset {
-        materials: vec![Material::diffuse("grey", [0.8, 0.6, 0.4])],
+        materials: vec![Material::dielectric("grey", [0.8, 0.6, 0.4])],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
     let file = gltf_writer::write(&dir, "tri", &asset, Container::Glb);
@@ -517,7 +561,7 @@ fn metals_render_as_the_conductor_they_map_to() {
         materials: vec![Material {
             metallic: 1.0,
             roughness: 0.5,
-            ..Material::diffuse("gold", [1.0, 0.8, 0.3])
+            ..Material::dielectric("gold", [1.0, 0.8, 0.3])
         }],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
@@ -546,6 +590,108 @@ fn metals_render_as_the_conductor_they_map_to() {
 }
 
 #[test]
+fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
+    // A smooth (roughness 0) white dielectric with a pure red base colour
+    // texture renders as the inline plastic whose base is red: the coat
+    // still mirrors the white light.
+    let dir = test_dir("textured-coat");
+    let mut tri = triangle();
+    tri.material = Some(0);
+    tri.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+    let asset = Asset {
+        materials: vec![Material {
+            roughness: 0.0,
+            base_color_texture: Some(0),
+            ..Material::dielectric("red-plastic", [1.0, 1.0, 1.0])
+        }],
+        images: vec![gltf_writer::png_rgb8(1, 1, &[[255, 0, 0]])],
+        ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "red", &asset, Container::Glb);
+    let from_gltf = load(
+        &dir,
+        &lit_scene(&format!("[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\n")),
+    );
+    assert!(from_gltf.scene.load_report().warnings.is_empty());
+
+    // At a hit (below the light): the mirror sample is white, the base red.
+    let ray = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::NEG_Z);
+    let hit = from_gltf.scene.intersect(&ray).expect("hit");
+    let ctx = BsdfContext {
+        uv: hit.uv,
+        ..BsdfContext::default()
+    };
+    let wo = Vec3::new(0.6, 0.0, 0.8);
+    let mirror = hit.bsdf.sample_f(&ctx, wo, 0.0, Vec2::splat(0.5)).unwrap();
+    assert!(mirror.flags.is_specular(), "{mirror:?}");
+    assert!(
+        mirror.f.g == mirror.f.r && mirror.f.b == mirror.f.r && mirror.f.r > 0.0,
+        "the coat is white: {:?}",
+        mirror.f
+    );
+    let base = hit.bsdf.f(&ctx, wo, Vec3::new(0.0, 0.6, 0.8));
+    assert!(base.r > 0.0 && base.g == 0.0 && base.b == 0.0, "{base:?}");
+
+    // The image: that of the inline plastic with a red base, up to the
+    // rounding of the bilinear lookup; its green and blue are the
+    // highlights of the white coat.
+    let inline = load(
+        &dir,
+        &lit_scene(&format!(
+            "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n\
+             indices = [0, 1, 2]\nbsdf = \"red\"\n\
+             [[bsdf]]\nname = \"red\"\ntype = \"plastic\"\n{}",
+            plastic_params([1.0, 0.0, 0.0], 0.0)
+        )),
+    );
+    let a = render_image(&from_gltf);
+    let b = render_image(&inline);
+    let green: f32 = a.iter().skip(1).step_by(3).sum();
+    assert!(green > 0.0, "the coat reflects the white light");
+    let diff: f32 = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).sum();
+    let total: f32 = b.iter().sum();
+    assert!(diff <= 1e-4 * total, "relative difference {}", diff / total);
+}
+
+#[test]
+fn double_sided_materials_reflect_from_behind_as_from_the_front() {
+    let dir = test_dir("double-sided");
+    let mut tri = triangle();
+    tri.material = Some(0);
+    let asset = Asset {
+        materials: vec![Material {
+            double_sided: true,
+            ..Material::dielectric("leaf", [0.2, 0.6, 0.1])
+        }],
+        ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+    };
+    let file = gltf_writer::write(&dir, "leaf", &asset, Container::Glb);
+    let scene = load(&dir, &gltf_shape(&file, ""));
+    let hit = scene
+        .scene
+        .intersect(&Ray::new(Vec3::new(0.2, 0.2, -10.0), Vec3::Z))
+        .expect("hit from behind");
+    let ctx = BsdfContext::default();
+    let (wo, wi) = (
+        Vec3::new(0.3, 0.0, 0.9).normalize(),
+        Vec3::new(0.0, 0.5, 0.8).normalize(),
+    );
+    let below = |v: Vec3| Vec3::new(v.x, v.y, -v.z);
+    let front = hit.bsdf.f(&ctx, wo, wi);
+    assert!(front.g > 0.0);
+    assert_eq!(hit.bsdf.f(&ctx, below(wo), below(wi)), front);
+    assert_eq!(
+        hit.bsdf.pdf(&ctx, below(wo), below(wi)),
+        hit.bsdf.pdf(&ctx, wo, wi)
+    );
+    let s = hit
+        .bsdf
+        .sample_f(&ctx, below(wo), 0.9, Vec2::splat(0.3))
+        .unwrap();
+    assert!(s.wi.z < 0.0 && s.pdf > 0.0, "{s:?}");
+}
+
+#[test]
 fn emissive_materials_become_triangle_lights() {
     let dir = test_dir("emissive");
     // An emitting triangle above a white floor, facing down.
@@ -557,7 +703,7 @@ fn emissive_materials_become_triangle_lights() {
     let asset = Asset {
         materials: vec![Material {
             emissive: [1.0, 0.9, 0.8],
-            ..Material::diffuse("lamp", [0.5, 0.5, 0.5])
+            ..Material::dielectric("lamp", [0.5, 0.5, 0.5])
         }],
         ..one_mesh(light, vec![mesh_node(0)], vec![0])
     };
@@ -809,7 +955,7 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
     let asset = Asset {
         materials: vec![Material {
             base_color_texture: Some(0),
-            ..Material::diffuse("checker", [0.5, 0.8, 1.0])
+            ..Material::dielectric("checker", [0.5, 0.8, 1.0])
         }],
         images: vec![png],
         ..one_mesh(tri.clone(), vec![mesh_node(0)], vec![0])
@@ -830,6 +976,7 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
         ((1.25, 0.25), [0.5, 0.0, 0.0]), // repeat
     ] {
         let got = reflectance_at_uv(&scene, x, y);
+        let expected = dielectric(expected);
         assert!(
             approx(got, expected),
             "at ({x}, {y}): {got:?} vs {expected:?}"
@@ -854,11 +1001,11 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
     );
     assert!(approx(
         reflectance_at_uv(&scene, 0.25, 0.25),
-        [0.0, 0.8, 0.0]
+        dielectric([0.0, 0.8, 0.0])
     ));
     assert!(approx(
         reflectance_at_uv(&scene, 0.75, 0.25),
-        [0.5, 0.0, 0.0]
+        dielectric([0.5, 0.0, 0.0])
     ));
 
     // A textured material on a primitive without uvs is refused.
@@ -904,7 +1051,7 @@ fn what_is_not_modelled_is_reported() {
         materials: vec![Material {
             metallic: 0.7,
             roughness: 0.2,
-            ..Material::diffuse("gold", [1.0, 0.8, 0.3])
+            ..Material::dielectric("gold", [1.0, 0.8, 0.3])
         }],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
@@ -949,7 +1096,7 @@ fn emissive_instances_get_their_own_world_space_lights() {
     let asset = Asset {
         materials: vec![Material {
             emissive: [0.5, 0.5, 0.5],
-            ..Material::diffuse("lamp", [0.2, 0.2, 0.2])
+            ..Material::dielectric("lamp", [0.2, 0.2, 0.2])
         }],
         ..one_mesh(panel, vec![at(0.0), at(4.0)], vec![0, 1])
     };
@@ -1128,7 +1275,7 @@ fn jpeg_base_colour_textures_are_decoded() {
     let asset = Asset {
         materials: vec![Material {
             base_color_texture: Some(0),
-            ..Material::diffuse("photo", [1.0, 1.0, 1.0])
+            ..Material::dielectric("photo", [1.0, 1.0, 1.0])
         }],
         images: vec![jpeg],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
@@ -1149,9 +1296,10 @@ fn jpeg_base_colour_textures_are_decoded() {
         }
     };
     let got = reflectance_at_uv(&scene, 0.3, 0.3);
-    for (g, c) in got.iter().zip(rgb) {
+    let want = dielectric(rgb.map(srgb));
+    for (g, w) in got.iter().zip(want) {
         // JPEG at quality 100 reproduces a flat colour within a step or two.
-        assert!((g - srgb(c)).abs() < 0.01, "{got:?} vs {rgb:?}");
+        assert!((g - w).abs() < 0.01, "{got:?} vs {want:?}");
     }
 }
 
@@ -1174,7 +1322,7 @@ fn emissive_textures_modulate_the_triangle_lights() {
         materials: vec![Material {
             emissive: [1.0, 1.0, 1.0],
             emissive_texture: Some(0),
-            ..Material::diffuse("sign", [0.1, 0.1, 0.1])
+            ..Material::dielectric("sign", [0.1, 0.1, 0.1])
         }],
         images: vec![png],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])

@@ -10,7 +10,12 @@
 //! resident memory the OS reports (`VmHWM`) is that of loading the scene
 //! alone.
 //!
-//! `cargo bench -p lumis-tests --bench high_poly [-- --quality medium --compact]`
+//! `cargo bench -p lumis-tests --bench high_poly [-- --quality medium --compact auto|true|false]`
+//! (`--compact` alone means `true`; the default is `auto`, the scene's).
+//!
+//! `-- --sweep` measures what `[accel] compact = "auto"`'s threshold rests
+//! on: single meshes of 20k to 1.3M triangles, each with and without a
+//! compact BVH, their peak memory per triangle and rays per second.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -20,6 +25,7 @@ use std::time::Instant;
 use lumis_core::{Scene, UVec2, Vec2, Vec3};
 use lumis_embree::bare::{self, BareRay};
 use lumis_embree::{BuildQuality, Device, PaddedBuffer, SceneBuilder, SceneOptions};
+use lumis_scene::Compaction;
 use lumis_tests::gltf_writer::{self, Asset, Container, Mesh, Node, Primitive};
 
 /// A unit icosphere subdivided `levels` times (20 * 4^levels triangles),
@@ -156,7 +162,7 @@ fn child(scene_path: &Path) {
     let r = loaded.scene.load_report().clone();
     println!(
         "child load_to_first_pixel={load_to_first_pixel:.3} parse={:.3} attributes={:.3} bvh={:.3} \
-         triangles={} unique={} instances={} geometry_bytes={} bvh_bytes={} baseline_kb={baseline_kb} peak_kb={peak_kb}",
+         triangles={} unique={} instances={} geometry_bytes={} bvh_bytes={} compact={} baseline_kb={baseline_kb} peak_kb={peak_kb}",
         r.parse.as_secs_f64(),
         r.attributes.as_secs_f64(),
         r.bvh.as_secs_f64(),
@@ -165,6 +171,7 @@ fn child(scene_path: &Path) {
         c.instances,
         r.geometry_bytes,
         r.bvh_bytes,
+        r.compact,
     );
 
     // Rays: one primary ray per pixel centre, then one cosine-distributed
@@ -292,11 +299,12 @@ fn summarise(name: &str, report: &str, bare_seconds: f64, bare_bytes: i64) {
     let baseline = field(report, "baseline_kb") * 1024.0;
     let first = field(report, "load_to_first_pixel");
     println!(
-        "{name}: {} triangles ({} unique): load-to-first-pixel {first:.2} s = {:.2}x the bare Embree build ({bare_seconds:.2} s); \
+        "{name}: {} triangles ({} unique), BVH {}: load-to-first-pixel {first:.2} s = {:.2}x the bare Embree build ({bare_seconds:.2} s); \
          peak RSS {:.0} MB, {:.1} B/unique triangle above the {:.0} MB baseline ({:.1} B total); \
          lumis geometry {:.1} + BVH {:.1} B/unique triangle (bare Embree BVH {:.1})",
         field(report, "triangles"),
         unique,
+        if report.contains("compact=true") { "compact" } else { "not compact" },
         first / bare_seconds,
         peak * 1e-6,
         (peak - baseline) / unique,
@@ -308,41 +316,35 @@ fn summarise(name: &str, report: &str, bare_seconds: f64, bare_bytes: i64) {
     );
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    if let Some(i) = args.iter().position(|a| a == "--child") {
-        child(Path::new(&args[i + 1]));
-        return;
-    }
-    let quality = args
-        .iter()
-        .position(|a| a == "--quality")
-        .map_or("medium", |i| args[i + 1].as_str())
-        .to_string();
-    let compact = args.iter().any(|a| a == "--compact");
-    let options = SceneOptions {
-        quality: match quality.as_str() {
-            "low" => BuildQuality::Low,
-            "high" => BuildQuality::High,
-            _ => BuildQuality::Medium,
-        },
-        robust: false,
-        compact,
+/// The `--compact` argument: `auto` (the default), `true` or `false`;
+/// alone, `true`.
+fn compaction(args: &[String]) -> Compaction {
+    let Some(i) = args.iter().position(|a| a == "--compact") else {
+        return Compaction::Auto;
     };
-    let accel = format!("[accel]\nquality = \"{quality}\"\ncompact = {compact}\n");
-    let dir = std::env::temp_dir().join("lumis-high-poly");
-    std::fs::create_dir_all(&dir).unwrap();
-    println!(
-        "quality {quality}, compact {compact}; files in {}",
-        dir.display()
-    );
+    match args.get(i + 1).map(String::as_str) {
+        Some("auto") => Compaction::Auto,
+        Some("false") => Compaction::Never,
+        Some("true") | None => Compaction::Always,
+        Some(a) if a.starts_with("--") => Compaction::Always,
+        Some(a) => panic!("--compact takes auto, true or false, not {a}"),
+    }
+}
 
-    // 1. One 1.31M-triangle mesh.
-    let (positions, indices) = displaced_sphere(8);
-    let asset = Asset {
+fn accel_table(quality: &str, compaction: Compaction) -> String {
+    let compact = match compaction {
+        Compaction::Auto => "\"auto\"",
+        Compaction::Always => "true",
+        Compaction::Never => "false",
+    };
+    format!("[accel]\nquality = \"{quality}\"\ncompact = {compact}\n")
+}
+
+fn one_mesh(positions: &[[f32; 3]], indices: &[u32]) -> Asset {
+    Asset {
         meshes: vec![Mesh {
             name: "displaced-sphere".into(),
-            primitives: vec![Primitive::triangles(positions.clone(), indices.clone())],
+            primitives: vec![Primitive::triangles(positions.to_vec(), indices.to_vec())],
         }],
         nodes: vec![Node {
             mesh: Some(0),
@@ -350,7 +352,88 @@ fn main() {
         }],
         roots: vec![0],
         ..Asset::default()
+    }
+}
+
+/// Single meshes from 20k to 1.3M triangles, uncompacted and compact: peak
+/// memory per triangle (with and without the process baseline) and rays
+/// per second, one line each.
+fn sweep(dir: &Path) {
+    println!(
+        "triangles, compact: peak B/triangle (above baseline); lumis primary, diffuse Mrays/s"
+    );
+    for levels in 5..=8 {
+        let (positions, indices) = displaced_sphere(levels);
+        let asset = one_mesh(&positions, &indices);
+        for compaction in [Compaction::Never, Compaction::Always] {
+            let scene = write_scene(
+                dir,
+                &format!("sweep-{levels}"),
+                &asset,
+                (Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO),
+                &accel_table("medium", compaction),
+            );
+            let report = run_child(&scene);
+            let unique = field(&report, "unique");
+            let peak = field(&report, "peak_kb") * 1024.0;
+            let baseline = field(&report, "baseline_kb") * 1024.0;
+            let rate = |kind: &str| {
+                report
+                    .lines()
+                    .find(|l| l.starts_with(&format!("child {kind}:")))
+                    .and_then(|l| l.split("lumis intersect ").nth(1))
+                    .and_then(|l| l.split_whitespace().next())
+                    .unwrap_or("?")
+                    .to_string()
+            };
+            println!(
+                "{unique}, {}: {:.1} ({:.1}); {}, {}",
+                compaction == Compaction::Always,
+                peak / unique,
+                (peak - baseline) / unique,
+                rate("primary"),
+                rate("diffuse"),
+            );
+        }
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(i) = args.iter().position(|a| a == "--child") {
+        child(Path::new(&args[i + 1]));
+        return;
+    }
+    let dir = std::env::temp_dir().join("lumis-high-poly");
+    std::fs::create_dir_all(&dir).unwrap();
+    if args.iter().any(|a| a == "--sweep") {
+        sweep(&dir);
+        return;
+    }
+    let quality = args
+        .iter()
+        .position(|a| a == "--quality")
+        .map_or("medium", |i| args[i + 1].as_str())
+        .to_string();
+    let compaction = compaction(&args);
+    let mut options = SceneOptions {
+        quality: match quality.as_str() {
+            "low" => BuildQuality::Low,
+            "high" => BuildQuality::High,
+            _ => BuildQuality::Medium,
+        },
+        robust: false,
+        compact: false,
     };
+    let accel = accel_table(&quality, compaction);
+    println!(
+        "quality {quality}, compact {compaction:?}; files in {}",
+        dir.display()
+    );
+
+    // 1. One 1.31M-triangle mesh.
+    let (positions, indices) = displaced_sphere(8);
+    let asset = one_mesh(&positions, &indices);
     let scene = write_scene(
         &dir,
         "sphere-1m",
@@ -358,6 +441,8 @@ fn main() {
         (Vec3::new(0.0, 0.0, 3.5), Vec3::ZERO),
         &accel,
     );
+    // The bare build is compact exactly when lumis decides to be.
+    options.compact = compaction.decide(indices.len() / 3);
     let (bare_s, bare_b) = bare_build(&positions, &indices, &[], options);
     summarise("1.3M mesh", &run_child(&scene), bare_s, bare_b);
 
@@ -390,6 +475,7 @@ fn main() {
         (Vec3::new(1.25, -6.0, 16.0), Vec3::new(1.25, 1.25, 0.0)),
         &accel,
     );
+    options.compact = compaction.decide(indices.len() / 3);
     let (bare_s, bare_b) = bare_build(&positions, &indices, &transforms, options);
     summarise("10.5M instanced", &run_child(&scene), bare_s, bare_b);
 }

@@ -55,7 +55,8 @@ pub struct Material {
 }
 
 impl Material {
-    pub fn diffuse(name: &str, rgb: [f32; 3]) -> Self {
+    /// A rough (roughness 1) non-metal of base colour `rgb`.
+    pub fn dielectric(name: &str, rgb: [f32; 3]) -> Self {
         Self {
             name: name.into(),
             base_color: [rgb[0], rgb[1], rgb[2], 1.0],

@@ -109,19 +109,9 @@ impl SceneBuilder {
         // stored in the builder and then in the Scene).
         let raw = unsafe { sys::rtcNewScene(device.raw()) };
         device.take_error()?;
-        let mut flags = sys::RTCSceneFlags::NONE;
-        if options.robust {
-            flags |= sys::RTCSceneFlags::ROBUST;
-        }
-        if options.compact {
-            flags |= sys::RTCSceneFlags::COMPACT;
-        }
         let quality = options.quality.raw();
         // SAFETY: `raw` is the scene just created.
-        unsafe {
-            sys::rtcSetSceneFlags(raw, flags);
-            sys::rtcSetSceneBuildQuality(raw, quality);
-        }
+        unsafe { sys::rtcSetSceneBuildQuality(raw, quality) };
         device.take_error()?;
         Ok(Self {
             device: device.clone(),
@@ -129,6 +119,13 @@ impl SceneBuilder {
             storage: Vec::new(),
             options,
         })
+    }
+
+    /// Sets `RTC_SCENE_FLAG_COMPACT` for the build to come. The scene flags
+    /// are applied at [`Self::commit`], so a loader can decide compaction
+    /// once it knows how many triangles the scene holds.
+    pub fn set_compact(&mut self, compact: bool) {
+        self.options.compact = compact;
     }
 
     fn geometry_quality(&self) -> sys::RTCBuildQuality {
@@ -283,8 +280,19 @@ impl SceneBuilder {
 
     /// Builds the BVH.
     pub fn commit(self) -> Result<Scene, EmbreeError> {
-        // SAFETY: the scene and every buffer it references are alive.
-        unsafe { sys::rtcCommitScene(self.raw) };
+        let mut flags = sys::RTCSceneFlags::NONE;
+        if self.options.robust {
+            flags |= sys::RTCSceneFlags::ROBUST;
+        }
+        if self.options.compact {
+            flags |= sys::RTCSceneFlags::COMPACT;
+        }
+        // SAFETY: the scene and every buffer it references are alive; the
+        // flags take effect at this commit.
+        unsafe {
+            sys::rtcSetSceneFlags(self.raw, flags);
+            sys::rtcCommitScene(self.raw);
+        }
         self.device.take_error()?;
         let this = std::mem::ManuallyDrop::new(self);
         // SAFETY: moving fields out of a ManuallyDrop builder whose Drop

@@ -5,6 +5,7 @@
 //! the [`Registry`], loads geometry into Embree, and creates an area light
 //! for every emissive shape.
 
+mod accel;
 mod gltf;
 mod render_scene;
 mod report;
@@ -20,12 +21,13 @@ use lumis_core::{
     Bsdf, Error, Integrator, Light, LightKind, LightSampler, LightShape, Location, ParamSpec,
     ParamType, Params, Registry, Result, Sampler, UVec2, Vec3,
 };
-use lumis_embree::{BuildQuality, Device, PaddedBuffer, SceneBuilder, SceneOptions};
+use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
 use lumis_render::PerspectiveCamera;
 
+pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
 
-use render_scene::{Geometry, MeshData, Prototype, NO_LIGHT};
+use render_scene::{Geometry, MeshData, Placement, Prototype, NO_LIGHT};
 use report::Phase;
 use shapes::{ShapeDesc, ShapeGeometry, SHAPE_TYPES};
 
@@ -56,38 +58,20 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "accel",
 ];
 
-const ACCEL_PARAMS: &[ParamSpec] = &[
-    ParamSpec::with_default(
-        "quality",
-        ParamType::String,
-        "\"medium\"",
-        "Embree BVH build quality: \"low\" (fastest build, Morton), \"medium\" (binned SAH), \"high\" (SAH with spatial splits: slower build, faster rays)",
-    )
-    .one_of(&["low", "medium", "high"]),
-    ParamSpec::with_default(
-        "robust",
-        ParamType::Bool,
-        "false",
-        "RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping through shared edges) at some cost in speed",
-    ),
-    ParamSpec::with_default(
-        "compact",
-        ParamType::Bool,
-        "false",
-        "RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed",
-    ),
-];
-
 /// A scene under construction: the Embree builder and everything shading
 /// will index by the geometry ids Embree hands out.
 pub(crate) struct Assembly<'r> {
     pub registry: &'r Registry,
     pub device: Device,
+    /// Quality and robustness for every BVH; `compaction` is decided once
+    /// every shape is counted, and applied by [`build_bvhs`].
     pub options: SceneOptions,
+    pub compaction: Compaction,
     pub builder: SceneBuilder,
     /// Indexed by top-level geometry id: one entry per `builder.add_*`.
     pub geometries: Vec<Geometry>,
-    pub prototypes: Vec<Prototype>,
+    /// Instanced meshes, built with the top-level scene by [`build_bvhs`].
+    pub pending: Vec<PendingPrototype>,
     pub lights: Vec<Box<dyn Light>>,
     pub bsdfs: Vec<(String, Arc<dyn Bsdf>)>,
     pub counts: SceneCounts,
@@ -181,14 +165,15 @@ pub fn load_str(
     let (camera, output) = film_and_camera(&root, &file_location, dir)?;
     let bsdfs = named_bsdfs(&root, registry)?;
     let device = device()?;
-    let options = accel_options(&root)?;
+    let accel = accel::accel_options(&root)?;
     let mut asm = Assembly {
         registry,
-        builder: SceneBuilder::new(&device, options).map_err(embree_error)?,
+        builder: SceneBuilder::new(&device, accel.embree).map_err(embree_error)?,
         device,
-        options,
+        options: accel.embree,
+        compaction: accel.compaction,
         geometries: Vec::new(),
-        prototypes: Vec::new(),
+        pending: Vec::new(),
         lights: Vec::new(),
         bsdfs,
         counts: SceneCounts::default(),
@@ -222,24 +207,27 @@ pub fn load_str(
         let geometry = add_shape(&owner, desc, &mut asm)?;
         asm.geometries.push(geometry);
     }
+    for (i, (table, location)) in tables_in(&root, "light")?.into_iter().enumerate() {
+        let light = PluginTable::new(format!("[[light]] #{}", i + 1), table, location)?;
+        asm.lights
+            .push(registry.create_light(&light.as_ref(), &LightShape::None)?);
+    }
+
     let Assembly {
         builder,
         device,
+        compaction,
         mut geometries,
-        prototypes,
+        pending,
         mut lights,
         bsdfs,
         mut counts,
         mut report,
         ..
     } = asm;
-
-    for (i, (table, location)) in tables_in(&root, "light")?.into_iter().enumerate() {
-        let light = PluginTable::new(format!("[[light]] #{}", i + 1), table, location)?;
-        lights.push(registry.create_light(&light.as_ref(), &LightShape::None)?);
-    }
-
-    let embree = report.time(Phase::Bvh, || builder.commit().map_err(embree_error))?;
+    report.compaction = compaction;
+    report.compact = compaction.decide(counts.unique_triangles);
+    let (embree, prototypes) = build_bvhs(builder, pending, &mut geometries, &mut report)?;
     report.bvh_bytes = (device.memory_in_use() - memory_before).max(0) as usize;
     report.geometry_bytes = geometry_bytes(&geometries, &prototypes);
     geometries.shrink_to_fit();
@@ -293,25 +281,71 @@ fn geometry_bytes(geometries: &[Geometry], prototypes: &[Prototype]) -> usize {
         .sum::<usize>()
 }
 
-/// The `[accel]` table: Embree build quality and scene flags.
-fn accel_options(root: &Table) -> Result<SceneOptions> {
-    let Some(node) = root.get("accel") else {
-        return Ok(SceneOptions::default());
-    };
-    let table = as_table(node, "accel")?;
-    let params = Params::new("[accel]", table, node.location.clone(), ACCEL_PARAMS, &[])?;
-    let quality = match params.get_choice("quality")?.as_str() {
-        "low" => BuildQuality::Low,
-        "high" => BuildQuality::High,
-        _ => BuildQuality::Medium,
-    };
-    let options = SceneOptions {
-        quality,
-        robust: params.get("robust")?,
-        compact: params.get("compact")?,
-    };
-    params.finish()?;
-    Ok(options)
+/// A mesh used by several nodes: its own Embree scene, built with the
+/// top-level one once the scene-wide build options are known.
+pub(crate) struct PendingPrototype {
+    pub builder: SceneBuilder,
+    pub meshes: Vec<MeshData>,
+    pub instances: Vec<PendingInstance>,
+    /// Prefixes a build error: the shape and file it came from.
+    pub owner: String,
+    pub location: Location,
+}
+
+/// One node's placement of a [`PendingPrototype`].
+pub(crate) struct PendingInstance {
+    /// 3x4 column-major, as Embree takes it.
+    pub transform: [f32; 12],
+    pub placement: Placement,
+    /// Per prototype mesh, the instance's light index per triangle.
+    pub lights: Vec<Vec<u32>>,
+}
+
+/// Builds the instanced meshes' BVHs (in parallel), places their
+/// instances and builds the top level, all compact or not as
+/// `report.compact` says. Returns the scene and the prototypes, indexed
+/// as the instances' `prototype`.
+fn build_bvhs(
+    mut builder: SceneBuilder,
+    pending: Vec<PendingPrototype>,
+    geometries: &mut Vec<Geometry>,
+    report: &mut LoadReport,
+) -> Result<(lumis_embree::Scene, Vec<Prototype>)> {
+    let compact = report.compact;
+    let (builders, rest): (Vec<_>, Vec<_>) = pending
+        .into_iter()
+        .map(|mut p| {
+            p.builder.set_compact(compact);
+            (p.builder, (p.meshes, p.instances, p.owner, p.location))
+        })
+        .unzip();
+    let scenes = report.time(Phase::Bvh, || {
+        use rayon::prelude::*;
+        builders
+            .into_par_iter()
+            .map(SceneBuilder::commit)
+            .collect::<Vec<_>>()
+    });
+    let mut prototypes = Vec::with_capacity(scenes.len());
+    for (scene, (meshes, instances, owner, location)) in scenes.into_iter().zip(rest) {
+        let err = |e: lumis_embree::EmbreeError| Error::at(&location, format!("{owner}: {e}"));
+        let scene = Arc::new(scene.map_err(err)?);
+        let prototype = prototypes.len() as u32;
+        for instance in instances {
+            builder
+                .add_instance(scene.clone(), &instance.transform)
+                .map_err(err)?;
+            geometries.push(Geometry::Instance {
+                prototype,
+                placement: instance.placement,
+                lights: instance.lights,
+            });
+        }
+        prototypes.push(Prototype { meshes });
+    }
+    builder.set_compact(compact);
+    let embree = report.time(Phase::Bvh, || builder.commit().map_err(embree_error))?;
+    Ok((embree, prototypes))
 }
 
 fn check_top_level_keys(root: &Table) -> Result<()> {

@@ -3,6 +3,7 @@
 
 use std::time::{Duration, Instant};
 
+use crate::accel::{Compaction, AUTO_COMPACT_TRIANGLES};
 use crate::render_scene::SceneCounts;
 
 /// Times and sizes measured while a scene loads.
@@ -21,6 +22,10 @@ pub struct LoadReport {
     pub bvh_bytes: usize,
     /// Bytes of decoded textures.
     pub texture_bytes: usize,
+    /// Whether the BVHs were built compact (`RTC_SCENE_FLAG_COMPACT`)...
+    pub compact: bool,
+    /// ... because `[accel] compact` said so, or by the triangle count.
+    pub compaction: Compaction,
     /// What the loader could not model and left out (e.g. textures), said
     /// once per asset and material.
     pub warnings: Vec<String>,
@@ -54,8 +59,30 @@ impl LoadReport {
                 self.texture_bytes as f64 * 1e-6
             ));
         }
+        lines[0].push_str(&format!("; {}", self.compaction_line(counts)));
         lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
         lines
+    }
+}
+
+impl LoadReport {
+    /// Whether the BVH is compact, and why.
+    fn compaction_line(&self, counts: &SceneCounts) -> String {
+        let built = if self.compact {
+            "compact"
+        } else {
+            "not compact"
+        };
+        let why = match self.compaction {
+            Compaction::Auto => format!(
+                "compact = \"auto\": {} unique triangles, {} the {AUTO_COMPACT_TRIANGLES} threshold",
+                counts.unique_triangles,
+                if self.compact { "at or above" } else { "below" }
+            ),
+            Compaction::Always => "compact = true".into(),
+            Compaction::Never => "compact = false".into(),
+        };
+        format!("BVH {built} ({why})")
     }
 }
 

@@ -17,6 +17,10 @@
 //! `wo`, `F(theta_o) s / (F(theta_o) s + (1 - F(theta_o)) rho)` (luminances),
 //! else the base (cosine-weighted); `pdf` is the mixture (one-sample MIS
 //! between the lobes). One-sided.
+//!
+//! A texture scales the base's albedo alone (`BsdfContext::albedo_scale`):
+//! the coat stays white, and `f`, `sample_f` and `pdf` derive the base term
+//! and the lobe choice from the same scaled albedo.
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -73,13 +77,25 @@ pub const SPEC: PluginSpec = PluginSpec {
     ],
 };
 
-#[derive(Debug, Clone)]
-pub struct Plastic {
+/// The base as one hit sees it: its albedo, constant or textured.
+#[derive(Debug, Clone, Copy)]
+struct Base {
     /// `rho'`, the base's albedo including the internal reflections, over
     /// `pi eta^2`.
-    base: Rgb,
+    f: Rgb,
     /// Luminance of `rho`, for the lobe choice.
-    base_weight: f32,
+    weight: f32,
+}
+
+#[derive(Debug, Clone)]
+pub struct Plastic {
+    /// The untextured base, precomputed.
+    untextured: Base,
+    /// `rho`, for a textured base.
+    diffuse: Rgb,
+    /// The coat's internal diffuse reflectance `F_dr,int`.
+    fdr_int: f32,
+    nonlinear: bool,
     specular: Rgb,
     specular_weight: f32,
     eta: f32,
@@ -91,14 +107,11 @@ impl Plastic {
     pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, coat: Microfacet, nonlinear: bool) -> Self {
         // Light inside the coat meets it from the side of index 1/eta.
         let fdr_int = fresnel::diffuse_reflectance(1.0 / eta);
-        let rho = if nonlinear {
-            diffuse.map(|r| r / (1.0 - r * fdr_int))
-        } else {
-            diffuse / (1.0 - fdr_int)
-        };
         Self {
-            base: rho * (FRAC_1_PI / (eta * eta)),
-            base_weight: diffuse.luminance(),
+            untextured: Self::base_of(diffuse, fdr_int, eta, nonlinear),
+            diffuse,
+            fdr_int,
+            nonlinear,
             specular,
             specular_weight: specular.luminance(),
             eta,
@@ -130,11 +143,40 @@ impl Plastic {
         ))
     }
 
+    #[inline]
+    fn base_of(diffuse: Rgb, fdr_int: f32, eta: f32, nonlinear: bool) -> Base {
+        let rho = if nonlinear {
+            diffuse.map(|r| r / (1.0 - r * fdr_int))
+        } else {
+            diffuse / (1.0 - fdr_int)
+        };
+        Base {
+            f: rho * (FRAC_1_PI / (eta * eta)),
+            weight: diffuse.luminance(),
+        }
+    }
+
+    /// The base at this hit: the precomputed one, or the albedo scaled by
+    /// the texture value the context carries (clamped to [0, 1], where the
+    /// internal reflections' series converges).
+    #[inline]
+    fn base(&self, ctx: &BsdfContext) -> Base {
+        match ctx.albedo_scale {
+            None => self.untextured,
+            Some(scale) => Self::base_of(
+                (self.diffuse * scale).map(|r| r.clamp(0.0, 1.0)),
+                self.fdr_int,
+                self.eta,
+                self.nonlinear,
+            ),
+        }
+    }
+
     /// Probability of sampling the coat from `wo`, which has Fresnel `fo`.
     #[inline]
-    fn coat_probability(&self, fo: f32) -> f32 {
+    fn coat_probability(&self, base: &Base, fo: f32) -> f32 {
         let coat = fo * self.specular_weight;
-        let base = (1.0 - fo) * self.base_weight;
+        let base = (1.0 - fo) * base.weight;
         if coat + base > 0.0 {
             coat / (coat + base)
         } else {
@@ -143,9 +185,9 @@ impl Plastic {
     }
 
     #[inline]
-    fn base_f(&self, fo: f32, wi: Vec3) -> Rgb {
+    fn base_f(&self, base: &Base, fo: f32, wi: Vec3) -> Rgb {
         let fi = fresnel::dielectric(wi.z, self.eta);
-        self.base * ((1.0 - fi) * (1.0 - fo))
+        base.f * ((1.0 - fi) * (1.0 - fo))
     }
 
     #[inline]
@@ -170,12 +212,12 @@ impl Plastic {
     }
 
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    fn eval(&self, base: &Base, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
         let fo = fresnel::dielectric(wo.z, self.eta);
-        let base = self.base_f(fo, wi);
+        let base = self.base_f(base, fo, wi);
         match &self.coat {
             Some(mf) => base + self.coat_f(mf, wo, wi),
             None => base,
@@ -183,11 +225,11 @@ impl Plastic {
     }
 
     #[inline]
-    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn eval_pdf(&self, base: &Base, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let p = self.coat_probability(fresnel::dielectric(wo.z, self.eta));
+        let p = self.coat_probability(base, fresnel::dielectric(wo.z, self.eta));
         let base = (1.0 - p) * warp::cosine_hemisphere_pdf(wi.z);
         match &self.coat {
             Some(mf) => base + p * Self::coat_pdf(mf, wo, wi),
@@ -206,16 +248,17 @@ impl Bsdf for Plastic {
     }
 
     #[inline]
-    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        self.eval(wo, wi)
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        self.eval(&self.base(ctx), wo, wi)
     }
 
-    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
+        let base = self.base(ctx);
         let fo = fresnel::dielectric(wo.z, self.eta);
-        let p = self.coat_probability(fo);
+        let p = self.coat_probability(&base, fo);
         let wi = if u1 < p {
             let Some(mf) = &self.coat else {
                 let wi = Vec3::new(-wo.x, -wo.y, wo.z);
@@ -243,14 +286,18 @@ impl Bsdf for Plastic {
         BsdfSample::reflection(
             wi,
             flags,
-            |wi| self.eval_pdf(wo, wi),
-            |wi| self.eval(wo, wi),
+            |wi| self.eval_pdf(&base, wo, wi),
+            |wi| self.eval(&base, wo, wi),
         )
     }
 
     #[inline]
-    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        self.eval_pdf(wo, wi)
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval_pdf(&self.base(ctx), wo, wi)
+    }
+
+    fn takes_albedo_scale(&self) -> bool {
+        true
     }
 }
 
@@ -288,5 +335,46 @@ mod tests {
             (albedo - want).map(f32::abs).max_component() < 4e-3,
             "{albedo:?} vs {want:?}"
         );
+    }
+
+    #[test]
+    fn a_scaled_albedo_is_the_plastic_of_that_albedo() {
+        // f, pdf and every sample (lobe choice included) of a textured
+        // base equal those of the plastic built with the product, so the
+        // chi-square coverage of the untextured model carries over.
+        let rho = Rgb::new(0.9, 0.6, 0.3);
+        let scale = Rgb::new(1.0, 0.25, 0.0);
+        for (alpha, nonlinear) in [(0.0, false), (0.3, false), (0.3, true)] {
+            let coat = Microfacet::new(Distribution::Ggx, alpha, alpha);
+            let textured = Plastic::new(rho, Rgb::WHITE, 1.5, coat, nonlinear);
+            let product = Plastic::new(rho * scale, Rgb::WHITE, 1.5, coat, nonlinear);
+            let ctx = BsdfContext {
+                albedo_scale: Some(scale),
+                ..Default::default()
+            };
+            let plain = BsdfContext::default();
+            let mut rng = lumis_sampling::Pcg32::new(3, 4);
+            for _ in 0..2000 {
+                let wo =
+                    warp::square_to_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+                let wi =
+                    warp::square_to_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
+                assert_eq!(textured.f(&ctx, wo, wi), product.f(&plain, wo, wi));
+                assert_eq!(textured.pdf(&ctx, wo, wi), product.pdf(&plain, wo, wi));
+                let (u1, u2) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
+                assert_eq!(
+                    textured.sample_f(&ctx, wo, u1, u2),
+                    product.sample_f(&plain, wo, u1, u2)
+                );
+            }
+            // The coat is not tinted: the smooth coat's mirror sample is
+            // white under a scale that removes blue from the base.
+            if alpha == 0.0 {
+                let wo = Vec3::new(0.6, 0.0, 0.8);
+                let s = textured.sample_f(&ctx, wo, 0.0, Vec2::splat(0.5)).unwrap();
+                assert!(s.flags.is_specular());
+                assert!(s.f.r == s.f.g && s.f.g == s.f.b && s.f.b > 0.0, "{:?}", s.f);
+            }
+        }
     }
 }

@@ -10,21 +10,26 @@ use lumis_core::Rgb;
 /// of a metal and a dielectric lobe by `metallic` has no lumis BSDF.
 const METALLIC_THRESHOLD: f32 = 0.5;
 
+/// The glTF dielectric's coat: IOR 1.5 (its specular F0 of 0.04).
+const DIELECTRIC_IOR: f32 = 1.5;
+
 /// A BSDF plugin table (`type = ...` and its parameters) for `material`,
-/// and what the mapping had to leave out.
+/// and what the mapping had to leave out. Both kinds have GGX normals of
+/// `alpha = roughness^2` (the glTF specification's remapping; below the
+/// plugins' 1e-3 floor the lobe is a mirror).
 ///
-/// - Metals (`metallicFactor >= 0.5`): `conductor` with GGX normals of
-///   `alpha = roughness^2` (the glTF specification's remapping), Fresnel 1
-///   scaled by the base colour, the glTF metal's reflectance at normal
-///   incidence (its Schlick rise towards white at grazing angles is not
-///   modelled). One-sided.
-/// - Dielectrics: `diffuse` with the base colour; the specular coat of
-///   glTF's dielectric (IOR 1.5, `roughness`) is left out, since most
-///   assets' dielectrics are meant matte, and `doubleSided` maps to
-///   `two_sided`.
+/// - Metals (`metallicFactor >= 0.5`): `conductor`, Fresnel 1 scaled by
+///   the base colour, the glTF metal's reflectance at normal incidence (its
+///   Schlick rise towards white at grazing angles is not modelled).
+/// - Dielectrics: `plastic`, a diffuse base of the base colour under a
+///   white coat of IOR 1.5, the two layers of glTF's dielectric. The base
+///   colour is the base's albedo seen through the coat at normal incidence
+///   (plastic's linear mode), where glTF mixes the two by Schlick's Fresnel.
 ///
-/// A base colour texture multiplies either (the caller wraps the BSDF).
-/// What is approximated is said in the warnings.
+/// `doubleSided` wraps either in [`super::two_sided::TwoSided`], and a base
+/// colour texture tints the conductor's reflectance or the plastic's base
+/// (the caller wraps the BSDF). What is approximated is said in the
+/// warnings.
 pub(crate) fn bsdf_table(
     material: &gltf::Material,
     label: &str,
@@ -38,44 +43,38 @@ pub(crate) fn bsdf_table(
         ));
     }
     let mut warnings = Vec::new();
-    // The default material (no index) is metallic 1 by the spec's defaults
-    // but means "untextured grey": it stays diffuse, and only declared
-    // materials are reported.
-    let declared = material.index().is_some();
+    // The default material (no index) is metallic 1 and roughness 1 by the
+    // spec's defaults, a rough white metal; lumis renders it as the matte
+    // grey most exporters mean by "no material", and reports nothing.
+    let Some(_) = material.index() else {
+        return Ok((
+            format!("type = \"diffuse\"\nreflectance = [{r:?}, {g:?}, {b:?}]\n"),
+            warnings,
+        ));
+    };
     let metallic = pbr.metallic_factor();
     let roughness = pbr.roughness_factor();
-    if declared && pbr.metallic_roughness_texture().is_some() {
+    if pbr.metallic_roughness_texture().is_some() {
         warnings.push(format!(
             "material {label}: metallicRoughnessTexture not modelled; metallic {metallic} and roughness {roughness} used everywhere"
         ));
     }
-    if declared && metallic > 0.0 && metallic < 1.0 {
+    if metallic > 0.0 && metallic < 1.0 {
         warnings.push(format!(
             "material {label}: metallic {metallic} rendered as {} (no blend of metal and dielectric)",
             if metallic >= METALLIC_THRESHOLD { "metal" } else { "dielectric" }
         ));
     }
-    if declared && metallic >= METALLIC_THRESHOLD {
-        if material.double_sided() {
-            warnings.push(format!(
-                "material {label}: doubleSided metal rendered one-sided (the conductor is black from behind)"
-            ));
-        }
-        let alpha = (roughness * roughness).clamp(0.0, 1.0);
-        let table = format!(
+    let alpha = (roughness * roughness).clamp(0.0, 1.0);
+    let table = if metallic >= METALLIC_THRESHOLD {
+        format!(
             "type = \"conductor\"\ndistribution = \"ggx\"\nroughness = {alpha:?}\nspecular_reflectance = [{r:?}, {g:?}, {b:?}]\n"
-        );
-        return Ok((table, warnings));
-    }
-    if declared && roughness < 1.0 {
-        warnings.push(format!(
-            "material {label}: dielectric with roughness {roughness} rendered as diffuse (its specular coat is not modelled)"
-        ));
-    }
-    let table = format!(
-        "type = \"diffuse\"\nreflectance = [{r:?}, {g:?}, {b:?}]\ntwo_sided = {}\n",
-        material.double_sided()
-    );
+        )
+    } else {
+        format!(
+            "type = \"plastic\"\ndiffuse_reflectance = [{r:?}, {g:?}, {b:?}]\nint_ior = {DIELECTRIC_IOR:?}\next_ior = 1.0\ndistribution = \"ggx\"\nroughness = {alpha:?}\n"
+        )
+    };
     Ok((table, warnings))
 }
 

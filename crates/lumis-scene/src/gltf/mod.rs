@@ -18,6 +18,7 @@ mod normals;
 mod resolve;
 mod scene_graph;
 mod texture;
+mod two_sided;
 mod unmodelled;
 
 use std::path::{Path, PathBuf};
@@ -30,10 +31,10 @@ use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Resu
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 use rayon::prelude::*;
 
-use crate::render_scene::{Geometry, MeshData, Placement, Prototype, NO_LIGHT};
+use crate::render_scene::{Geometry, MeshData, Placement, NO_LIGHT};
 use crate::report::Phase;
 use crate::transform::parse_transform;
-use crate::Assembly;
+use crate::{Assembly, PendingInstance, PendingPrototype};
 use decode::{MissingNormals, Part};
 
 pub(crate) const GLTF_PARAMS: &[ParamSpec] = &[
@@ -245,10 +246,10 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
         }
     }
 
-    // Meshes used by several nodes: one Embree scene each, built in parallel.
-    let mut pending = Vec::new();
+    // Meshes used by several nodes: one Embree scene each, built with the
+    // top level (`build_bvhs`) once the scene's size decides compaction.
     for (mesh_index, parts) in instanced {
-        let mut child =
+        let mut builder =
             SceneBuilder::new(&asm.device, asm.options).map_err(|e| err(e.to_string()))?;
         let mut meshes = Vec::with_capacity(parts.len());
         let mut emissions = Vec::with_capacity(parts.len());
@@ -263,32 +264,15 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 lights: Vec::new(),
                 orientation: 1.0,
             };
-            child
+            builder
                 .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
                 .map_err(|e| err(e.to_string()))?;
             asm.counts.shading_normals |= mesh.normals.is_some();
             emissions.push((r.emission.clone(), r.emission_texture.clone()));
             meshes.push(mesh);
         }
-        pending.push((mesh_index, child, meshes, emissions));
-    }
-    let (builders, rest): (Vec<_>, Vec<_>) = pending
-        .into_iter()
-        .map(|(i, child, meshes, emissions)| (child, (i, meshes, emissions)))
-        .unzip();
-    let scenes = asm
-        .report
-        .time(Phase::Bvh, || {
-            builders
-                .into_par_iter()
-                .map(|b| b.commit())
-                .collect::<std::result::Result<Vec<_>, _>>()
-        })
-        .map_err(|e| err(e.to_string()))?;
-    for (scene, (mesh_index, meshes, emissions)) in scenes.into_iter().zip(rest) {
-        let scene = Arc::new(scene);
-        let prototype = asm.prototypes.len() as u32;
         let triangles: usize = meshes.iter().map(|m| m.indices.len()).sum();
+        let mut instances = Vec::with_capacity(uses[mesh_index].len());
         for world in &uses[mesh_index] {
             let lights = instance_lights(&meshes, &emissions, world, &light_owner, &at, asm)?;
             let columns = world.to_cols_array();
@@ -306,12 +290,9 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 columns[13],
                 columns[14],
             ];
-            asm.builder
-                .add_instance(scene.clone(), &transform)
-                .map_err(|e| err(e.to_string()))?;
             let linear = Mat3::from_mat4(*world);
-            asm.geometries.push(Geometry::Instance {
-                prototype,
+            instances.push(PendingInstance {
+                transform,
                 placement: Placement {
                     linear,
                     translation: world.w_axis.truncate(),
@@ -325,7 +306,13 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
         asm.counts.meshes += meshes.len();
         asm.counts.prototypes += 1;
         asm.counts.unique_triangles += triangles;
-        asm.prototypes.push(Prototype { meshes });
+        asm.pending.push(PendingPrototype {
+            builder,
+            meshes,
+            instances,
+            owner: owner.to_string(),
+            location: at.clone(),
+        });
     }
     Ok(())
 }

@@ -11,7 +11,7 @@ use lumis_core::doc::{self, Node, Table, Value};
 use lumis_core::registry::TableRef;
 use lumis_core::{Error, Location, Result};
 
-use super::{buffers, material, texture, GltfShape};
+use super::{buffers, material, texture, two_sided, GltfShape};
 use crate::Assembly;
 
 /// What a glTF material became: a BSDF of the scene and, if it emits, the
@@ -124,14 +124,14 @@ pub(crate) fn resolve_materials(
                     type_location: at,
                     structural: &["type"],
                 })?;
+                if material.index().is_some() && material.double_sided() {
+                    bsdf = Arc::new(two_sided::TwoSided { inner: bsdf });
+                }
                 if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
                     match texture_of(asset, &info, &shape.path) {
                         Ok((t, set)) => {
                             asm.report.texture_bytes += t.byte_size();
-                            bsdf = Arc::new(texture::AlbedoTextured {
-                                inner: bsdf,
-                                texture: Arc::new(t),
-                            });
+                            bsdf = Arc::new(texture::AlbedoTextured::new(bsdf, Arc::new(t)));
                             uv_set = Some(set);
                         }
                         Err(why) => asm.report.warnings.push(format!(

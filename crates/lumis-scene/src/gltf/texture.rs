@@ -205,15 +205,39 @@ impl Texture {
     }
 }
 
-/// A BSDF whose albedo is multiplied by a texture at the hit's uv.
+/// A BSDF whose colour a texture scales at the hit's uv.
 ///
-/// Exact for BSDFs whose value is linear in their albedo and whose sampling
-/// does not depend on it, as `diffuse`: the texture then scales `f` and
-/// leaves `pdf` and the sampled directions alone. The conductor/plastic
-/// mapping to come will need its own treatment of textures.
+/// A BSDF that takes an albedo scale (`plastic`, whose coat stays white
+/// and whose lobe choice follows the tinted base) gets the texel through
+/// [`BsdfContext::albedo_scale`], so that `f`, `sample_f` and `pdf` all see
+/// the same value. Any other BSDF (`diffuse`, `conductor`) is linear in its
+/// colour and samples independently of it: the texel scales `f` and leaves
+/// `pdf` and the sampled directions alone.
 pub(crate) struct AlbedoTextured {
-    pub inner: Arc<dyn Bsdf>,
-    pub texture: Arc<Texture>,
+    inner: Arc<dyn Bsdf>,
+    texture: Arc<Texture>,
+    /// `inner.takes_albedo_scale()`, asked once.
+    through_context: bool,
+}
+
+impl AlbedoTextured {
+    pub fn new(inner: Arc<dyn Bsdf>, texture: Arc<Texture>) -> Self {
+        Self {
+            through_context: inner.takes_albedo_scale(),
+            inner,
+            texture,
+        }
+    }
+
+    /// The context with the texel at its uv as the albedo scale.
+    #[inline]
+    fn textured(&self, ctx: &BsdfContext) -> BsdfContext {
+        let texel = self.texture.lookup(ctx.uv);
+        BsdfContext {
+            albedo_scale: Some(ctx.albedo_scale.map_or(texel, |s| s * texel)),
+            ..*ctx
+        }
+    }
 }
 
 impl Bsdf for AlbedoTextured {
@@ -223,11 +247,18 @@ impl Bsdf for AlbedoTextured {
 
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        self.texture.lookup(ctx.uv) * self.inner.f(ctx, wo, wi)
+        if self.through_context {
+            self.inner.f(&self.textured(ctx), wo, wi)
+        } else {
+            self.texture.lookup(ctx.uv) * self.inner.f(ctx, wo, wi)
+        }
     }
 
     #[inline]
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        if self.through_context {
+            return self.inner.sample_f(&self.textured(ctx), wo, u1, u2);
+        }
         let mut s = self.inner.sample_f(ctx, wo, u1, u2)?;
         s.f = self.texture.lookup(ctx.uv) * s.f;
         Some(s)
@@ -235,7 +266,11 @@ impl Bsdf for AlbedoTextured {
 
     #[inline]
     fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        self.inner.pdf(ctx, wo, wi)
+        if self.through_context {
+            self.inner.pdf(&self.textured(ctx), wo, wi)
+        } else {
+            self.inner.pdf(ctx, wo, wi)
+        }
     }
 }
 

@@ -1,0 +1,164 @@
+//! The `[accel]` table: Embree build quality and scene flags, and the
+//! scene-wide choice of a compact BVH.
+
+use lumis_core::doc::{Node, Table, Value};
+use lumis_core::params::FromParam;
+use lumis_core::{ParamSpec, ParamType, Params, Result};
+use lumis_embree::{BuildQuality, SceneOptions};
+
+use crate::as_table;
+
+/// `compact = "auto"` builds a compact BVH from this many unique triangles.
+///
+/// The target is a peak of at most 120 bytes per unique triangle, BVH
+/// included. Measured on single meshes (`cargo bench -p lumis-tests --bench
+/// high_poly -- --sweep`, README "High-poly assets"), peak bytes per
+/// triangle above the ~7 MB process baseline, uncompacted / compact:
+/// 179.7 / 147.9 at 82k triangles, 142.5 / 110.5 at 328k, 152.6 / 91.8 at
+/// 1.3M (Embree's uncompacted leaves copy the vertices). An uncompacted
+/// BVH never meets the target; a compact one does from about 250k
+/// triangles on. Below that, compaction saves under 3 MB (82k: 2.6 MB)
+/// and still costs 16-29% of the rays per second, so small scenes keep the
+/// fast BVH.
+pub const AUTO_COMPACT_TRIANGLES: usize = 250_000;
+
+/// The `compact` setting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Compaction {
+    /// Compact from [`AUTO_COMPACT_TRIANGLES`] unique triangles on.
+    #[default]
+    Auto,
+    Always,
+    Never,
+}
+
+impl Compaction {
+    /// Whether a scene of `unique_triangles` (each instanced mesh counted
+    /// once: that is what the BVHs hold) gets a compact BVH.
+    pub fn decide(self, unique_triangles: usize) -> bool {
+        match self {
+            Compaction::Auto => unique_triangles >= AUTO_COMPACT_TRIANGLES,
+            Compaction::Always => true,
+            Compaction::Never => false,
+        }
+    }
+}
+
+impl FromParam for Compaction {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match &node.value {
+            Value::Bool(true) => Ok(Compaction::Always),
+            Value::Bool(false) => Ok(Compaction::Never),
+            Value::String(s) if s == "auto" => Ok(Compaction::Auto),
+            Value::String(s) => Err(format!("expected true, false or \"auto\", found \"{s}\"")),
+            v => Err(format!(
+                "expected true, false or \"auto\", found {}",
+                v.type_name()
+            )),
+        }
+    }
+}
+
+const ACCEL_PARAMS: &[ParamSpec] = &[
+    ParamSpec::with_default(
+        "quality",
+        ParamType::String,
+        "\"medium\"",
+        "Embree BVH build quality: \"low\" (fastest build, Morton), \"medium\" (binned SAH), \"high\" (SAH with spatial splits: slower build, faster rays)",
+    )
+    .one_of(&["low", "medium", "high"]),
+    ParamSpec::with_default(
+        "robust",
+        ParamType::Bool,
+        "false",
+        "RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping through shared edges) at some cost in speed",
+    ),
+    ParamSpec::with_default(
+        "compact",
+        ParamType::String,
+        "\"auto\"",
+        "true, false or \"auto\". RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed; \"auto\": from 250000 unique triangles on",
+    ),
+];
+
+/// What `[accel]` asks for; compaction is decided once the scene's
+/// triangles are counted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct AccelOptions {
+    /// Quality and robustness; `compact` is set at the build.
+    pub embree: SceneOptions,
+    pub compaction: Compaction,
+}
+
+/// Reads `[accel]` (all defaults when absent).
+pub(crate) fn accel_options(root: &Table) -> Result<AccelOptions> {
+    let Some(node) = root.get("accel") else {
+        return Ok(AccelOptions::default());
+    };
+    let table = as_table(node, "accel")?;
+    let params = Params::new("[accel]", table, node.location.clone(), ACCEL_PARAMS, &[])?;
+    let quality = match params.get_choice("quality")?.as_str() {
+        "low" => BuildQuality::Low,
+        "high" => BuildQuality::High,
+        _ => BuildQuality::Medium,
+    };
+    let options = AccelOptions {
+        embree: SceneOptions {
+            quality,
+            robust: params.get("robust")?,
+            compact: false,
+        },
+        compaction: params.get("compact")?,
+    };
+    params.finish()?;
+    Ok(options)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(accel: &str) -> std::result::Result<AccelOptions, String> {
+        let root = lumis_core::doc::parse(&format!("[accel]\n{accel}"), "s.toml").unwrap();
+        accel_options(&root).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn auto_compacts_from_the_threshold_on() {
+        let auto = parse("").unwrap().compaction;
+        assert_eq!(auto, Compaction::Auto);
+        assert_eq!(
+            accel_options(&Table::default()).unwrap().compaction,
+            Compaction::Auto
+        );
+        assert!(!auto.decide(0));
+        assert!(!auto.decide(AUTO_COMPACT_TRIANGLES - 1));
+        assert!(auto.decide(AUTO_COMPACT_TRIANGLES));
+        assert_eq!(
+            parse("compact = \"auto\"").unwrap().compaction,
+            Compaction::Auto
+        );
+    }
+
+    #[test]
+    fn explicit_settings_win_over_the_count() {
+        let on = parse("compact = true").unwrap().compaction;
+        let off = parse("compact = false").unwrap().compaction;
+        assert!(on.decide(1));
+        assert!(!off.decide(100 * AUTO_COMPACT_TRIANGLES));
+    }
+
+    #[test]
+    fn a_bad_value_names_the_key_and_the_accepted_values() {
+        for (value, found) in [("\"yes\"", "\"yes\""), ("1", "an integer")] {
+            let err = parse(&format!("compact = {value}")).unwrap_err();
+            assert!(
+                err.contains("s.toml:2:")
+                    && err.contains("[accel] key 'compact'")
+                    && err.contains("expected true, false or \"auto\"")
+                    && err.contains(found),
+                "{err}"
+            );
+        }
+    }
+}
