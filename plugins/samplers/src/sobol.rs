@@ -175,6 +175,7 @@ impl SobolSampler {
             self.sobol_dimension(start, 1),
         ];
         let [r0, r1] = sobol_reversed_pair(index, dims);
+        // Filling the cache up to `start + 1` fills `start` too.
         let seed1 = self.scramble_seed(start + 1);
         let seed0 = self.seeds[start as usize];
         Vec2::new(self.randomized(r0, seed0), self.randomized(r1, seed1))
