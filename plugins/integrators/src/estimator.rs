@@ -308,8 +308,14 @@ impl Estimator {
             uv: hit.uv,
             ..Default::default()
         };
-        // One call for both: the pdf is only unused for delta lights.
-        let (f, p_bsdf) = hit.bsdf.eval(&bsdf_ctx, wo, wi);
+        // The MIS weight needs the BSDF's pdf too (one call for both), except
+        // for a delta light, whose samples take weight 1.
+        let delta = light.kind() == LightKind::DeltaPosition;
+        let (f, p_bsdf) = if delta {
+            (hit.bsdf.f(&bsdf_ctx, wo, wi), 0.0)
+        } else {
+            hit.bsdf.eval(&bsdf_ctx, wo, wi)
+        };
         let f = f * wi.z.abs();
         if f.is_black() {
             return Rgb::BLACK;
@@ -320,8 +326,6 @@ impl Estimator {
         }
         stats.light_samples += 1;
         let p_light = chosen.pmf * ls.pdf;
-        let delta = light.kind() == LightKind::DeltaPosition;
-        let p_bsdf = if delta { 0.0 } else { p_bsdf };
         f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
     }
 

@@ -20,6 +20,8 @@ mod scene_graph;
 mod texture;
 mod two_sided;
 mod unmodelled;
+#[cfg(test)]
+mod wrapper_tests;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -120,7 +120,7 @@ impl Texture {
         Ok(Self::from_srgb8(width, height, texels))
     }
 
-    fn from_srgb8(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Self {
+    pub(crate) fn from_srgb8(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Self {
         Self {
             width,
             height,
@@ -271,6 +271,16 @@ impl Bsdf for AlbedoTextured {
         } else {
             self.inner.pdf(ctx, wo, wi)
         }
+    }
+
+    /// One texel lookup for both values, and the inner model's own `eval`.
+    #[inline]
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if self.through_context {
+            return self.inner.eval(&self.textured(ctx), wo, wi);
+        }
+        let (f, pdf) = self.inner.eval(ctx, wo, wi);
+        (self.texture.lookup(ctx.uv) * f, pdf)
     }
 }
 

@@ -49,6 +49,16 @@ impl Bsdf for TwoSided {
         }
     }
 
+    /// Mirrored once for both values, through the inner model's own `eval`.
+    #[inline]
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if wo.z < 0.0 {
+            self.inner.eval(ctx, mirrored(wo), mirrored(wi))
+        } else {
+            self.inner.eval(ctx, wo, wi)
+        }
+    }
+
     fn takes_albedo_scale(&self) -> bool {
         self.inner.takes_albedo_scale()
     }
