@@ -63,9 +63,7 @@ impl LoadReport {
         lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
         lines
     }
-}
 
-impl LoadReport {
     /// Whether the BVH is compact, and why.
     fn compaction_line(&self, counts: &SceneCounts) -> String {
         let built = if self.compact {

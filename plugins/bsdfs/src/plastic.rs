@@ -190,11 +190,9 @@ impl Plastic {
         base.f * ((1.0 - fi) * (1.0 - fo))
     }
 
+    /// The coat's value for the half vector `m` (with `<wo, m>`).
     #[inline]
-    fn coat_f(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> Rgb {
-        let Some((m, wo_m)) = half_vector(wo, wi) else {
-            return Rgb::BLACK;
-        };
+    fn coat_f(&self, mf: &Microfacet, (m, wo_m): (Vec3, f32), wo: Vec3, wi: Vec3) -> Rgb {
         let d = mf.d(m);
         if d == 0.0 {
             return Rgb::BLACK;
@@ -204,36 +202,64 @@ impl Plastic {
     }
 
     #[inline]
-    fn coat_pdf(mf: &Microfacet, wo: Vec3, wi: Vec3) -> f32 {
-        match half_vector(wo, wi) {
-            Some((m, wo_m)) => mf.pdf_normal(wo, m, wo_m) / (4.0 * wo_m),
-            None => 0.0,
+    fn coat_pdf(mf: &Microfacet, (m, wo_m): (Vec3, f32), wo: Vec3) -> f32 {
+        mf.pdf_normal(wo, m, wo_m) / (4.0 * wo_m)
+    }
+
+    /// `f` for directions both above the surface; `fo` is the Fresnel
+    /// term at `wo`, `half` the half vector (if any) for a rough coat.
+    #[inline]
+    fn f_above(&self, base: &Base, fo: f32, half: Option<(Vec3, f32)>, wo: Vec3, wi: Vec3) -> Rgb {
+        let base = self.base_f(base, fo, wi);
+        match (&self.coat, half) {
+            (Some(mf), Some(half)) => base + self.coat_f(mf, half, wo, wi),
+            _ => base,
         }
     }
 
+    /// `pdf` for directions both above the surface, as [`Self::f_above`].
     #[inline]
-    fn eval(&self, base: &Base, wo: Vec3, wi: Vec3) -> Rgb {
+    fn pdf_above(
+        &self,
+        base: &Base,
+        fo: f32,
+        half: Option<(Vec3, f32)>,
+        wo: Vec3,
+        wi: Vec3,
+    ) -> f32 {
+        let p = self.coat_probability(base, fo);
+        let base = (1.0 - p) * warp::cosine_hemisphere_pdf(wi.z);
+        match (&self.coat, half) {
+            (Some(mf), Some(half)) => base + p * Self::coat_pdf(mf, half, wo),
+            _ => base,
+        }
+    }
+
+    /// What `f` and `pdf` share: `None` below the surface, else the Fresnel
+    /// term at `wo` and the rough coat's half vector.
+    #[inline]
+    fn geometry(&self, wo: Vec3, wi: Vec3) -> Option<(f32, Option<(Vec3, f32)>)> {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Rgb::BLACK;
+            return None;
         }
         let fo = fresnel::dielectric(wo.z, self.eta);
-        let base = self.base_f(base, fo, wi);
-        match &self.coat {
-            Some(mf) => base + self.coat_f(mf, wo, wi),
-            None => base,
+        let half = self.coat.as_ref().and_then(|_| half_vector(wo, wi));
+        Some((fo, half))
+    }
+
+    #[inline]
+    fn eval_f(&self, base: &Base, wo: Vec3, wi: Vec3) -> Rgb {
+        match self.geometry(wo, wi) {
+            Some((fo, half)) => self.f_above(base, fo, half, wo, wi),
+            None => Rgb::BLACK,
         }
     }
 
     #[inline]
     fn eval_pdf(&self, base: &Base, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
-        let p = self.coat_probability(base, fresnel::dielectric(wo.z, self.eta));
-        let base = (1.0 - p) * warp::cosine_hemisphere_pdf(wi.z);
-        match &self.coat {
-            Some(mf) => base + p * Self::coat_pdf(mf, wo, wi),
-            None => base,
+        match self.geometry(wo, wi) {
+            Some((fo, half)) => self.pdf_above(base, fo, half, wo, wi),
+            None => 0.0,
         }
     }
 }
@@ -249,7 +275,7 @@ impl Bsdf for Plastic {
 
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        self.eval(&self.base(ctx), wo, wi)
+        self.eval_f(&self.base(ctx), wo, wi)
     }
 
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
@@ -287,13 +313,26 @@ impl Bsdf for Plastic {
             wi,
             flags,
             |wi| self.eval_pdf(&base, wo, wi),
-            |wi| self.eval(&base, wo, wi),
+            |wi| self.eval_f(&base, wo, wi),
         )
     }
 
     #[inline]
     fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
         self.eval_pdf(&self.base(ctx), wo, wi)
+    }
+
+    /// One base (texture), one Fresnel term at `wo`, one half vector.
+    #[inline]
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        let Some((fo, half)) = self.geometry(wo, wi) else {
+            return (Rgb::BLACK, 0.0);
+        };
+        let base = self.base(ctx);
+        (
+            self.f_above(&base, fo, half, wo, wi),
+            self.pdf_above(&base, fo, half, wo, wi),
+        )
     }
 
     fn takes_albedo_scale(&self) -> bool {
