@@ -3,17 +3,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::Bsdf;
-use crate::light::Light;
 use crate::math::Frame;
 use crate::ray::{Ray, SurfacePoint};
-
-/// An area light attached to the surface that was hit.
-#[derive(Clone, Copy)]
-pub struct HitLight<'a> {
-    /// Index into [`crate::Scene::lights`], for the light sampler's pmf.
-    pub index: u32,
-    pub light: &'a dyn Light,
-}
 
 /// A ray-surface intersection, ready for shading.
 #[derive(Clone, Copy)]
@@ -29,7 +20,12 @@ pub struct SurfaceInteraction<'a> {
     /// Unit direction back along the incoming ray, in world space.
     pub wo: Vec3,
     pub bsdf: &'a dyn Bsdf,
-    pub light: Option<HitLight<'a>>,
+    /// The area light attached to the surface, as an index into
+    /// [`crate::Scene::lights`] (the light sampler's pmf needs the index). An
+    /// index rather than a reference keeps the interaction within 128 bytes,
+    /// which the compiler copies inline instead of calling `memcpy` on every
+    /// hit.
+    pub light: Option<u32>,
 }
 
 impl SurfaceInteraction<'_> {
@@ -80,3 +76,7 @@ impl LightSampleContext {
         self.point.p
     }
 }
+
+// The integrators copy interactions by value on every hit: above 128 bytes
+// that copy becomes a call to `memcpy`.
+const _: () = assert!(std::mem::size_of::<Option<SurfaceInteraction>>() <= 128);

@@ -3,7 +3,6 @@
 use std::sync::Arc;
 
 use lumis_core::glam::Mat3;
-use lumis_core::interaction::HitLight;
 use lumis_core::math::{gamma, Frame};
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{Bsdf, Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3};
@@ -160,11 +159,8 @@ impl RenderScene {
     }
 
     #[inline]
-    fn light_ref(&self, index: u32) -> Option<HitLight<'_>> {
-        (index != NO_LIGHT).then(|| HitLight {
-            index,
-            light: self.lights[index as usize].as_ref(),
-        })
+    fn light_ref(&self, index: u32) -> Option<u32> {
+        (index != NO_LIGHT).then_some(index)
     }
 }
 
@@ -224,7 +220,7 @@ impl RenderScene {
 
 /// The hit point (recomputed from barycentrics, with its error bound), the
 /// shading normal on a mesh, in the mesh's own space, and the uv.
-#[inline]
+#[inline(always)]
 fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3, Vec2) {
     let tri = mesh.indices[hit.prim_id as usize];
     let vertices: &[Vertex] = &mesh.vertices;

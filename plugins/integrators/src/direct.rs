@@ -60,7 +60,7 @@ impl Integrator for DirectIntegrator {
             return le;
         };
         let mut radiance = match hit.light {
-            Some(emitter) => emitter.light.l(hit.p(), hit.n(), hit.uv, hit.wo),
+            Some(emitter) => scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo),
             None => Rgb::BLACK,
         };
         let wo = hit.shading.to_local(hit.wo);
@@ -81,8 +81,7 @@ impl Integrator for DirectIntegrator {
                 uv: hit.uv,
                 ..Default::default()
             };
-            let u1 = sampler.get_1d();
-            let u2 = sampler.get_2d();
+            let (u1, u2) = sampler.get_1d_2d();
             if let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) {
                 let wi = hit.shading.to_world(bs.wi);
                 if wi.dot(hit.n()) * bs.wi.z > 0.0 {
