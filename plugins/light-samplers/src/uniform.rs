@@ -12,12 +12,15 @@ pub const SPEC: PluginSpec = PluginSpec {
 #[derive(Debug, Clone)]
 pub struct UniformLightSampler {
     count: u32,
+    /// `1 / count`, divided once rather than at every light sample.
+    pmf: f32,
 }
 
 impl UniformLightSampler {
     pub fn new(count: usize) -> Self {
         Self {
             count: count as u32,
+            pmf: 1.0 / count as f32,
         }
     }
 }
@@ -31,14 +34,14 @@ impl LightSampler for UniformLightSampler {
         let index = ((u * self.count as f32) as u32).min(self.count - 1);
         Some(SampledLight {
             index,
-            pmf: 1.0 / self.count as f32,
+            pmf: self.pmf,
         })
     }
 
     #[inline]
     fn pmf(&self, _ctx: &LightSampleContext, index: u32) -> f32 {
         if index < self.count {
-            1.0 / self.count as f32
+            self.pmf
         } else {
             0.0
         }
