@@ -16,6 +16,16 @@ pub trait Sampler: Send + Sync {
 
     fn get_2d(&mut self) -> Vec2;
 
+    /// `get_1d()` then `get_2d()`, the same three numbers: what a light
+    /// sample (which light, which point) and a BSDF sample (which lobe,
+    /// which direction) each draw. One call instead of two, so a sampler
+    /// can share the work of the three dimensions (a Sobol' sampler walks
+    /// the sample index's bits once for all three).
+    fn get_1d_2d(&mut self) -> (f32, Vec2) {
+        let u = self.get_1d();
+        (u, self.get_2d())
+    }
+
     /// The film position within the pixel (the first two dimensions of a
     /// sample, so samplers can stratify them best).
     fn get_pixel_2d(&mut self) -> Vec2;

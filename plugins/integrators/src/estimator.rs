@@ -278,6 +278,11 @@ impl Estimator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        // One sample is the common case: without the loop around it the
+        // compiler does not hoist (and spill) the whole interaction first.
+        if plan.light_samples == 1 {
+            return self.sample_one_light(hit, wo, scene, sampler, stats) * plan.light_scale;
+        }
         let mut sum = Rgb::BLACK;
         for _ in 0..plan.light_samples {
             sum += self.sample_one_light(hit, wo, scene, sampler, stats);
@@ -293,8 +298,7 @@ impl Estimator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
-        let u_light = sampler.get_1d();
-        let u = sampler.get_2d();
+        let (u_light, u) = sampler.get_1d_2d();
         let ctx = hit.light_context();
         let Some(chosen) = scene.light_sampler().sample(&ctx, u_light) else {
             return Rgb::BLACK;
@@ -343,8 +347,7 @@ impl Estimator {
     ) -> Rgb {
         let mut sum = Rgb::BLACK;
         for _ in 0..plan.extra_bsdf_samples {
-            let u1 = sampler.get_1d();
-            let u2 = sampler.get_2d();
+            let (u1, u2) = sampler.get_1d_2d();
             let bsdf_ctx = BsdfContext {
                 uv: hit.uv,
                 ..Default::default()
@@ -382,10 +385,9 @@ impl Estimator {
         match scene.intersect(ray) {
             Some(hit) => {
                 if let Some(emitter) = hit.light {
-                    let le = emitter.light.l(hit.p(), hit.n(), hit.uv, hit.wo);
+                    let le = scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                     if !le.is_black() {
-                        let w =
-                            self.bsdf_weight(scene, emitter.index, prev, ray.d, p_bsdf, specular);
+                        let w = self.bsdf_weight(scene, emitter, prev, ray.d, p_bsdf, specular);
                         if w > 0.0 {
                             sum += le * w;
                             stats.bsdf_light_hits += 1;

@@ -93,7 +93,10 @@ impl Integrator for PathIntegrator {
         let mut segments = 1;
         loop {
             stats.rays += 1;
-            let Some(hit) = scene.intersect(&ray) else {
+            // Borrowed where `intersect` wrote it, not moved out of the
+            // Option: that move is a 120-byte copy per vertex.
+            let found = scene.intersect(&ray);
+            let Some(hit) = &found else {
                 for &index in scene.infinite_lights() {
                     let light = &scene.lights()[index as usize];
                     let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
@@ -109,17 +112,12 @@ impl Integrator for PathIntegrator {
                 break;
             };
             if let Some(emitter) = hit.light {
-                let le = emitter.light.l(hit.p(), hit.n(), hit.uv, hit.wo);
+                let le = scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                 if !le.is_black() {
                     let w = plan.bsdf_scale
-                        * self.estimator.bsdf_weight(
-                            scene,
-                            emitter.index,
-                            &prev,
-                            ray.d,
-                            bsdf_pdf,
-                            specular,
-                        );
+                        * self
+                            .estimator
+                            .bsdf_weight(scene, emitter, &prev, ray.d, bsdf_pdf, specular);
                     if w > 0.0 {
                         radiance += beta * le * w;
                         stats.bsdf_light_hits += u64::from(segments > 1);
@@ -152,8 +150,7 @@ impl Integrator for PathIntegrator {
                 uv: hit.uv,
                 ..Default::default()
             };
-            let u1 = sampler.get_1d();
-            let u2 = sampler.get_2d();
+            let (u1, u2) = sampler.get_1d_2d();
             let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) else {
                 break;
             };
