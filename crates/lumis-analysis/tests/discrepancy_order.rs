@@ -54,11 +54,7 @@ fn low_discrepancy_below_jittered_below_independent() {
             ),
             (
                 "sobol",
-                Box::new(SobolSampler::new(
-                    n,
-                    SobolRandomize::Owen,
-                    SobolDimensions::Sobol,
-                )),
+                SobolSampler::boxed(n, SobolRandomize::Owen, SobolDimensions::Sobol),
             ),
             ("hammersley", Box::new(HammersleySampler::new(n))),
         ];

@@ -27,7 +27,11 @@ pub use radical_inverse::{
     ONE_MINUS_EPSILON,
 };
 pub use rng::{hash_u64, hash_with, pixel_key, Pcg32};
-pub use scramble::{fixed_to_unit_f32, owen_scramble, owen_scramble_reversed, xor_scramble};
+pub use scramble::{
+    fixed_to_unit_f32, laine_karras_permutation, owen_scramble, owen_scramble_reversed,
+    reverse_bits_pair, reverse_bits_top24, reversed_pair_to_unit_f32, reversed_to_unit_f32,
+    xor_scramble,
+};
 pub use sobol::{sobol_reversed_pair, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};
 pub use spherical_rectangle::SphericalRectangle;
 pub use spherical_triangle::{

@@ -15,7 +15,10 @@ pub use halton::HaltonSampler;
 pub use hammersley::HammersleySampler;
 pub use independent::IndependentSampler;
 pub use poisson_disk::PoissonDiskSampler;
-pub use sobol::{Dimensions as SobolDimensions, Randomize as SobolRandomize, SobolSampler};
+pub use sobol::{
+    DimensionMapping as SobolDimensionMapping, Dimensions as SobolDimensions, Randomization,
+    Randomize as SobolRandomize, SobolSampler,
+};
 pub use stratified::{strata_grid, StratifiedSampler};
 pub use zsobol::ZSobolSampler;
 
@@ -35,7 +38,7 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_sampler(hammersley::SPEC, |p| {
         Ok(Box::new(HammersleySampler::from_params(p)?))
     })?;
-    registry.add_sampler(sobol::SPEC, |p| Ok(Box::new(SobolSampler::from_params(p)?)))?;
+    registry.add_sampler(sobol::SPEC, SobolSampler::from_params)?;
     registry.add_sampler(zsobol::SPEC, |p| {
         Ok(Box::new(ZSobolSampler::from_params(p)?))
     })?;

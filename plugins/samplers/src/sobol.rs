@@ -1,11 +1,14 @@
 //! `sobol`: the Sobol' sequence per pixel, Owen-scrambled.
 
+use std::fmt;
+use std::marker::PhantomData;
+
 use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
 use lumis_sampling::{
-    fixed_to_unit_f32, hash_with, owen_scramble, owen_scramble_reversed, pixel_key,
-    sobol_reversed_pair, sobol_reversed_u32, xor_scramble, SOBOL_DIMENSIONS,
+    hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_pair_to_unit_f32,
+    reversed_to_unit_f32, sobol_reversed_pair, sobol_reversed_u32, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -33,6 +36,7 @@ pub const SPEC: PluginSpec = PluginSpec {
     ],
 };
 
+/// The `randomize` parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Randomize {
     Owen,
@@ -53,40 +57,205 @@ pub enum Dimensions {
     Padded,
 }
 
+/// How a Sobol' coordinate is randomised: a type parameter of
+/// [`SobolSampler`], so the per-sample path has no branch on it.
+pub trait Randomization: fmt::Debug + Clone + Send + Sync + 'static {
+    /// Whether [`Self::apply`] reads its seed; seeds are not hashed otherwise.
+    const SEEDED: bool;
+
+    /// The randomised coordinate, both it and `reversed` bit-reversed
+    /// (first digit in bit 0).
+    fn apply(reversed: u32, seed: u32) -> u32;
+}
+
+/// Owen's nested uniform scrambling, hash-based (Burley 2020).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Owen;
+
+impl Randomization for Owen {
+    const SEEDED: bool = true;
+
+    #[inline(always)]
+    fn apply(reversed: u32, seed: u32) -> u32 {
+        laine_karras_permutation(reversed, seed)
+    }
+}
+
+/// A random digital shift. XOR by `seed` in the reversed domain is the
+/// shift by `seed.reverse_bits()`, as uniform a shift as `seed` itself.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Xor;
+
+impl Randomization for Xor {
+    const SEEDED: bool = true;
+
+    #[inline(always)]
+    fn apply(reversed: u32, seed: u32) -> u32 {
+        reversed ^ seed
+    }
+}
+
+/// The bare sequence: the same points in every pixel.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Unrandomized;
+
+impl Randomization for Unrandomized {
+    const SEEDED: bool = false;
+
+    #[inline(always)]
+    fn apply(reversed: u32, _seed: u32) -> u32 {
+        reversed
+    }
+}
+
+/// Which Sobol' dimensions a request uses: a type parameter of
+/// [`SobolSampler`], like [`Randomization`].
+pub trait DimensionMapping: fmt::Debug + Clone + Send + Sync + 'static {
+    /// Whether requests past the film plane shuffle the sample index.
+    const SHUFFLED: bool;
+
+    /// The Sobol' dimensions of the two components of a request that starts
+    /// at sampler dimension `start` (a 1D request uses the first).
+    fn sobol_dimensions(start: u32) -> [usize; 2];
+}
+
+/// [`Dimensions::Sobol`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SobolOrder;
+
+impl DimensionMapping for SobolOrder {
+    const SHUFFLED: bool = false;
+
+    #[inline(always)]
+    fn sobol_dimensions(start: u32) -> [usize; 2] {
+        [start, start.wrapping_add(1)].map(|d| d as usize % SOBOL_DIMENSIONS)
+    }
+}
+
+/// [`Dimensions::Padded`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Padded;
+
+impl DimensionMapping for Padded {
+    const SHUFFLED: bool = true;
+
+    #[inline(always)]
+    fn sobol_dimensions(_start: u32) -> [usize; 2] {
+        [0, 1]
+    }
+}
+
 /// Sobol' sampling in the style of pbrt-v4's `PaddedSobolSampler` and
 /// `SobolSampler`, per pixel: sample `i` of a pixel is Sobol' point `i`, each
 /// dimension scrambled with a seed from (pixel, dimension, seed). Owen
 /// scrambling is what makes it unbiased and decorrelates pixels; it keeps the
 /// (0,m,2)-net property of every aligned power-of-two block, so any prefix of
 /// 2^m samples is as well stratified as the full set.
+///
+/// Generic over the randomisation and the dimension mapping so each of the
+/// six combinations compiles to its own straight-line code;
+/// [`SobolSampler::boxed`] picks one at run time.
 #[derive(Debug, Clone)]
-pub struct SobolSampler {
+pub struct SobolSampler<R = Owen, D = SobolOrder> {
     spp: u32,
-    randomize: Randomize,
-    dimensions: Dimensions,
+    /// The (pixel, seed) that `key` was derived from.
+    keyed: Option<(UVec2, u64)>,
+    /// The pixel's key, hashed with each request's dimension into its seeds.
     key: u64,
     index: u32,
     dimension: u32,
-    /// Scramble seeds of the current pixel, per dimension, filled lazily:
-    /// a pixel's samples are drawn one after another, so each seed is
-    /// hashed once per pixel rather than once per sample.
-    seeds: Vec<u32>,
+    strategy: PhantomData<(R, D)>,
 }
 
-impl SobolSampler {
-    pub fn new(spp: u32, randomize: Randomize, dimensions: Dimensions) -> Self {
+impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
+    pub fn new(spp: u32) -> Self {
         Self {
             spp,
-            randomize,
-            dimensions,
+            keyed: None,
             key: 0,
             index: 0,
             dimension: 0,
-            seeds: Vec::new(),
+            strategy: PhantomData,
         }
     }
 
-    pub fn from_params(params: &Params) -> Result<Self> {
+    /// The scramble seeds of the two components of the request starting at
+    /// sampler dimension `start` (a 1D request uses the first): the halves of
+    /// one 64-bit hash of (pixel key, start), as pbrt-v4's
+    /// `PaddedSobolSampler::Get2D` does. Hashed on every call: one hash costs
+    /// less than filling and reading a per-pixel cache of seeds (measured on
+    /// the Cornell box at 4 spp).
+    #[inline(always)]
+    fn scramble_seeds(&self, start: u32) -> [u32; 2] {
+        let h = hash_with(self.key, start as u64);
+        [h as u32, (h >> 32) as u32]
+    }
+
+    /// The seed of the sample-index shuffle of a (padded) request: counters
+    /// past 2^32 never meet a scramble seed's.
+    #[inline(always)]
+    fn shuffle_seed(&self, start: u32) -> u32 {
+        hash_with(self.key, 1 << 32 | start as u64) as u32
+    }
+
+    /// The sample index a request starting at `dimension` uses: shuffled per
+    /// request in padded mode (an Owen scramble of the index is a nested
+    /// permutation, so aligned power-of-two blocks map onto themselves).
+    #[inline(always)]
+    fn index_for(&self, dimension: u32) -> u32 {
+        if D::SHUFFLED && R::SEEDED && dimension >= 2 {
+            owen_scramble(self.index, self.shuffle_seed(dimension))
+        } else {
+            self.index
+        }
+    }
+
+    #[inline(always)]
+    fn sample_1d(&self, start: u32) -> f32 {
+        let [dim, _] = D::sobol_dimensions(start);
+        let reversed = sobol_reversed_u32(self.index_for(start), dim);
+        let seed = if R::SEEDED {
+            self.scramble_seeds(start)[0]
+        } else {
+            0
+        };
+        reversed_to_unit_f32(R::apply(reversed, seed))
+    }
+
+    /// Both components of a 2D request: one pass over the index bits, one
+    /// 64-bit bit reversal.
+    #[inline(always)]
+    fn sample_2d(&self, start: u32) -> Vec2 {
+        let [r0, r1] = sobol_reversed_pair(self.index_for(start), D::sobol_dimensions(start));
+        let [s0, s1] = if R::SEEDED {
+            self.scramble_seeds(start)
+        } else {
+            [0, 0]
+        };
+        Vec2::from(reversed_pair_to_unit_f32([
+            R::apply(r0, s0),
+            R::apply(r1, s1),
+        ]))
+    }
+}
+
+impl SobolSampler {
+    /// The sampler with the given randomisation and dimension mapping.
+    pub fn boxed(spp: u32, randomize: Randomize, dimensions: Dimensions) -> Box<dyn Sampler> {
+        fn make<R: Randomization, D: DimensionMapping>(spp: u32) -> Box<dyn Sampler> {
+            Box::new(SobolSampler::<R, D>::new(spp))
+        }
+        match (randomize, dimensions) {
+            (Randomize::Owen, Dimensions::Sobol) => make::<Owen, SobolOrder>(spp),
+            (Randomize::Owen, Dimensions::Padded) => make::<Owen, Padded>(spp),
+            (Randomize::Xor, Dimensions::Sobol) => make::<Xor, SobolOrder>(spp),
+            (Randomize::Xor, Dimensions::Padded) => make::<Xor, Padded>(spp),
+            (Randomize::None, Dimensions::Sobol) => make::<Unrandomized, SobolOrder>(spp),
+            (Randomize::None, Dimensions::Padded) => make::<Unrandomized, Padded>(spp),
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Box<dyn Sampler>> {
         let randomize = match params.get_choice("randomize")?.as_str() {
             "owen" => Randomize::Owen,
             "xor" => Randomize::Xor,
@@ -96,102 +265,20 @@ impl SobolSampler {
             "padded" => Dimensions::Padded,
             _ => Dimensions::Sobol,
         };
-        Ok(Self::new(read_spp(params)?, randomize, dimensions))
-    }
-
-    /// The scramble seed of a dimension (salt 0) or of its index shuffle
-    /// (salt 1).
-    fn seed(&self, dimension: u32, salt: u64) -> u32 {
-        hash_with(self.key, ((dimension as u64) << 2) | salt) as u32
-    }
-
-    /// The scramble seed of sampler dimension `dimension`, hashed once per
-    /// pixel: the cached fast path stays small enough to inline.
-    #[inline(always)]
-    fn scramble_seed(&mut self, dimension: u32) -> u32 {
-        match self.seeds.get(dimension as usize) {
-            Some(&seed) => seed,
-            None => self.fill_seeds(dimension),
-        }
-    }
-
-    #[cold]
-    #[inline(never)]
-    fn fill_seeds(&mut self, dimension: u32) -> u32 {
-        while self.seeds.len() <= dimension as usize {
-            let seed = self.seed(self.seeds.len() as u32, 0);
-            self.seeds.push(seed);
-        }
-        self.seeds[dimension as usize]
-    }
-
-    /// The sample index a request starting at `dimension` uses: shuffled per
-    /// request in padded mode (an Owen scramble of the index is a nested
-    /// permutation, so aligned power-of-two blocks map onto themselves).
-    #[inline(always)]
-    fn index_for(&self, dimension: u32) -> u32 {
-        match (self.dimensions, self.randomize) {
-            (Dimensions::Padded, Randomize::Owen | Randomize::Xor) if dimension >= 2 => {
-                owen_scramble(self.index, self.seed(dimension, 1))
-            }
-            _ => self.index,
-        }
-    }
-
-    /// The Sobol' dimension behind sampler dimension `d` (component `c` of
-    /// a request that started at `start`).
-    #[inline(always)]
-    fn sobol_dimension(&self, start: u32, component: u32) -> usize {
-        match self.dimensions {
-            Dimensions::Sobol => (start + component) as usize % SOBOL_DIMENSIONS,
-            Dimensions::Padded => component as usize,
-        }
-    }
-
-    /// A bit-reversed Sobol' coordinate, randomised with `seed`, as a float.
-    #[inline(always)]
-    fn randomized(&self, reversed: u32, seed: u32) -> f32 {
-        fixed_to_unit_f32(match self.randomize {
-            Randomize::Owen => owen_scramble_reversed(reversed, seed),
-            Randomize::Xor => xor_scramble(reversed.reverse_bits(), seed),
-            Randomize::None => reversed.reverse_bits(),
-        })
-    }
-
-    #[inline(always)]
-    fn sample_1d(&mut self, start: u32) -> f32 {
-        let index = self.index_for(start);
-        let reversed = sobol_reversed_u32(index, self.sobol_dimension(start, 0));
-        let seed = self.scramble_seed(start);
-        self.randomized(reversed, seed)
-    }
-
-    /// Both components of a 2D request: one index, one pass over its bits.
-    #[inline(always)]
-    fn sample_2d(&mut self, start: u32) -> Vec2 {
-        let index = self.index_for(start);
-        let dims = [
-            self.sobol_dimension(start, 0),
-            self.sobol_dimension(start, 1),
-        ];
-        let [r0, r1] = sobol_reversed_pair(index, dims);
-        // Filling the cache up to `start + 1` fills `start` too.
-        let seed1 = self.scramble_seed(start + 1);
-        let seed0 = self.seeds[start as usize];
-        Vec2::new(self.randomized(r0, seed0), self.randomized(r1, seed1))
+        Ok(Self::boxed(read_spp(params)?, randomize, dimensions))
     }
 }
 
-impl Sampler for SobolSampler {
+impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
     fn samples_per_pixel(&self) -> u32 {
         self.spp
     }
 
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
-        let key = pixel_key(pixel.x, pixel.y, seed);
-        if key != self.key || self.seeds.is_empty() {
-            self.key = key;
-            self.seeds.clear();
+        // A pixel's samples come one after another: hash its key once.
+        if self.keyed != Some((pixel, seed)) {
+            self.keyed = Some((pixel, seed));
+            self.key = pixel_key(pixel.x, pixel.y, seed);
         }
         self.index = index;
         self.dimension = 2;
@@ -199,13 +286,13 @@ impl Sampler for SobolSampler {
 
     fn get_1d(&mut self) -> f32 {
         let d = self.dimension;
-        self.dimension += 1;
+        self.dimension = d.wrapping_add(1);
         self.sample_1d(d)
     }
 
     fn get_2d(&mut self) -> Vec2 {
         let d = self.dimension;
-        self.dimension += 2;
+        self.dimension = d.wrapping_add(2);
         self.sample_2d(d)
     }
 
@@ -223,7 +310,7 @@ mod tests {
     use super::*;
     use crate::net_check::is_02_net;
 
-    fn pairs(s: &mut SobolSampler, n: u32, skip_pairs: usize, seed: u64) -> Vec<Vec2> {
+    fn pairs(s: &mut dyn Sampler, n: u32, skip_pairs: usize, seed: u64) -> Vec<Vec2> {
         (0..n)
             .map(|i| {
                 s.start_pixel_sample(UVec2::new(17, 3), i, seed);
@@ -244,8 +331,8 @@ mod tests {
         let max = 1u32 << 14;
         for randomize in [Randomize::None, Randomize::Xor, Randomize::Owen] {
             for (dimensions, skip) in [(Dimensions::Sobol, 0), (Dimensions::Padded, 3)] {
-                let mut s = SobolSampler::new(max, randomize, dimensions);
-                let points = pairs(&mut s, max, skip, 5);
+                let mut s = SobolSampler::boxed(max, randomize, dimensions);
+                let points = pairs(s.as_mut(), max, skip, 5);
                 for m in [0u32, 1, 2, 5, 8, 11, 14] {
                     assert!(
                         is_02_net(&points[..1 << m], m),
@@ -256,12 +343,109 @@ mod tests {
         }
     }
 
+    fn correlation(a: &[f32], b: &[f32]) -> f64 {
+        let n = a.len() as f64;
+        let mean = |v: &[f32]| v.iter().map(|&x| x as f64).sum::<f64>() / n;
+        let (ma, mb) = (mean(a), mean(b));
+        let (mut ab, mut aa, mut bb) = (0.0, 0.0, 0.0);
+        for (&x, &y) in a.iter().zip(b) {
+            let (x, y) = (x as f64 - ma, y as f64 - mb);
+            ab += x * y;
+            aa += x * x;
+            bb += y * y;
+        }
+        ab / (aa * bb).sqrt()
+    }
+
+    /// The first sample's values of a request pattern like a path's (film
+    /// plane, 1D, 2D, 1D, 2D), one row per pixel of a 128-wide image.
+    fn first_samples(s: &mut dyn Sampler, pixels: u32, seed: u64) -> Vec<Vec<f32>> {
+        let mut columns = vec![Vec::new(); 8];
+        for i in 0..pixels {
+            s.start_pixel_sample(UVec2::new(i % 128, i / 128), 0, seed);
+            let (p, a, b, c, d) = (
+                s.get_pixel_2d(),
+                s.get_1d(),
+                s.get_2d(),
+                s.get_1d(),
+                s.get_2d(),
+            );
+            for (column, v) in columns.iter_mut().zip([p.x, p.y, a, b.x, b.y, c, d.x, d.y]) {
+                column.push(v);
+            }
+        }
+        columns
+    }
+
+    /// Scramble seeds are hashed from (pixel, dimension, seed): across
+    /// pixels, every pair of dimensions of a sample is uncorrelated, and so
+    /// is each dimension between horizontal neighbours and between scene
+    /// seeds. In Sobol' order sample 0 is the origin in every dimension, so
+    /// its values are the scrambles alone.
+    #[test]
+    fn seeds_decorrelate_dimensions_pixels_and_scene_seeds() {
+        let n = 1u32 << 14;
+        // |r| < 5 sd of the null distribution (sd = 1/sqrt(n)).
+        let bound = 5.0 / (n as f64).sqrt();
+        for randomize in [Randomize::Owen, Randomize::Xor] {
+            for dimensions in [Dimensions::Sobol, Dimensions::Padded] {
+                let mut s = SobolSampler::boxed(16, randomize, dimensions);
+                let v = first_samples(s.as_mut(), n, 7);
+                let w = first_samples(s.as_mut(), n, 8);
+                let label = format!("{randomize:?} {dimensions:?}");
+                for i in 0..v.len() {
+                    for j in i + 1..v.len() {
+                        let r = correlation(&v[i], &v[j]);
+                        assert!(r.abs() < bound, "{label}: dims {i} {j}: {r}");
+                    }
+                    let r = correlation(&v[i][1..], &v[i][..n as usize - 1]);
+                    assert!(r.abs() < bound, "{label}: dim {i}, neighbours: {r}");
+                    let r = correlation(&v[i], &w[i]);
+                    assert!(r.abs() < bound, "{label}: dim {i}, seeds: {r}");
+                }
+            }
+        }
+    }
+
+    /// Every instantiation [`SobolSampler::boxed`] picks is the one asked
+    /// for: the randomisations differ, padded differs from Sobol' order past
+    /// the film plane only.
+    #[test]
+    fn boxed_picks_the_requested_strategies() {
+        let draw = |randomize, dimensions| {
+            let mut s = SobolSampler::boxed(16, randomize, dimensions);
+            s.start_pixel_sample(UVec2::new(3, 4), 5, 1);
+            [s.get_pixel_2d(), s.get_2d()]
+        };
+        let none = draw(Randomize::None, Dimensions::Sobol);
+        // Sobol' point 5 of dimensions 0..4, unscrambled.
+        let point = |d| sobol_u32_unit(5, d);
+        assert_eq!(
+            none,
+            [Vec2::new(point(0), point(1)), Vec2::new(point(2), point(3))]
+        );
+        let none_padded = draw(Randomize::None, Dimensions::Padded);
+        assert_eq!(none_padded, [none[0], none[0]]);
+        let owen = draw(Randomize::Owen, Dimensions::Sobol);
+        let xor = draw(Randomize::Xor, Dimensions::Sobol);
+        let owen_padded = draw(Randomize::Owen, Dimensions::Padded);
+        assert_ne!(owen, none);
+        assert_ne!(xor, none);
+        assert_ne!(owen, xor);
+        assert_eq!(owen_padded[0], owen[0]);
+        assert_ne!(owen_padded[1], owen[1]);
+    }
+
+    fn sobol_u32_unit(index: u32, dim: usize) -> f32 {
+        lumis_sampling::fixed_to_unit_f32(lumis_sampling::sobol_u32(index, dim))
+    }
+
     #[test]
     fn seeds_and_pixels_change_the_points() {
-        let mut s = SobolSampler::new(16, Randomize::Owen, Dimensions::Sobol);
-        let a = pairs(&mut s, 4, 1, 1);
-        assert_ne!(a, pairs(&mut s, 4, 1, 2));
-        let mut t = SobolSampler::new(16, Randomize::None, Dimensions::Sobol);
-        assert_eq!(pairs(&mut t, 4, 1, 1), pairs(&mut t, 4, 1, 2));
+        let mut s = SobolSampler::boxed(16, Randomize::Owen, Dimensions::Sobol);
+        let a = pairs(s.as_mut(), 4, 1, 1);
+        assert_ne!(a, pairs(s.as_mut(), 4, 1, 2));
+        let mut t = SobolSampler::boxed(16, Randomize::None, Dimensions::Sobol);
+        assert_eq!(pairs(t.as_mut(), 4, 1, 1), pairs(t.as_mut(), 4, 1, 2));
     }
 }

@@ -25,27 +25,15 @@ fn samplers() -> Vec<(&'static str, Box<dyn Sampler>)> {
         ("hammersley", Box::new(HammersleySampler::new(SPP))),
         (
             "sobol owen",
-            Box::new(SobolSampler::new(
-                SPP,
-                SobolRandomize::Owen,
-                SobolDimensions::Sobol,
-            )),
+            SobolSampler::boxed(SPP, SobolRandomize::Owen, SobolDimensions::Sobol),
         ),
         (
             "sobol xor",
-            Box::new(SobolSampler::new(
-                SPP,
-                SobolRandomize::Xor,
-                SobolDimensions::Sobol,
-            )),
+            SobolSampler::boxed(SPP, SobolRandomize::Xor, SobolDimensions::Sobol),
         ),
         (
             "sobol padded",
-            Box::new(SobolSampler::new(
-                SPP,
-                SobolRandomize::Owen,
-                SobolDimensions::Padded,
-            )),
+            SobolSampler::boxed(SPP, SobolRandomize::Owen, SobolDimensions::Padded),
         ),
         ("zsobol", Box::new(ZSobolSampler::new(SPP, true))),
         (
