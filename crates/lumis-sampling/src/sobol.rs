@@ -28,22 +28,27 @@ pub fn sobol_reversed_u32(mut index: u32, dim: usize) -> u32 {
     x
 }
 
-/// [`sobol_reversed_u32`] of two dimensions of the same point in one pass
-/// over the index bits: a 2D request costs one loop, not two.
+/// [`sobol_reversed_u32`] of `N` dimensions of the same point in one pass
+/// over the index bits: a 2D request, or a 1D and a 2D request drawn
+/// together, costs one loop, not one per dimension.
 #[inline]
-pub fn sobol_reversed_pair(mut index: u32, dims: [usize; 2]) -> [u32; 2] {
-    let (c0, c1) = (
-        &SOBOL_MATRICES_REVERSED[dims[0]],
-        &SOBOL_MATRICES_REVERSED[dims[1]],
-    );
-    let (mut x0, mut x1) = (0, 0);
+pub fn sobol_reversed_columns<const N: usize>(mut index: u32, dims: [usize; N]) -> [u32; N] {
+    let columns = dims.map(|d| &SOBOL_MATRICES_REVERSED[d]);
+    let mut x = [0; N];
     while index != 0 {
         let bit = index.trailing_zeros() as usize;
-        x0 ^= c0[bit];
-        x1 ^= c1[bit];
+        for (x, column) in x.iter_mut().zip(&columns) {
+            *x ^= column[bit];
+        }
         index &= index - 1;
     }
-    [x0, x1]
+    x
+}
+
+/// [`sobol_reversed_columns`] of two dimensions.
+#[inline]
+pub fn sobol_reversed_pair(index: u32, dims: [usize; 2]) -> [u32; 2] {
+    sobol_reversed_columns(index, dims)
 }
 
 #[cfg(test)]
@@ -124,11 +129,18 @@ mod tests {
     }
 
     #[test]
-    fn pairs_match_single_dimensions() {
+    fn pairs_and_triples_match_single_dimensions() {
         for index in [0u32, 1, 2, 3, 63, 64, 1000, u32::MAX] {
             for dims in [[0, 1], [2, 3], [7, 1023], [500, 500]] {
                 assert_eq!(
                     sobol_reversed_pair(index, dims),
+                    dims.map(|d| sobol_reversed_u32(index, d)),
+                    "index {index} dims {dims:?}"
+                );
+            }
+            for dims in [[2, 3, 4], [1021, 1022, 1023], [9, 9, 0]] {
+                assert_eq!(
+                    sobol_reversed_columns(index, dims),
                     dims.map(|d| sobol_reversed_u32(index, d)),
                     "index {index} dims {dims:?}"
                 );

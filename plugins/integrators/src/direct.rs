@@ -11,7 +11,7 @@ use lumis_core::{
     Scene, Vec3,
 };
 
-use crate::estimator::{self, Estimator, VertexPlan};
+use crate::estimator::{self, Estimator, SceneView, VertexPlan};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
@@ -45,12 +45,13 @@ impl Integrator for DirectIntegrator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        let scene = &SceneView::new(scene);
         // What the camera sees directly counts fully (a specular "bounce").
         stats.rays += 1;
         let Some(hit) = scene.intersect(camera_ray) else {
             let mut le = Rgb::BLACK;
-            for &index in scene.infinite_lights() {
-                le += scene.lights()[index as usize].l(
+            for &index in scene.infinite_lights {
+                le += scene.lights[index as usize].l(
                     camera_ray.o,
                     Vec3::ZERO,
                     Default::default(),
@@ -60,7 +61,7 @@ impl Integrator for DirectIntegrator {
             return le;
         };
         let mut radiance = match hit.light {
-            Some(emitter) => scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo),
+            Some(emitter) => scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo),
             None => Rgb::BLACK,
         };
         let wo = hit.shading.to_local(hit.wo);

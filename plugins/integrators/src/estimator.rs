@@ -25,8 +25,8 @@
 
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    LightKind, LightSampleContext, ParamSpec, ParamType, Params, RenderStats, Result, Rgb, Sampler,
-    Scene, SurfaceInteraction, Vec3,
+    Light, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params, Ray,
+    RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -69,6 +69,38 @@ pub const PARAMS: [ParamSpec; 6] = [
     )
     .one_of(&["multi-sample", "one-sample"]),
 ];
+
+/// The scene as the estimators use it: traversal plus its lights. The
+/// light list, the light sampler and the infinite lights are read from the
+/// scene once per path instead of through a virtual call at every vertex.
+#[derive(Clone, Copy)]
+pub struct SceneView<'a> {
+    pub scene: &'a dyn Scene,
+    pub lights: &'a [Box<dyn Light>],
+    pub light_sampler: &'a dyn LightSampler,
+    pub infinite_lights: &'a [u32],
+}
+
+impl<'a> SceneView<'a> {
+    pub fn new(scene: &'a dyn Scene) -> Self {
+        Self {
+            scene,
+            lights: scene.lights(),
+            light_sampler: scene.light_sampler(),
+            infinite_lights: scene.infinite_lights(),
+        }
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'a>> {
+        self.scene.intersect(ray)
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.scene.occluded(ray)
+    }
+}
 
 /// Which estimator finds emission.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -249,7 +281,7 @@ impl Estimator {
     #[inline]
     pub fn bsdf_weight(
         &self,
-        scene: &dyn Scene,
+        scene: &SceneView,
         index: u32,
         prev: &LightSampleContext,
         wi: Vec3,
@@ -262,8 +294,8 @@ impl Estimator {
         if self.strategy == Strategy::Light {
             return 0.0;
         }
-        let light = &scene.lights()[index as usize];
-        let p_light = scene.light_sampler().pmf(prev, index) * light.pdf_li(prev, wi);
+        let light = &scene.lights[index as usize];
+        let p_light = scene.light_sampler.pmf(prev, index) * light.pdf_li(prev, wi);
         self.heuristic.weight(self.n_f, p_bsdf, self.n_g, p_light)
     }
 
@@ -274,7 +306,7 @@ impl Estimator {
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
         wo: Vec3,
-        scene: &dyn Scene,
+        scene: &SceneView,
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
@@ -294,16 +326,16 @@ impl Estimator {
         &self,
         hit: &SurfaceInteraction,
         wo: Vec3,
-        scene: &dyn Scene,
+        scene: &SceneView,
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
         let (u_light, u) = sampler.get_1d_2d();
         let ctx = hit.light_context();
-        let Some(chosen) = scene.light_sampler().sample(&ctx, u_light) else {
+        let Some(chosen) = scene.light_sampler.sample(&ctx, u_light) else {
             return Rgb::BLACK;
         };
-        let light = &scene.lights()[chosen.index as usize];
+        let light = &scene.lights[chosen.index as usize];
         let Some(ls) = light.sample_li(&ctx, u) else {
             return Rgb::BLACK;
         };
@@ -341,7 +373,7 @@ impl Estimator {
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
         wo: Vec3,
-        scene: &dyn Scene,
+        scene: &SceneView,
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
@@ -374,8 +406,8 @@ impl Estimator {
     /// counts the ray and applies the plan's scale.
     pub fn emission_along(
         &self,
-        scene: &dyn Scene,
-        ray: &lumis_core::Ray,
+        scene: &SceneView,
+        ray: &Ray,
         prev: &LightSampleContext,
         p_bsdf: f32,
         specular: bool,
@@ -385,7 +417,7 @@ impl Estimator {
         match scene.intersect(ray) {
             Some(hit) => {
                 if let Some(emitter) = hit.light {
-                    let le = scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
+                    let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                     if !le.is_black() {
                         let w = self.bsdf_weight(scene, emitter, prev, ray.d, p_bsdf, specular);
                         if w > 0.0 {
@@ -396,8 +428,8 @@ impl Estimator {
                 }
             }
             None => {
-                for &index in scene.infinite_lights() {
-                    let light = &scene.lights()[index as usize];
+                for &index in scene.infinite_lights {
+                    let light = &scene.lights[index as usize];
                     let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
                     let w = self.bsdf_weight(scene, index, prev, ray.d, p_bsdf, specular);
                     if w > 0.0 && !le.is_black() {

@@ -8,7 +8,7 @@ use lumis_core::{
     RenderStats, Result, Rgb, Sampler, Scene, Vec3,
 };
 
-use crate::estimator::{self, Estimator, Heuristic, Strategy, VertexPlan};
+use crate::estimator::{self, Estimator, Heuristic, SceneView, Strategy, VertexPlan};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
@@ -81,6 +81,7 @@ impl Integrator for PathIntegrator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        let scene = &SceneView::new(scene);
         let mut radiance = Rgb::BLACK;
         let mut beta = Rgb::WHITE;
         let mut ray = *camera_ray;
@@ -97,8 +98,8 @@ impl Integrator for PathIntegrator {
             // Option: that move is a 120-byte copy per vertex.
             let found = scene.intersect(&ray);
             let Some(hit) = &found else {
-                for &index in scene.infinite_lights() {
-                    let light = &scene.lights()[index as usize];
+                for &index in scene.infinite_lights {
+                    let light = &scene.lights[index as usize];
                     let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
                     let w = plan.bsdf_scale
                         * self
@@ -112,7 +113,7 @@ impl Integrator for PathIntegrator {
                 break;
             };
             if let Some(emitter) = hit.light {
-                let le = scene.lights()[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
+                let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                 if !le.is_black() {
                     let w = plan.bsdf_scale
                         * self

@@ -8,7 +8,8 @@ use lumis_core::{
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_pair_to_unit_f32,
-    reversed_to_unit_f32, sobol_reversed_pair, sobol_reversed_u32, SOBOL_DIMENSIONS,
+    reversed_to_unit_f32, sobol_reversed_columns, sobol_reversed_pair, sobol_reversed_u32,
+    SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -294,6 +295,31 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         let d = self.dimension;
         self.dimension = d.wrapping_add(2);
         self.sample_2d(d)
+    }
+
+    /// In Sobol' order the three dimensions share the sample index: one
+    /// pass over its bits. Padded requests each shuffle the index their own
+    /// way, so they stay two requests.
+    fn get_1d_2d(&mut self) -> (f32, Vec2) {
+        let d = self.dimension;
+        self.dimension = d.wrapping_add(3);
+        if D::SHUFFLED {
+            return (self.sample_1d(d), self.sample_2d(d.wrapping_add(1)));
+        }
+        let [c0, _] = D::sobol_dimensions(d);
+        let [c1, c2] = D::sobol_dimensions(d.wrapping_add(1));
+        let [r0, r1, r2] = sobol_reversed_columns(self.index, [c0, c1, c2]);
+        let (s0, [s1, s2]) = if R::SEEDED {
+            (
+                self.scramble_seeds(d)[0],
+                self.scramble_seeds(d.wrapping_add(1)),
+            )
+        } else {
+            (0, [0, 0])
+        };
+        let u = reversed_to_unit_f32(R::apply(r0, s0));
+        let v = reversed_pair_to_unit_f32([R::apply(r1, s1), R::apply(r2, s2)]);
+        (u, Vec2::from(v))
     }
 
     fn get_pixel_2d(&mut self) -> Vec2 {
