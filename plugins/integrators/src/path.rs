@@ -138,13 +138,13 @@ impl Integrator for PathIntegrator {
                 radiance += beta
                     * self
                         .estimator
-                        .sample_lights(&plan, &hit, wo, scene, sampler, stats);
+                        .sample_lights(&plan, hit, wo, scene, sampler, stats);
             }
             if plan.extra_bsdf_samples > 0 {
                 radiance += beta
                     * self
                         .estimator
-                        .extra_bsdf_samples(&plan, &hit, wo, scene, sampler, stats);
+                        .extra_bsdf_samples(&plan, hit, wo, scene, sampler, stats);
             }
 
             let bsdf_ctx = BsdfContext {
