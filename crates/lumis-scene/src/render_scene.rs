@@ -233,7 +233,10 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Vec3, Vec2) {
     let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
     let p = q0 + q1 + q2;
     let p_error = gamma(7) * (q0.abs() + q1.abs() + q2.abs());
-    let n = (p1 - p0).cross(p2 - p0).normalize() * mesh.orientation;
+    // Embree's geometric normal is (p1 - p0) x (p2 - p0), unnormalised, in
+    // the mesh's own space (counter-clockwise = front, as here); reusing it
+    // saves recomputing the cross product.
+    let n = Vec3::from(hit.ng).normalize() * mesh.orientation;
     let ns = match &mesh.normals {
         Some(ns) => {
             let [n0, n1, n2] = tri.map(|i| ns[i as usize]);
