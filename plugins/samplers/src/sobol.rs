@@ -156,6 +156,11 @@ impl DimensionMapping for Padded {
 /// Generic over the randomisation and the dimension mapping so each of the
 /// six combinations compiles to its own straight-line code;
 /// [`SobolSampler::boxed`] picks one at run time.
+/// Request dimensions whose seed hashes a pixel caches: one bit each in a
+/// `u64`, enough for the camera and seven vertices of a path tracer's
+/// requests.
+const SEED_CACHE: usize = 64;
+
 #[derive(Debug, Clone)]
 pub struct SobolSampler<R = Owen, D = SobolOrder> {
     spp: u32,
@@ -163,6 +168,13 @@ pub struct SobolSampler<R = Owen, D = SobolOrder> {
     keyed: Option<(UVec2, u64)>,
     /// The pixel's key, hashed with each request's dimension into its seeds.
     key: u64,
+    /// The seed hashes of this pixel's first [`SEED_CACHE`] request
+    /// dimensions, valid where `cached` has the dimension's bit: a pixel's
+    /// samples are drawn one after another and share their seeds, so at
+    /// 64 spp each is hashed once instead of 64 times, and a new pixel costs
+    /// one store to invalidate.
+    seed_hashes: [u64; SEED_CACHE],
+    cached: u64,
     index: u32,
     dimension: u32,
     strategy: PhantomData<(R, D)>,
@@ -174,6 +186,8 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
             spp,
             keyed: None,
             key: 0,
+            seed_hashes: [0; SEED_CACHE],
+            cached: 0,
             index: 0,
             dimension: 0,
             strategy: PhantomData,
@@ -183,13 +197,27 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     /// The scramble seeds of the two components of the request starting at
     /// sampler dimension `start` (a 1D request uses the first): the halves of
     /// one 64-bit hash of (pixel key, start), as pbrt-v4's
-    /// `PaddedSobolSampler::Get2D` does. Hashed on every call: one hash costs
-    /// less than filling and reading a per-pixel cache of seeds (measured on
-    /// the Cornell box at 4 spp).
+    /// `PaddedSobolSampler::Get2D` does, cached for the pixel's later samples.
     #[inline(always)]
-    fn scramble_seeds(&self, start: u32) -> [u32; 2] {
-        let h = hash_with(self.key, start as u64);
+    fn scramble_seeds(&mut self, start: u32) -> [u32; 2] {
+        let h = if start < SEED_CACHE as u32 && self.cached >> start & 1 != 0 {
+            self.seed_hashes[start as usize]
+        } else {
+            self.hash_seeds(start)
+        };
         [h as u32, (h >> 32) as u32]
+    }
+
+    /// The first sample of a pixel to reach a dimension hashes its seeds.
+    #[cold]
+    #[inline(never)]
+    fn hash_seeds(&mut self, start: u32) -> u64 {
+        let h = hash_with(self.key, start as u64);
+        if start < SEED_CACHE as u32 {
+            self.seed_hashes[start as usize] = h;
+            self.cached |= 1 << start;
+        }
+        h
     }
 
     /// The seed of the sample-index shuffle of a (padded) request: counters
@@ -212,7 +240,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     }
 
     #[inline(always)]
-    fn sample_1d(&self, start: u32) -> f32 {
+    fn sample_1d(&mut self, start: u32) -> f32 {
         let [dim, _] = D::sobol_dimensions(start);
         let reversed = sobol_reversed_u32(self.index_for(start), dim);
         let seed = if R::SEEDED {
@@ -226,7 +254,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     /// Both components of a 2D request: one pass over the index bits, one
     /// 64-bit bit reversal.
     #[inline(always)]
-    fn sample_2d(&self, start: u32) -> Vec2 {
+    fn sample_2d(&mut self, start: u32) -> Vec2 {
         let [r0, r1] = sobol_reversed_pair(self.index_for(start), D::sobol_dimensions(start));
         let [s0, s1] = if R::SEEDED {
             self.scramble_seeds(start)
@@ -280,6 +308,7 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         if self.keyed != Some((pixel, seed)) {
             self.keyed = Some((pixel, seed));
             self.key = pixel_key(pixel.x, pixel.y, seed);
+            self.cached = 0;
         }
         self.index = index;
         self.dimension = 2;
