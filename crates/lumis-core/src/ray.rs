@@ -59,8 +59,8 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
 /// Every component of `po` moved one ulp toward the sign of the matching
 /// component of `offset` by [`step_bits`], or `None` when a component of
 /// `po` is zero, infinite or NaN (their step is not an integer increment).
-/// On x86-64 the three lanes go through SSE2 at once: the offset runs three
-/// times per path vertex, and this is its whole cost.
+/// On x86-64 the three lanes go through SSE2 at once (a path vertex offsets
+/// three ray ends), with `safe_arch`'s safe wrappers of the intrinsics.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn step_away_fast(po: Vec3, offset: Vec3) -> Option<Vec3> {
