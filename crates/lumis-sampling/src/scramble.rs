@@ -38,13 +38,7 @@ pub fn laine_karras_permutation(mut x: u32, seed: u32) -> u32 {
 /// `[0,1)`.
 #[inline]
 pub fn owen_scramble(x: u32, seed: u32) -> u32 {
-    owen_scramble_reversed(x.reverse_bits(), seed)
-}
-
-/// [`owen_scramble`] of the value whose bit-reversal is `reversed`.
-#[inline]
-pub fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
-    laine_karras_permutation(reversed, seed).reverse_bits()
+    laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
 }
 
 /// A 32-bit fixed-point fraction as an `f32` in `[0, 1)`: the top 24 bits,

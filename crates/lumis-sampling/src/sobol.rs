@@ -15,7 +15,7 @@ pub fn sobol_u32(index: u32, dim: usize) -> u32 {
 }
 
 /// [`sobol_u32`] with its bits reversed (first digit in bit 0), the form
-/// [`crate::scramble::owen_scramble_reversed`] takes.
+/// [`crate::scramble::laine_karras_permutation`] takes.
 #[inline]
 pub fn sobol_reversed_u32(mut index: u32, dim: usize) -> u32 {
     let columns = &SOBOL_MATRICES_REVERSED[dim];
@@ -43,12 +43,6 @@ pub fn sobol_reversed_columns<const N: usize>(mut index: u32, dims: [usize; N]) 
         index &= index - 1;
     }
     x
-}
-
-/// [`sobol_reversed_columns`] of two dimensions.
-#[inline]
-pub fn sobol_reversed_pair(index: u32, dims: [usize; 2]) -> [u32; 2] {
-    sobol_reversed_columns(index, dims)
 }
 
 #[cfg(test)]
@@ -133,7 +127,7 @@ mod tests {
         for index in [0u32, 1, 2, 3, 63, 64, 1000, u32::MAX] {
             for dims in [[0, 1], [2, 3], [7, 1023], [500, 500]] {
                 assert_eq!(
-                    sobol_reversed_pair(index, dims),
+                    sobol_reversed_columns(index, dims),
                     dims.map(|d| sobol_reversed_u32(index, d)),
                     "index {index} dims {dims:?}"
                 );

@@ -8,7 +8,7 @@ use lumis_core::{
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_pair_to_unit_f32,
-    reversed_to_unit_f32, sobol_reversed_columns, sobol_reversed_pair, sobol_reversed_u32,
+    reversed_to_unit_f32, sobol_reversed_columns, sobol_reversed_u32, xor_scramble,
     SOBOL_DIMENSIONS,
 };
 
@@ -92,7 +92,7 @@ impl Randomization for Xor {
 
     #[inline(always)]
     fn apply(reversed: u32, seed: u32) -> u32 {
-        reversed ^ seed
+        xor_scramble(reversed, seed)
     }
 }
 
@@ -146,6 +146,11 @@ impl DimensionMapping for Padded {
     }
 }
 
+/// Request dimensions whose seed hashes a pixel caches: one bit each in a
+/// `u64`, enough for the camera and seven vertices of a path tracer's
+/// requests.
+const SEED_CACHE: usize = 64;
+
 /// Sobol' sampling in the style of pbrt-v4's `PaddedSobolSampler` and
 /// `SobolSampler`, per pixel: sample `i` of a pixel is Sobol' point `i`, each
 /// dimension scrambled with a seed from (pixel, dimension, seed). Owen
@@ -156,11 +161,6 @@ impl DimensionMapping for Padded {
 /// Generic over the randomisation and the dimension mapping so each of the
 /// six combinations compiles to its own straight-line code;
 /// [`SobolSampler::boxed`] picks one at run time.
-/// Request dimensions whose seed hashes a pixel caches: one bit each in a
-/// `u64`, enough for the camera and seven vertices of a path tracer's
-/// requests.
-const SEED_CACHE: usize = 64;
-
 #[derive(Debug, Clone)]
 pub struct SobolSampler<R = Owen, D = SobolOrder> {
     spp: u32,
@@ -198,8 +198,12 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     /// sampler dimension `start` (a 1D request uses the first): the halves of
     /// one 64-bit hash of (pixel key, start), as pbrt-v4's
     /// `PaddedSobolSampler::Get2D` does, cached for the pixel's later samples.
+    /// Zero, and never hashed, for a randomisation that takes no seed.
     #[inline(always)]
     fn scramble_seeds(&mut self, start: u32) -> [u32; 2] {
+        if !R::SEEDED {
+            return [0, 0];
+        }
         let h = if start < SEED_CACHE as u32 && self.cached >> start & 1 != 0 {
             self.seed_hashes[start as usize]
         } else {
@@ -243,11 +247,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     fn sample_1d(&mut self, start: u32) -> f32 {
         let [dim, _] = D::sobol_dimensions(start);
         let reversed = sobol_reversed_u32(self.index_for(start), dim);
-        let seed = if R::SEEDED {
-            self.scramble_seeds(start)[0]
-        } else {
-            0
-        };
+        let [seed, _] = self.scramble_seeds(start);
         reversed_to_unit_f32(R::apply(reversed, seed))
     }
 
@@ -255,12 +255,8 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     /// 64-bit bit reversal.
     #[inline(always)]
     fn sample_2d(&mut self, start: u32) -> Vec2 {
-        let [r0, r1] = sobol_reversed_pair(self.index_for(start), D::sobol_dimensions(start));
-        let [s0, s1] = if R::SEEDED {
-            self.scramble_seeds(start)
-        } else {
-            [0, 0]
-        };
+        let [r0, r1] = sobol_reversed_columns(self.index_for(start), D::sobol_dimensions(start));
+        let [s0, s1] = self.scramble_seeds(start);
         Vec2::from(reversed_pair_to_unit_f32([
             R::apply(r0, s0),
             R::apply(r1, s1),
@@ -338,14 +334,8 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         let [c0, _] = D::sobol_dimensions(d);
         let [c1, c2] = D::sobol_dimensions(d.wrapping_add(1));
         let [r0, r1, r2] = sobol_reversed_columns(self.index, [c0, c1, c2]);
-        let (s0, [s1, s2]) = if R::SEEDED {
-            (
-                self.scramble_seeds(d)[0],
-                self.scramble_seeds(d.wrapping_add(1)),
-            )
-        } else {
-            (0, [0, 0])
-        };
+        let [s0, _] = self.scramble_seeds(d);
+        let [s1, s2] = self.scramble_seeds(d.wrapping_add(1));
         let u = reversed_to_unit_f32(R::apply(r0, s0));
         let v = reversed_pair_to_unit_f32([R::apply(r1, s1), R::apply(r2, s2)]);
         (u, Vec2::from(v))
