@@ -16,6 +16,17 @@ fn mirrored(v: Vec3) -> Vec3 {
     Vec3::new(v.x, v.y, -v.z)
 }
 
+/// `(wo, wi)` as the inner BSDF sees them: mirrored to the front for a hit
+/// from behind.
+#[inline]
+fn to_front(wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+    if wo.z < 0.0 {
+        (mirrored(wo), mirrored(wi))
+    } else {
+        (wo, wi)
+    }
+}
+
 impl Bsdf for TwoSided {
     fn flags(&self) -> BsdfFlags {
         self.inner.flags()
@@ -23,11 +34,8 @@ impl Bsdf for TwoSided {
 
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z < 0.0 {
-            self.inner.f(ctx, mirrored(wo), mirrored(wi))
-        } else {
-            self.inner.f(ctx, wo, wi)
-        }
+        let (wo, wi) = to_front(wo, wi);
+        self.inner.f(ctx, wo, wi)
     }
 
     #[inline]
@@ -42,21 +50,15 @@ impl Bsdf for TwoSided {
 
     #[inline]
     fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z < 0.0 {
-            self.inner.pdf(ctx, mirrored(wo), mirrored(wi))
-        } else {
-            self.inner.pdf(ctx, wo, wi)
-        }
+        let (wo, wi) = to_front(wo, wi);
+        self.inner.pdf(ctx, wo, wi)
     }
 
     /// Mirrored once for both values, through the inner model's own `eval`.
     #[inline]
     fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        if wo.z < 0.0 {
-            self.inner.eval(ctx, mirrored(wo), mirrored(wi))
-        } else {
-            self.inner.eval(ctx, wo, wi)
-        }
+        let (wo, wi) = to_front(wo, wi);
+        self.inner.eval(ctx, wo, wi)
     }
 
     fn takes_albedo_scale(&self) -> bool {
