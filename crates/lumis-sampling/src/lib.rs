@@ -31,7 +31,9 @@ pub use scramble::{
     fixed_to_unit_f32, laine_karras_permutation, owen_scramble, reverse_bits_pair,
     reverse_bits_top24, reversed_pair_to_unit_f32, reversed_to_unit_f32, xor_scramble,
 };
-pub use sobol::{sobol_reversed_columns, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS};
+pub use sobol::{
+    sobol_reversed_columns, sobol_reversed_run, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS,
+};
 pub use spherical_rectangle::SphericalRectangle;
 pub use spherical_triangle::{
     SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,

@@ -5,6 +5,41 @@ include!(concat!(env!("OUT_DIR"), "/sobol_matrices.rs"));
 /// Dimensions with their own generator matrix.
 pub const SOBOL_DIMENSIONS: usize = 1024;
 
+/// Points and dimensions of [`SOBOL_PREFIX_REVERSED`]: the first 256 points
+/// (every pixel's samples up to 256 spp) in the first 64 dimensions (a
+/// camera sample and seven path vertices of a path tracer's requests).
+pub const SOBOL_PREFIX_POINTS: usize = 256;
+pub const SOBOL_PREFIX_DIMENSIONS: usize = 64;
+
+/// [`sobol_reversed_u32`] of the first points and dimensions, evaluated at
+/// compile time (64 KiB). Every pixel draws the same unscrambled points,
+/// only their scrambles differ, so a per-pixel sampler reads a coordinate
+/// here instead of running the matrix product per request; at 64 spp the
+/// rows in use fit in 16 KiB.
+pub static SOBOL_PREFIX_REVERSED: [[u32; SOBOL_PREFIX_DIMENSIONS]; SOBOL_PREFIX_POINTS] = {
+    let mut table = [[0; SOBOL_PREFIX_DIMENSIONS]; SOBOL_PREFIX_POINTS];
+    let mut index = 0;
+    while index < SOBOL_PREFIX_POINTS {
+        let mut dim = 0;
+        while dim < SOBOL_PREFIX_DIMENSIONS {
+            let mut bits = index;
+            let mut bit = 0;
+            let mut x = 0;
+            while bits != 0 {
+                if bits & 1 != 0 {
+                    x ^= SOBOL_MATRICES_REVERSED[dim][bit];
+                }
+                bits >>= 1;
+                bit += 1;
+            }
+            table[index][dim] = x;
+            dim += 1;
+        }
+        index += 1;
+    }
+    table
+};
+
 /// Coordinate `dim` of Sobol' point `index` as a 32-bit fixed-point
 /// fraction: the XOR of the matrix columns selected by the set bits of the
 /// index (a matrix-vector product over GF(2)). Dimensions 0 and 1 together
@@ -43,6 +78,22 @@ pub fn sobol_reversed_columns<const N: usize>(mut index: u32, dims: [usize; N]) 
         index &= index - 1;
     }
     x
+}
+
+/// [`sobol_reversed_columns`] of the `N` consecutive dimensions from
+/// `first` (wrapping past the last dimension to the first): a table read for
+/// the points and dimensions of [`SOBOL_PREFIX_REVERSED`], the matrix
+/// product beyond.
+#[inline]
+pub fn sobol_reversed_run<const N: usize>(index: u32, first: usize) -> [u32; N] {
+    if (index as usize) < SOBOL_PREFIX_POINTS && first + N <= SOBOL_PREFIX_DIMENSIONS {
+        let row = &SOBOL_PREFIX_REVERSED[index as usize];
+        return std::array::from_fn(|k| row[first + k]);
+    }
+    sobol_reversed_columns(
+        index,
+        std::array::from_fn(|k| (first + k) % SOBOL_DIMENSIONS),
+    )
 }
 
 #[cfg(test)]
@@ -118,6 +169,46 @@ mod tests {
                 let cell = (sobol_u32(i, dim) >> (32 - m)) as usize;
                 assert!(!seen[cell], "dim {dim}");
                 seen[cell] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn the_prefix_table_and_runs_match_the_matrix_product() {
+        for (index, row) in SOBOL_PREFIX_REVERSED.iter().enumerate() {
+            for (dim, &x) in row.iter().enumerate() {
+                assert_eq!(
+                    x,
+                    sobol_reversed_u32(index as u32, dim),
+                    "index {index} dim {dim}"
+                );
+            }
+        }
+        // Inside the table, across its edges (index 256, dimension 64) and
+        // wrapping past the last dimension.
+        for index in [0u32, 1, 63, 255, 256, 1000, u32::MAX] {
+            for first in [
+                0,
+                2,
+                61,
+                62,
+                63,
+                64,
+                500,
+                SOBOL_DIMENSIONS - 2,
+                SOBOL_DIMENSIONS - 1,
+            ] {
+                let expect = |k: usize| sobol_reversed_u32(index, (first + k) % SOBOL_DIMENSIONS);
+                assert_eq!(sobol_reversed_run::<1>(index, first), [expect(0)]);
+                assert_eq!(
+                    sobol_reversed_run::<2>(index, first),
+                    [expect(0), expect(1)]
+                );
+                assert_eq!(
+                    sobol_reversed_run::<3>(index, first),
+                    [expect(0), expect(1), expect(2)],
+                    "index {index} first {first}"
+                );
             }
         }
     }

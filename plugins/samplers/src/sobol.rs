@@ -8,8 +8,7 @@ use lumis_core::{
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_pair_to_unit_f32,
-    reversed_to_unit_f32, sobol_reversed_columns, sobol_reversed_u32, xor_scramble,
-    SOBOL_DIMENSIONS,
+    reversed_to_unit_f32, sobol_reversed_run, xor_scramble, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -115,12 +114,15 @@ pub trait DimensionMapping: fmt::Debug + Clone + Send + Sync + 'static {
     /// Whether requests past the film plane shuffle the sample index.
     const SHUFFLED: bool;
 
-    /// The Sobol' dimensions of the two components of a request that starts
-    /// at sampler dimension `start` (a 1D request uses the first).
-    fn sobol_dimensions(start: u32) -> [usize; 2];
+    /// The unscrambled, bit-reversed Sobol' coordinates of point `index`
+    /// for the `N` components of a request that starts at sampler dimension
+    /// `start` (a 1D request takes one, a 2D request two).
+    fn reversed_coordinates<const N: usize>(index: u32, start: u32) -> [u32; N];
 }
 
-/// [`Dimensions::Sobol`].
+/// [`Dimensions::Sobol`]: consecutive sampler dimensions are consecutive
+/// Sobol' dimensions, so a 1D request and the 2D request after it are three
+/// consecutive coordinates of one point.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct SobolOrder;
 
@@ -128,8 +130,8 @@ impl DimensionMapping for SobolOrder {
     const SHUFFLED: bool = false;
 
     #[inline(always)]
-    fn sobol_dimensions(start: u32) -> [usize; 2] {
-        [start, start.wrapping_add(1)].map(|d| d as usize % SOBOL_DIMENSIONS)
+    fn reversed_coordinates<const N: usize>(index: u32, start: u32) -> [u32; N] {
+        sobol_reversed_run(index, start as usize % SOBOL_DIMENSIONS)
     }
 }
 
@@ -141,8 +143,8 @@ impl DimensionMapping for Padded {
     const SHUFFLED: bool = true;
 
     #[inline(always)]
-    fn sobol_dimensions(_start: u32) -> [usize; 2] {
-        [0, 1]
+    fn reversed_coordinates<const N: usize>(index: u32, _start: u32) -> [u32; N] {
+        sobol_reversed_run(index, 0)
     }
 }
 
@@ -245,17 +247,16 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
 
     #[inline(always)]
     fn sample_1d(&mut self, start: u32) -> f32 {
-        let [dim, _] = D::sobol_dimensions(start);
-        let reversed = sobol_reversed_u32(self.index_for(start), dim);
+        let [reversed] = D::reversed_coordinates(self.index_for(start), start);
         let [seed, _] = self.scramble_seeds(start);
         reversed_to_unit_f32(R::apply(reversed, seed))
     }
 
-    /// Both components of a 2D request: one pass over the index bits, one
-    /// 64-bit bit reversal.
+    /// Both components of a 2D request: one pass over the index bits (or
+    /// one table row), one 64-bit bit reversal.
     #[inline(always)]
     fn sample_2d(&mut self, start: u32) -> Vec2 {
-        let [r0, r1] = sobol_reversed_columns(self.index_for(start), D::sobol_dimensions(start));
+        let [r0, r1] = D::reversed_coordinates(self.index_for(start), start);
         let [s0, s1] = self.scramble_seeds(start);
         Vec2::from(reversed_pair_to_unit_f32([
             R::apply(r0, s0),
@@ -322,18 +323,17 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         self.sample_2d(d)
     }
 
-    /// In Sobol' order the three dimensions share the sample index: one
-    /// pass over its bits. Padded requests each shuffle the index their own
-    /// way, so they stay two requests.
+    /// In Sobol' order the three dimensions are consecutive coordinates of
+    /// one point: one table row, or one pass over the index bits. Padded
+    /// requests each shuffle the index their own way, so they stay two
+    /// requests.
     fn get_1d_2d(&mut self) -> (f32, Vec2) {
         let d = self.dimension;
         self.dimension = d.wrapping_add(3);
         if D::SHUFFLED {
             return (self.sample_1d(d), self.sample_2d(d.wrapping_add(1)));
         }
-        let [c0, _] = D::sobol_dimensions(d);
-        let [c1, c2] = D::sobol_dimensions(d.wrapping_add(1));
-        let [r0, r1, r2] = sobol_reversed_columns(self.index, [c0, c1, c2]);
+        let [r0, r1, r2] = D::reversed_coordinates(self.index, d);
         let [s0, _] = self.scramble_seeds(d);
         let [s1, s2] = self.scramble_seeds(d.wrapping_add(1));
         let u = reversed_to_unit_f32(R::apply(r0, s0));
