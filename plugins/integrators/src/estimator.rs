@@ -25,8 +25,8 @@
 
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    Light, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params, Ray,
-    RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
+    Light, LightIndex, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params,
+    Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -172,18 +172,63 @@ pub struct Estimator {
     pub n_f: u32,
     pub n_g: u32,
     pub mode: MisEstimator,
+    /// The plans [`Estimator::plan`] hands out, worked out once from the
+    /// settings above rather than per vertex: the plan, or for the
+    /// one-sample estimator its light and its BSDF plan.
+    plans: [VertexPlan; 2],
+    /// The one-sample estimator's probability `c_g` of the light strategy.
+    light_choice: Option<f32>,
 }
 
 impl Estimator {
     /// One sample of each strategy per vertex: what the path tracer did
     /// before sample counts existed.
     pub fn new(strategy: Strategy, heuristic: Heuristic) -> Self {
+        Self::with_counts(strategy, heuristic, 1, 1, MisEstimator::MultiSample)
+    }
+
+    /// `n_f` BSDF and `n_g` light samples per vertex (both at least 1),
+    /// combined by `mode` when the strategy is MIS.
+    pub fn with_counts(
+        strategy: Strategy,
+        heuristic: Heuristic,
+        n_f: u32,
+        n_g: u32,
+        mode: MisEstimator,
+    ) -> Self {
+        assert!(n_f >= 1 && n_g >= 1, "sample counts start at 1");
+        let (inv_f, inv_g) = (1.0 / n_f as f32, 1.0 / n_g as f32);
+        let plan = |light_samples, extra_bsdf_samples, light_scale, bsdf_scale| VertexPlan {
+            light_samples,
+            extra_bsdf_samples,
+            light_scale,
+            bsdf_scale,
+        };
+        let (plans, light_choice) = match (strategy, mode) {
+            (Strategy::Bsdf, _) => ([plan(0, n_f - 1, 0.0, inv_f); 2], None),
+            (Strategy::Light, _) => ([plan(n_g, 0, inv_g, 0.0); 2], None),
+            (Strategy::Mis, MisEstimator::MultiSample) => {
+                ([plan(n_g, n_f - 1, inv_g, inv_f); 2], None)
+            }
+            (Strategy::Mis, MisEstimator::OneSample) => {
+                let c_g = n_g as f32 / (n_f + n_g) as f32;
+                (
+                    [
+                        plan(1, 0, 1.0 / c_g, 0.0),
+                        plan(0, 0, 0.0, 1.0 / (1.0 - c_g)),
+                    ],
+                    Some(c_g),
+                )
+            }
+        };
         Self {
             strategy,
             heuristic,
-            n_f: 1,
-            n_g: 1,
-            mode: MisEstimator::MultiSample,
+            n_f,
+            n_g,
+            mode,
+            plans,
+            light_choice,
         }
     }
 
@@ -211,56 +256,18 @@ impl Estimator {
             "one-sample" => MisEstimator::OneSample,
             _ => MisEstimator::MultiSample,
         };
-        Ok(Self {
-            strategy,
-            heuristic,
-            n_f: n_f as u32,
-            n_g: n_g as u32,
-            mode,
-        })
+        Ok(Self::with_counts(
+            strategy, heuristic, n_f as u32, n_g as u32, mode,
+        ))
     }
 
     /// The plan at a vertex whose BSDF has a non-specular component; the
     /// one-sample estimator draws its choice from `sampler` (only then).
+    #[inline]
     pub fn plan(&self, sampler: &mut dyn Sampler) -> VertexPlan {
-        let (n_f, n_g) = (self.n_f, self.n_g);
-        match (self.strategy, self.mode) {
-            (Strategy::Bsdf, _) => VertexPlan {
-                light_samples: 0,
-                extra_bsdf_samples: n_f - 1,
-                light_scale: 0.0,
-                bsdf_scale: 1.0 / n_f as f32,
-            },
-            (Strategy::Light, _) => VertexPlan {
-                light_samples: n_g,
-                extra_bsdf_samples: 0,
-                light_scale: 1.0 / n_g as f32,
-                bsdf_scale: 0.0,
-            },
-            (Strategy::Mis, MisEstimator::MultiSample) => VertexPlan {
-                light_samples: n_g,
-                extra_bsdf_samples: n_f - 1,
-                light_scale: 1.0 / n_g as f32,
-                bsdf_scale: 1.0 / n_f as f32,
-            },
-            (Strategy::Mis, MisEstimator::OneSample) => {
-                let c_g = n_g as f32 / (n_f + n_g) as f32;
-                if sampler.get_1d() < c_g {
-                    VertexPlan {
-                        light_samples: 1,
-                        extra_bsdf_samples: 0,
-                        light_scale: 1.0 / c_g,
-                        bsdf_scale: 0.0,
-                    }
-                } else {
-                    VertexPlan {
-                        light_samples: 0,
-                        extra_bsdf_samples: 0,
-                        light_scale: 0.0,
-                        bsdf_scale: 1.0 / (1.0 - c_g),
-                    }
-                }
-            }
+        match self.light_choice {
+            Some(c_g) if sampler.get_1d() >= c_g => self.plans[1],
+            _ => self.plans[0],
         }
     }
 
@@ -416,7 +423,7 @@ impl Estimator {
         let mut sum = Rgb::BLACK;
         match scene.intersect(ray) {
             Some(hit) => {
-                if let Some(emitter) = hit.light {
+                if let Some(emitter) = hit.light.map(LightIndex::get) {
                     let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                     if !le.is_black() {
                         let w = self.bsdf_weight(scene, emitter, prev, ray.d, p_bsdf, specular);
