@@ -86,7 +86,7 @@ fn down(scene: &LoadedScene, x: f32, y: f32) -> Option<(Vec3, Vec3, Vec3)> {
     scene
         .scene
         .intersect(&ray)
-        .map(|h| (h.p(), h.n(), h.shading.z))
+        .map(|h| (h.p(), h.n(), h.shading.normal()))
 }
 
 fn close(a: Vec3, b: Vec3) -> bool {
@@ -1110,7 +1110,7 @@ fn emissive_instances_get_their_own_world_space_lights() {
             .scene
             .intersect(&Ray::new(Vec3::new(x, 0.25, 10.0), Vec3::NEG_Z))
             .expect("panel");
-        let index = hit.light.expect("the panel emits");
+        let index = hit.light.expect("the panel emits").get();
         let light = &scene.scene.lights()[index as usize];
         // The light is the triangle of this instance, in world space: its
         // radiance is seen from the front, at this point.
@@ -1341,7 +1341,7 @@ fn emissive_textures_modulate_the_triangle_lights() {
             .scene
             .intersect(&Ray::new(Vec3::new(x, y, 10.0), Vec3::NEG_Z))
             .unwrap();
-        let light = &scene.scene.lights()[hit.light.expect("emissive") as usize];
+        let light = &scene.scene.lights()[hit.light.expect("emissive").get() as usize];
         light.l(hit.p(), hit.n(), hit.uv, hit.wo).r
     };
     assert!(le_at(0.5, 0.5).abs() < 1e-6);

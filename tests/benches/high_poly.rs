@@ -212,7 +212,7 @@ fn child(scene_path: &Path) {
             let mut sum = 0.0f32;
             for ray in rays.iter() {
                 if let Some(h) = loaded.scene.intersect(ray) {
-                    sum += h.shading.z.x + h.p().y;
+                    sum += h.shading.normal().x + h.p().y;
                 }
             }
             std::hint::black_box(sum);

@@ -1,8 +1,10 @@
 //! What an integrator knows about a surface hit.
 
+use std::num::NonZeroU32;
+
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, BsdfFlags};
 use crate::math::Frame;
 use crate::ray::{Ray, SurfacePoint};
 
@@ -12,20 +14,39 @@ pub struct SurfaceInteraction<'a> {
     /// The hit point, its error bound and the unit geometric normal (on the
     /// front side of the surface as the shape defines it).
     pub point: SurfacePoint,
-    /// Ray parameter of the hit.
-    pub t: f32,
     /// Shading frame; `z` is the shading normal, on the same side as `point.n`.
     pub shading: Frame,
     pub uv: Vec2,
     /// Unit direction back along the incoming ray, in world space.
     pub wo: Vec3,
     pub bsdf: &'a dyn Bsdf,
+    /// `bsdf.flags()`, read once when the scene was built: every path vertex
+    /// asks whether it may sample lights, and the answer never changes.
+    pub bsdf_flags: BsdfFlags,
     /// The area light attached to the surface, as an index into
     /// [`crate::Scene::lights`] (the light sampler's pmf needs the index). An
-    /// index rather than a reference keeps the interaction within 128 bytes,
-    /// which the compiler copies inline instead of calling `memcpy` on every
-    /// hit.
-    pub light: Option<u32>,
+    /// index rather than a reference, and one with a niche, keeps the
+    /// interaction within 128 bytes, which the compiler copies inline
+    /// instead of calling `memcpy` on every hit.
+    pub light: Option<LightIndex>,
+}
+
+/// An index into [`crate::Scene::lights`], stored plus one so that
+/// `Option<LightIndex>` takes 4 bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LightIndex(NonZeroU32);
+
+impl LightIndex {
+    /// `index`, or `None` for `u32::MAX` (which has no successor).
+    #[inline]
+    pub fn new(index: u32) -> Option<Self> {
+        NonZeroU32::new(index.wrapping_add(1)).map(Self)
+    }
+
+    #[inline]
+    pub fn get(self) -> u32 {
+        self.0.get() - 1
+    }
 }
 
 impl SurfaceInteraction<'_> {
@@ -49,7 +70,7 @@ impl SurfaceInteraction<'_> {
     pub fn light_context(&self) -> LightSampleContext {
         LightSampleContext {
             point: self.point,
-            ns: self.shading.z,
+            ns: self.shading.normal(),
         }
     }
 }
@@ -80,3 +101,16 @@ impl LightSampleContext {
 // The integrators copy interactions by value on every hit: above 128 bytes
 // that copy becomes a call to `memcpy`.
 const _: () = assert!(std::mem::size_of::<Option<SurfaceInteraction>>() <= 128);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn light_indices_round_trip() {
+        for index in [0, 1, 7, u32::MAX - 1] {
+            assert_eq!(LightIndex::new(index).map(LightIndex::get), Some(index));
+        }
+        assert_eq!(LightIndex::new(u32::MAX), None);
+    }
+}

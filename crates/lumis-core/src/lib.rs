@@ -26,7 +26,7 @@ pub mod stats;
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
 pub use error::{Error, Location, Result};
 pub use integrator::Integrator;
-pub use interaction::{LightSampleContext, SurfaceInteraction};
+pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use light::{Light, LightKind, LightSample, LightShape};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;

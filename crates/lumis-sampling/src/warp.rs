@@ -14,9 +14,16 @@ use glam::{Vec2, Vec3};
 /// (so sine and cosine swap) in the top/bottom ones.
 #[inline]
 pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
+    concentric_disk_and_radius(u).0
+}
+
+/// [`square_to_concentric_disk`] and the radius of its point, which the map
+/// knows before the angle.
+#[inline(always)]
+fn concentric_disk_and_radius(u: Vec2) -> (Vec2, f32) {
     let o = 2.0 * u - Vec2::ONE;
     if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
+        return (Vec2::ZERO, 0.0);
     }
     // The wedge is a coin flip for every sample: selects, not branches, so
     // the processor has nothing to mispredict. In the top/bottom wedges
@@ -25,7 +32,7 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
     let (r, along) = if vertical { (o.y, o.x) } else { (o.x, o.y) };
     let (sin, cos) = sin_cos_quarter_turn(FRAC_PI_4 * (along / r));
     let (x, y) = if vertical { (sin, cos) } else { (cos, sin) };
-    r * Vec2::new(x, y)
+    (r * Vec2::new(x, y), r.abs())
 }
 
 /// `(sin x, cos x)` for `|x| <= pi/4`, the only angles the concentric map
@@ -54,8 +61,12 @@ pub fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
 /// disk up onto the hemisphere. Density `cos theta / pi`.
 #[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = square_to_concentric_disk(u);
-    let z = (1.0 - d.x * d.x - d.y * d.y).max(0.0).sqrt();
+    let (d, r) = concentric_disk_and_radius(u);
+    // From the radius rather than from |d|^2 (equal to within rounding):
+    // the square root then runs alongside the division and the sine and
+    // cosine instead of after them, off the chain of dependent latencies
+    // that every diffuse bounce waits on before its next ray.
+    let z = (1.0 - r * r).max(0.0).sqrt();
     Vec3::new(d.x, d.y, z)
 }
 

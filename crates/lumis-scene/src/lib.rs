@@ -27,7 +27,7 @@ use lumis_render::PerspectiveCamera;
 pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
 
-use render_scene::{Geometry, MeshData, Placement, Prototype, NO_LIGHT};
+use render_scene::{Geometry, MeshData, Placement, Prototype, SceneBsdf, NO_LIGHT};
 use report::Phase;
 use shapes::{ShapeDesc, ShapeGeometry, SHAPE_TYPES};
 
@@ -243,7 +243,7 @@ pub fn load_str(
         embree,
         geometries,
         prototypes,
-        bsdfs: bsdfs.into_iter().map(|(_, b)| b).collect(),
+        bsdfs: bsdfs.into_iter().map(|(_, b)| SceneBsdf::new(b)).collect(),
         lights,
         infinite_lights,
         light_sampler,

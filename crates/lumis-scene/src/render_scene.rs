@@ -5,7 +5,9 @@ use std::sync::Arc;
 use lumis_core::glam::Mat3;
 use lumis_core::math::{gamma, Frame};
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{Bsdf, Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3};
+use lumis_core::{
+    Bsdf, BsdfFlags, Light, LightIndex, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3,
+};
 use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID};
 
 pub use crate::report::LoadReport;
@@ -126,11 +128,25 @@ pub struct SceneCounts {
     pub unique_triangles: usize,
 }
 
+/// A BSDF of the scene with its flags, read once at load so that a hit
+/// hands them to the integrator without a virtual call per vertex.
+pub(crate) struct SceneBsdf {
+    pub(crate) bsdf: Arc<dyn Bsdf>,
+    pub(crate) flags: BsdfFlags,
+}
+
+impl SceneBsdf {
+    pub(crate) fn new(bsdf: Arc<dyn Bsdf>) -> Self {
+        let flags = bsdf.flags();
+        Self { bsdf, flags }
+    }
+}
+
 pub struct RenderScene {
     pub(crate) embree: lumis_embree::Scene,
     pub(crate) geometries: Vec<Geometry>,
     pub(crate) prototypes: Vec<Prototype>,
-    pub(crate) bsdfs: Vec<Arc<dyn Bsdf>>,
+    pub(crate) bsdfs: Vec<SceneBsdf>,
     pub(crate) lights: Vec<Box<dyn Light>>,
     pub(crate) infinite_lights: Vec<u32>,
     pub(crate) light_sampler: Box<dyn LightSampler>,
@@ -159,8 +175,12 @@ impl RenderScene {
     }
 
     #[inline]
-    fn light_ref(&self, index: u32) -> Option<u32> {
-        (index != NO_LIGHT).then_some(index)
+    fn light_ref(&self, index: u32) -> Option<LightIndex> {
+        if index == NO_LIGHT {
+            None
+        } else {
+            LightIndex::new(index)
+        }
     }
 }
 
@@ -208,11 +228,12 @@ impl RenderScene {
             .and_then(|&i| self.light_ref(i));
         SurfaceInteraction {
             point: SurfacePoint { p, p_error, n },
-            t: hit.t,
+
             shading: Frame::from_z(ns),
             uv,
             wo,
-            bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
+            bsdf: self.bsdfs[mesh.bsdf as usize].bsdf.as_ref(),
+            bsdf_flags: self.bsdfs[mesh.bsdf as usize].flags,
             light,
         }
     }
@@ -283,11 +304,12 @@ impl Scene for RenderScene {
                     .and_then(|&i| self.light_ref(i));
                 Some(SurfaceInteraction {
                     point,
-                    t: hit.t,
+
                     shading: Frame::from_z(ns),
                     uv,
                     wo,
-                    bsdf: self.bsdfs[mesh.bsdf as usize].as_ref(),
+                    bsdf: self.bsdfs[mesh.bsdf as usize].bsdf.as_ref(),
+                    bsdf_flags: self.bsdfs[mesh.bsdf as usize].flags,
                     light,
                 })
             }
@@ -314,11 +336,12 @@ impl Scene for RenderScene {
                 );
                 Some(SurfaceInteraction {
                     point: SurfacePoint { p, p_error, n },
-                    t: hit.t,
+
                     shading: Frame::from_z(n),
                     uv,
                     wo,
-                    bsdf: self.bsdfs[*bsdf as usize].as_ref(),
+                    bsdf: self.bsdfs[*bsdf as usize].bsdf.as_ref(),
+                    bsdf_flags: self.bsdfs[*bsdf as usize].flags,
                     light: light.and_then(|i| self.light_ref(i)),
                 })
             }

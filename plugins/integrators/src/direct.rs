@@ -7,8 +7,8 @@
 
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    Integrator, ParamSpec, Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler,
-    Scene, Vec3,
+    Integrator, LightIndex, ParamSpec, Params, PluginKind, PluginSpec, Ray, RenderStats, Result,
+    Rgb, Sampler, Scene, Vec3,
 };
 
 use crate::estimator::{self, Estimator, SceneView, VertexPlan};
@@ -60,12 +60,12 @@ impl Integrator for DirectIntegrator {
             }
             return le;
         };
-        let mut radiance = match hit.light {
+        let mut radiance = match hit.light.map(LightIndex::get) {
             Some(emitter) => scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo),
             None => Rgb::BLACK,
         };
         let wo = hit.shading.to_local(hit.wo);
-        let plan = if hit.bsdf.flags().is_non_specular() {
+        let plan = if hit.bsdf_flags.is_non_specular() {
             self.estimator.plan(sampler)
         } else {
             VertexPlan::UNWEIGHTED
