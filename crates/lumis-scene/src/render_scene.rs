@@ -174,6 +174,30 @@ impl RenderScene {
         bounding_sphere(&self.embree)
     }
 
+    /// The interaction at `point` with shading normal `ns` on a surface of
+    /// scene BSDF `bsdf`.
+    #[inline(always)]
+    fn interaction(
+        &self,
+        point: SurfacePoint,
+        ns: Vec3,
+        uv: Vec2,
+        wo: Vec3,
+        bsdf: u32,
+        light: Option<LightIndex>,
+    ) -> SurfaceInteraction<'_> {
+        let bsdf = &self.bsdfs[bsdf as usize];
+        SurfaceInteraction {
+            point,
+            shading: Frame::from_z(ns),
+            uv,
+            wo,
+            bsdf: bsdf.bsdf.as_ref(),
+            bsdf_flags: bsdf.flags,
+            light,
+        }
+    }
+
     #[inline]
     fn light_ref(&self, index: u32) -> Option<LightIndex> {
         if index == NO_LIGHT {
@@ -226,16 +250,7 @@ impl RenderScene {
             .get(hit.geom_id as usize)
             .and_then(|l| l.get(hit.prim_id as usize))
             .and_then(|&i| self.light_ref(i));
-        SurfaceInteraction {
-            point: SurfacePoint { p, p_error, n },
-
-            shading: Frame::from_z(ns),
-            uv,
-            wo,
-            bsdf: self.bsdfs[mesh.bsdf as usize].bsdf.as_ref(),
-            bsdf_flags: self.bsdfs[mesh.bsdf as usize].flags,
-            light,
-        }
+        self.interaction(SurfacePoint { p, p_error, n }, ns, uv, wo, mesh.bsdf, light)
     }
 }
 
@@ -302,16 +317,7 @@ impl Scene for RenderScene {
                     .lights
                     .get(hit.prim_id as usize)
                     .and_then(|&i| self.light_ref(i));
-                Some(SurfaceInteraction {
-                    point,
-
-                    shading: Frame::from_z(ns),
-                    uv,
-                    wo,
-                    bsdf: self.bsdfs[mesh.bsdf as usize].bsdf.as_ref(),
-                    bsdf_flags: self.bsdfs[mesh.bsdf as usize].flags,
-                    light,
-                })
+                Some(self.interaction(point, ns, uv, wo, mesh.bsdf, light))
             }
             Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
             Geometry::Sphere {
@@ -334,16 +340,14 @@ impl Scene for RenderScene {
                     (phi * 0.5 * std::f32::consts::FRAC_1_PI).rem_euclid(1.0),
                     outward.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
                 );
-                Some(SurfaceInteraction {
-                    point: SurfacePoint { p, p_error, n },
-
-                    shading: Frame::from_z(n),
+                Some(self.interaction(
+                    SurfacePoint { p, p_error, n },
+                    n,
                     uv,
                     wo,
-                    bsdf: self.bsdfs[*bsdf as usize].bsdf.as_ref(),
-                    bsdf_flags: self.bsdfs[*bsdf as usize].flags,
-                    light: light.and_then(|i| self.light_ref(i)),
-                })
+                    *bsdf,
+                    light.and_then(|i| self.light_ref(i)),
+                ))
             }
         }
     }
