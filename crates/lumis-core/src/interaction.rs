@@ -39,8 +39,11 @@ pub struct LightIndex(NonZeroU32);
 impl LightIndex {
     /// `index`, or `None` for `u32::MAX` (which has no successor).
     #[inline]
-    pub fn new(index: u32) -> Option<Self> {
-        NonZeroU32::new(index.wrapping_add(1)).map(Self)
+    pub const fn new(index: u32) -> Option<Self> {
+        match NonZeroU32::new(index.wrapping_add(1)) {
+            Some(plus_one) => Some(Self(plus_one)),
+            None => None,
+        }
     }
 
     #[inline]

@@ -12,8 +12,11 @@ use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID};
 
 pub use crate::report::LoadReport;
 
-/// Marks a triangle without an area light in [`MeshData::lights`].
+/// Marks a triangle without an area light in [`MeshData::lights`]: the one
+/// index [`LightIndex::new`] maps to `None`, so a hit converts either kind
+/// of entry with that one call.
 pub(crate) const NO_LIGHT: u32 = u32::MAX;
+const _: () = assert!(LightIndex::new(NO_LIGHT).is_none());
 
 /// A triangle mesh as shading sees it; its buffers are the ones Embree reads.
 pub(crate) struct MeshData {
@@ -197,15 +200,6 @@ impl RenderScene {
             light,
         }
     }
-
-    #[inline]
-    fn light_ref(&self, index: u32) -> Option<LightIndex> {
-        if index == NO_LIGHT {
-            None
-        } else {
-            LightIndex::new(index)
-        }
-    }
 }
 
 pub(crate) fn bounding_sphere(scene: &lumis_embree::Scene) -> (Vec3, f32) {
@@ -249,7 +243,7 @@ impl RenderScene {
         let light = lights
             .get(hit.geom_id as usize)
             .and_then(|l| l.get(hit.prim_id as usize))
-            .and_then(|&i| self.light_ref(i));
+            .and_then(|&i| LightIndex::new(i));
         self.interaction(SurfacePoint { p, p_error, n }, ns, uv, wo, mesh.bsdf, light)
     }
 }
@@ -316,7 +310,7 @@ impl Scene for RenderScene {
                 let light = mesh
                     .lights
                     .get(hit.prim_id as usize)
-                    .and_then(|&i| self.light_ref(i));
+                    .and_then(|&i| LightIndex::new(i));
                 Some(self.interaction(point, ns, uv, wo, mesh.bsdf, light))
             }
             Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
@@ -346,7 +340,7 @@ impl Scene for RenderScene {
                     uv,
                     wo,
                     *bsdf,
-                    light.and_then(|i| self.light_ref(i)),
+                    light.and_then(LightIndex::new),
                 ))
             }
         }

@@ -163,6 +163,19 @@ impl VertexPlan {
     };
 }
 
+/// What [`Estimator::plan`] answers: one plan for every vertex, or for the
+/// one-sample estimator a choice between its light and its BSDF plan, the
+/// light one with probability `c_g`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Plans {
+    Fixed(VertexPlan),
+    OneSample {
+        c_g: f32,
+        light: VertexPlan,
+        bsdf: VertexPlan,
+    },
+}
+
 /// Strategy, heuristic and sample counts: the whole direct-lighting
 /// estimator.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,11 +186,8 @@ pub struct Estimator {
     pub n_g: u32,
     pub mode: MisEstimator,
     /// The plans [`Estimator::plan`] hands out, worked out once from the
-    /// settings above rather than per vertex: the plan, or for the
-    /// one-sample estimator its light and its BSDF plan.
-    plans: [VertexPlan; 2],
-    /// The one-sample estimator's probability `c_g` of the light strategy.
-    light_choice: Option<f32>,
+    /// settings above rather than at every vertex.
+    plans: Plans,
 }
 
 impl Estimator {
@@ -204,21 +214,19 @@ impl Estimator {
             light_scale,
             bsdf_scale,
         };
-        let (plans, light_choice) = match (strategy, mode) {
-            (Strategy::Bsdf, _) => ([plan(0, n_f - 1, 0.0, inv_f); 2], None),
-            (Strategy::Light, _) => ([plan(n_g, 0, inv_g, 0.0); 2], None),
+        let plans = match (strategy, mode) {
+            (Strategy::Bsdf, _) => Plans::Fixed(plan(0, n_f - 1, 0.0, inv_f)),
+            (Strategy::Light, _) => Plans::Fixed(plan(n_g, 0, inv_g, 0.0)),
             (Strategy::Mis, MisEstimator::MultiSample) => {
-                ([plan(n_g, n_f - 1, inv_g, inv_f); 2], None)
+                Plans::Fixed(plan(n_g, n_f - 1, inv_g, inv_f))
             }
             (Strategy::Mis, MisEstimator::OneSample) => {
                 let c_g = n_g as f32 / (n_f + n_g) as f32;
-                (
-                    [
-                        plan(1, 0, 1.0 / c_g, 0.0),
-                        plan(0, 0, 0.0, 1.0 / (1.0 - c_g)),
-                    ],
-                    Some(c_g),
-                )
+                Plans::OneSample {
+                    c_g,
+                    light: plan(1, 0, 1.0 / c_g, 0.0),
+                    bsdf: plan(0, 0, 0.0, 1.0 / (1.0 - c_g)),
+                }
             }
         };
         Self {
@@ -228,7 +236,6 @@ impl Estimator {
             n_g,
             mode,
             plans,
-            light_choice,
         }
     }
 
@@ -265,9 +272,15 @@ impl Estimator {
     /// one-sample estimator draws its choice from `sampler` (only then).
     #[inline]
     pub fn plan(&self, sampler: &mut dyn Sampler) -> VertexPlan {
-        match self.light_choice {
-            Some(c_g) if sampler.get_1d() >= c_g => self.plans[1],
-            _ => self.plans[0],
+        match self.plans {
+            Plans::Fixed(plan) => plan,
+            Plans::OneSample { c_g, light, bsdf } => {
+                if sampler.get_1d() < c_g {
+                    light
+                } else {
+                    bsdf
+                }
+            }
         }
     }
 

@@ -78,10 +78,17 @@ impl Emission {
         })
     }
 
+    /// Whether a direction `w` with `n.dot(w) = n_dot_w` leaves from an
+    /// emitting side (`w` need not be unit length: only its side counts).
+    #[inline]
+    pub fn emits_toward(&self, n_dot_w: f32) -> bool {
+        self.two_sided || n_dot_w > 0.0
+    }
+
     /// Radiance leaving the surface with normal `n` in direction `w`.
     #[inline]
     pub fn radiance_toward(&self, n: Vec3, w: Vec3) -> Rgb {
-        if self.two_sided || n.dot(w) > 0.0 {
+        if self.emits_toward(n.dot(w)) {
             self.radiance
         } else {
             Rgb::BLACK
@@ -110,7 +117,7 @@ pub fn area_sample(
     // tested first: points behind a one-sided emitter (a sixth of the
     // Cornell box's light samples, from its ceiling) cost nothing more.
     let n_dot = point.n.dot(to_light);
-    if !(emission.two_sided || n_dot < 0.0) || emission.radiance.is_black() {
+    if !emission.emits_toward(-n_dot) || emission.radiance.is_black() {
         return None;
     }
     let dist2 = to_light.length_squared();
