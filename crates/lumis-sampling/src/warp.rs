@@ -120,6 +120,7 @@ pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Pcg32;
 
     /// The polynomial sine and cosine stay within 2 ulp of the correctly
     /// rounded values over the whole quarter-turn range, including its ends.
@@ -142,7 +143,6 @@ mod tests {
             assert!(ulp(c, xf.cos()) <= 2.0, "cos({xf}) = {c}, {}", xf.cos());
         }
     }
-    use crate::Pcg32;
 
     fn grid(n: usize) -> impl Iterator<Item = Vec2> {
         (0..n * n).map(move |i| {

@@ -95,7 +95,7 @@ impl Integrator for PathIntegrator {
         loop {
             stats.rays += 1;
             // Borrowed where `intersect` wrote it, not moved out of the
-            // Option: that move is a 120-byte copy per vertex.
+            // Option: that move is a 128-byte copy per vertex.
             let found = scene.intersect(&ray);
             let Some(hit) = &found else {
                 for &index in scene.infinite_lights {
