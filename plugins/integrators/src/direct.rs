@@ -71,9 +71,10 @@ impl Integrator for DirectIntegrator {
             VertexPlan::UNWEIGHTED
         };
         if plan.light_samples > 0 {
+            let u_light = sampler.get_1d_2d();
             radiance += self
                 .estimator
-                .sample_lights(&plan, &hit, wo, scene, sampler, stats);
+                .sample_lights(&plan, &hit, wo, scene, u_light, sampler, stats);
         }
         // The first BSDF sample, then the extra ones: all only look for
         // emission. A specular sample's emission is not weighted.

@@ -26,7 +26,7 @@
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
     Light, LightIndex, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params,
-    Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec3,
+    Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec2, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -320,24 +320,29 @@ impl Estimator {
     }
 
     /// Next-event estimation at `hit`: `plan.light_samples` lights chosen
-    /// by the light sampler, one point on each, weighted and scaled.
+    /// by the light sampler, one point on each, weighted and scaled. The
+    /// first sample's numbers `first` (light choice, point on the light)
+    /// are drawn by the caller, which may draw them before it knows the
+    /// hit; further samples draw theirs from `sampler`.
+    #[allow(clippy::too_many_arguments)]
     pub fn sample_lights(
         &self,
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
         wo: Vec3,
         scene: &SceneView,
+        first: (f32, Vec2),
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        let mut sum = self.sample_one_light(hit, wo, scene, first, stats);
         // One sample is the common case: without the loop around it the
         // compiler does not hoist (and spill) the whole interaction first.
         if plan.light_samples == 1 {
-            return self.sample_one_light(hit, wo, scene, sampler, stats) * plan.light_scale;
+            return sum * plan.light_scale;
         }
-        let mut sum = Rgb::BLACK;
-        for _ in 0..plan.light_samples {
-            sum += self.sample_one_light(hit, wo, scene, sampler, stats);
+        for _ in 1..plan.light_samples {
+            sum += self.sample_one_light(hit, wo, scene, sampler.get_1d_2d(), stats);
         }
         sum * plan.light_scale
     }
@@ -347,10 +352,9 @@ impl Estimator {
         hit: &SurfaceInteraction,
         wo: Vec3,
         scene: &SceneView,
-        sampler: &mut dyn Sampler,
+        (u_light, u): (f32, Vec2),
         stats: &mut RenderStats,
     ) -> Rgb {
-        let (u_light, u) = sampler.get_1d_2d();
         let ctx = hit.light_context();
         let Some(chosen) = scene.light_sampler.sample(&ctx, u_light) else {
             return Rgb::BLACK;

@@ -94,6 +94,11 @@ impl Integrator for PathIntegrator {
         let mut segments = 1;
         loop {
             stats.rays += 1;
+            // The continuation's and the light sample's numbers do not
+            // depend on the hit: drawn before the intersection, their
+            // latency overlaps it instead of delaying what follows it.
+            let (u1, u2) = sampler.get_1d_2d();
+            let u_light = sampler.get_1d_2d();
             // Borrowed where `intersect` wrote it, not moved out of the
             // Option: that move is a 128-byte copy per vertex.
             let found = scene.intersect(&ray);
@@ -144,13 +149,12 @@ impl Integrator for PathIntegrator {
                 uv: hit.uv,
                 ..Default::default()
             };
-            let (u1, u2) = sampler.get_1d_2d();
             let sampled = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2);
             if plan.light_samples > 0 {
                 radiance += beta
                     * self
                         .estimator
-                        .sample_lights(&plan, hit, wo, scene, sampler, stats);
+                        .sample_lights(&plan, hit, wo, scene, u_light, sampler, stats);
             }
             if plan.extra_bsdf_samples > 0 {
                 radiance += beta
