@@ -268,6 +268,12 @@ impl Estimator {
         ))
     }
 
+    /// Whether any vertex takes light samples.
+    #[inline]
+    pub fn samples_lights(&self) -> bool {
+        self.strategy != Strategy::Bsdf
+    }
+
     /// The plan at a vertex whose BSDF has a non-specular component; the
     /// one-sample estimator draws its choice from `sampler` (only then).
     #[inline]

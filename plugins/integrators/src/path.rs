@@ -5,7 +5,7 @@
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
     Integrator, LightIndex, LightSampleContext, ParamSpec, ParamType, Params, PluginKind,
-    PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, Vec3,
+    PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, Vec2, Vec3,
 };
 
 use crate::estimator::{self, Estimator, Heuristic, SceneView, Strategy, VertexPlan};
@@ -96,9 +96,15 @@ impl Integrator for PathIntegrator {
             stats.rays += 1;
             // The continuation's and the light sample's numbers do not
             // depend on the hit: drawn before the intersection, their
-            // latency overlaps it instead of delaying what follows it.
+            // latency overlaps it instead of delaying what follows it (the
+            // light sample's only where the estimator samples lights, so
+            // BSDF-only paths keep their dimensions).
             let (u1, u2) = sampler.get_1d_2d();
-            let u_light = sampler.get_1d_2d();
+            let u_light = if self.estimator.samples_lights() {
+                sampler.get_1d_2d()
+            } else {
+                (0.0, Vec2::ZERO)
+            };
             // Borrowed where `intersect` wrote it, not moved out of the
             // Option: that move is a 128-byte copy per vertex.
             let found = scene.intersect(&ray);
