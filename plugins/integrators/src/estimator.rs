@@ -341,12 +341,10 @@ impl Estimator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        // The first sample outside the loop: with the loop around every
+        // sample the compiler hoisted (and spilled) the whole interaction
+        // before it.
         let mut sum = self.sample_one_light(hit, wo, scene, first, stats);
-        // One sample is the common case: without the loop around it the
-        // compiler does not hoist (and spill) the whole interaction first.
-        if plan.light_samples == 1 {
-            return sum * plan.light_scale;
-        }
         for _ in 1..plan.light_samples {
             sum += self.sample_one_light(hit, wo, scene, sampler.get_1d_2d(), stats);
         }
