@@ -4,7 +4,8 @@
 
 use embree4_sys as sys;
 
-use crate::scene::{empty_hit, raw_ray, Ray, Scene};
+use crate::record::{raw_ray, RayHit};
+use crate::scene::{Ray, Scene};
 
 /// A recorded query: a closest-hit ray or a shadow ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,26 +40,24 @@ fn trace_impl(scene: &Scene, rays: &[BareRay], dependent: bool) -> u64 {
         if dependent {
             org[0] = f32::from_bits(org[0].to_bits() ^ (previous & mask));
         }
-        let ray = raw_ray(&Ray {
+        let ray = Ray {
             org,
             dir: r.dir,
             tnear: 0.0,
             tfar: r.tfar,
-        });
+        };
         if r.shadow {
-            let mut ray = ray;
+            let mut ray = raw_ray(&ray);
             // SAFETY: committed, live scene; valid RTCRay; default arguments.
             unsafe { sys::rtcOccluded1(raw, &mut ray, std::ptr::null_mut()) };
             hits += u64::from(ray.tfar == f32::NEG_INFINITY);
             previous = ray.tfar.to_bits();
         } else {
-            let mut rayhit = sys::RTCRayHit {
-                ray,
-                hit: empty_hit(),
-            };
-            // SAFETY: as above, with a properly aligned RTCRayHit.
-            unsafe { sys::rtcIntersect1(raw, &mut rayhit, std::ptr::null_mut()) };
-            hits += u64::from(rayhit.hit.geomID != sys::RTC_INVALID_GEOMETRY_ID);
+            let mut rayhit = RayHit::new(&ray);
+            // SAFETY: as above, with an aligned RTCRayHit that has room for
+            // every field the runtime writes (see `record`).
+            unsafe { sys::rtcIntersect1(raw, rayhit.as_raw(), std::ptr::null_mut()) };
+            hits += u64::from(rayhit.found());
             previous = rayhit.ray.tfar.to_bits();
         }
     }

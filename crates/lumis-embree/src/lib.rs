@@ -13,6 +13,7 @@
 pub mod bare;
 mod buffer;
 mod device;
+mod record;
 mod scene;
 
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};

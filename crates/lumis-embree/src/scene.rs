@@ -6,6 +6,7 @@ use embree4_sys as sys;
 
 use crate::buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 use crate::device::{Device, EmbreeError};
+use crate::record::{raw_ray, RayHit};
 
 /// Embree's BVH build quality (`RTC_BUILD_QUALITY_*`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -322,38 +323,6 @@ impl Drop for Scene {
     }
 }
 
-#[inline]
-pub(crate) fn raw_ray(ray: &Ray) -> sys::RTCRay {
-    sys::RTCRay {
-        org_x: ray.org[0],
-        org_y: ray.org[1],
-        org_z: ray.org[2],
-        tnear: ray.tnear,
-        dir_x: ray.dir[0],
-        dir_y: ray.dir[1],
-        dir_z: ray.dir[2],
-        time: 0.0,
-        tfar: ray.tfar,
-        mask: u32::MAX,
-        id: 0,
-        flags: 0,
-    }
-}
-
-#[inline]
-pub(crate) fn empty_hit() -> sys::RTCHit {
-    sys::RTCHit {
-        Ng_x: 0.0,
-        Ng_y: 0.0,
-        Ng_z: 0.0,
-        u: 0.0,
-        v: 0.0,
-        primID: sys::RTC_INVALID_GEOMETRY_ID,
-        geomID: sys::RTC_INVALID_GEOMETRY_ID,
-        instID: [sys::RTC_INVALID_GEOMETRY_ID; 1],
-    }
-}
-
 /// One field of what Embree just wrote, read on its own. Embree stores the
 /// hit field by field; left alone, the compiler merges neighbouring reads
 /// (`u` and `v`, `Ng_x` and `Ng_y`) into one 8-byte load, which the CPU
@@ -380,14 +349,11 @@ impl Scene {
     /// The closest hit in `[tnear, tfar]`, if any.
     #[inline]
     pub fn intersect1(&self, ray: &Ray) -> Option<Hit> {
-        let mut rayhit = sys::RTCRayHit {
-            ray: raw_ray(ray),
-            hit: empty_hit(),
-        };
-        // SAFETY: the scene is committed and alive; `rayhit` is a properly
-        // aligned RTCRayHit (bindgen keeps RTC_ALIGN(16)); null arguments
-        // select Embree's defaults.
-        unsafe { sys::rtcIntersect1(self.raw, &mut rayhit, std::ptr::null_mut()) };
+        let mut rayhit = RayHit::new(ray);
+        // SAFETY: the scene is committed and alive; `rayhit` is an aligned
+        // RTCRayHit with room for every field the runtime writes (see
+        // `record`); null arguments select Embree's defaults.
+        unsafe { sys::rtcIntersect1(self.raw, rayhit.as_raw(), std::ptr::null_mut()) };
         let hit = &rayhit.hit;
         let geom_id = field(&hit.geomID);
         if geom_id == sys::RTC_INVALID_GEOMETRY_ID {
