@@ -80,8 +80,32 @@ impl RayHit {
 }
 
 /// The ray as Embree takes it: `time` 0, every mask bit set, no flags.
+///
+/// Embree loads `org` and `dir` as 16-byte vectors (`tnear` and `time` in
+/// their fourth lanes). Written field by field, each would reach it as
+/// three narrower stores that the CPU cannot forward into one wide load,
+/// so every query would start by waiting for its ray to reach the cache;
+/// written as whole vectors, the loads take the stores' values directly.
+/// Measured with the `embree_overhead` bench: the bare loop 1.84-1.96 s ->
+/// 1.53-1.58 s, lumis 3.92-4.19 s -> 3.74-3.92 s (README, Performance).
 #[inline]
 pub(crate) fn raw_ray(ray: &Ray) -> sys::RTCRay {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{__m128, _mm_setr_ps};
+        const _: () = assert!(std::mem::size_of::<sys::RTCRay>() == 48);
+        // SAFETY: SSE is part of the x86_64 baseline. RTCRay is twelve
+        // 4-byte fields, org_x org_y org_z tnear | dir_x dir_y dir_z time |
+        // tfar mask id flags, 48 bytes (asserted), so three __m128 hold
+        // exactly its bytes, and every bit pattern is a valid f32 or u32.
+        unsafe {
+            let org = _mm_setr_ps(ray.org[0], ray.org[1], ray.org[2], ray.tnear);
+            let dir = _mm_setr_ps(ray.dir[0], ray.dir[1], ray.dir[2], 0.0);
+            let rest = _mm_setr_ps(ray.tfar, f32::from_bits(u32::MAX), 0.0, 0.0);
+            std::mem::transmute::<[__m128; 3], sys::RTCRay>([org, dir, rest])
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
     sys::RTCRay {
         org_x: ray.org[0],
         org_y: ray.org[1],
@@ -129,6 +153,21 @@ mod tests {
     struct Probe {
         rayhit: RayHit,
         beyond: [u32; 16],
+    }
+
+    #[test]
+    fn the_vector_written_ray_has_every_field_in_place() {
+        let ray = Ray {
+            org: [1.5, -2.0, 3.25],
+            dir: [0.0, -0.6, 0.8],
+            tnear: 1e-3,
+            tfar: f32::INFINITY,
+        };
+        let raw = raw_ray(&ray);
+        assert_eq!([raw.org_x, raw.org_y, raw.org_z], ray.org);
+        assert_eq!([raw.dir_x, raw.dir_y, raw.dir_z], ray.dir);
+        assert_eq!((raw.tnear, raw.tfar, raw.time), (1e-3, f32::INFINITY, 0.0));
+        assert_eq!((raw.mask, raw.id, raw.flags), (u32::MAX, 0, 0));
     }
 
     #[test]
