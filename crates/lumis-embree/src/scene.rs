@@ -323,20 +323,6 @@ impl Drop for Scene {
     }
 }
 
-/// One field of what Embree just wrote, read on its own. Embree stores the
-/// hit field by field; left alone, the compiler merges neighbouring reads
-/// (`u` and `v`, `Ng_x` and `Ng_y`) into one 8-byte load, which the CPU
-/// cannot forward from two 4-byte stores still in flight, so the load
-/// waits for both to reach the cache (a store-forwarding stall, about 15
-/// cycles on the path from the hit to everything shaded at it).
-#[inline(always)]
-fn field<T: Copy>(value: &T) -> T {
-    // SAFETY: `value` is a reference, so valid, aligned and initialised; a
-    // volatile read of it only keeps the compiler from merging it with
-    // other reads.
-    unsafe { std::ptr::read_volatile(value) }
-}
-
 impl Scene {
     pub(crate) fn raw(&self) -> sys::RTCScene {
         self.raw
@@ -355,18 +341,17 @@ impl Scene {
         // `record`); null arguments select Embree's defaults.
         unsafe { sys::rtcIntersect1(self.raw, rayhit.as_raw(), std::ptr::null_mut()) };
         let hit = &rayhit.hit;
-        let geom_id = field(&hit.geomID);
-        if geom_id == sys::RTC_INVALID_GEOMETRY_ID {
+        if !rayhit.found() {
             return None;
         }
         Some(Hit {
-            t: field(&rayhit.ray.tfar),
-            u: field(&hit.u),
-            v: field(&hit.v),
-            ng: [field(&hit.Ng_x), field(&hit.Ng_y), field(&hit.Ng_z)],
-            geom_id,
-            prim_id: field(&hit.primID),
-            inst_id: field(&hit.instID[0]),
+            t: rayhit.ray.tfar,
+            u: hit.u,
+            v: hit.v,
+            ng: [hit.Ng_x, hit.Ng_y, hit.Ng_z],
+            geom_id: hit.geomID,
+            prim_id: hit.primID,
+            inst_id: hit.instID[0],
         })
     }
 
