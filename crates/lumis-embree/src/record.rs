@@ -86,8 +86,8 @@ impl RayHit {
 /// three narrower stores that the CPU cannot forward into one wide load,
 /// so every query would start by waiting for its ray to reach the cache;
 /// written as whole vectors, the loads take the stores' values directly.
-/// Measured with the `embree_overhead` bench: the bare loop 1.84-1.96 s ->
-/// 1.53-1.58 s, lumis 3.92-4.19 s -> 3.74-3.92 s (README, Performance).
+/// Measured with the `embree_overhead` bench: the bare loop 1.86-1.92 s ->
+/// 1.53-1.58 s, lumis 3.99-4.35 s -> 3.74-3.92 s (README, Performance).
 #[inline]
 pub(crate) fn raw_ray(ray: &Ray) -> sys::RTCRay {
     #[cfg(target_arch = "x86_64")]
