@@ -29,9 +29,9 @@ use crate::scene::Ray;
 /// one level deep.
 const MAX_INSTANCE_LEVELS: usize = 8;
 
-/// Words Embree may write after the 4.2 `RTCHit`, which ends with `instID[1]`:
-/// `instID[1..L]` and `instPrimID[0..L]`, `2 L - 1` words, rounded up to the
-/// record's 16-byte alignment.
+/// Words Embree may write after the 4.2 `RTCHit`, whose `instID` holds one
+/// word: `instID[1..L]` and `instPrimID[0..L]`, `2 L - 1` words, rounded up
+/// to the record's 16-byte alignment.
 const TAIL_WORDS: usize = (2 * MAX_INSTANCE_LEVELS - 1).next_multiple_of(4);
 
 /// An `RTCRayHit` with room for whatever a newer runtime writes after it.

@@ -340,10 +340,10 @@ impl Scene {
         // RTCRayHit with room for every field the runtime writes (see
         // `record`); null arguments select Embree's defaults.
         unsafe { sys::rtcIntersect1(self.raw, rayhit.as_raw(), std::ptr::null_mut()) };
-        let hit = &rayhit.hit;
         if !rayhit.found() {
             return None;
         }
+        let hit = &rayhit.hit;
         Some(Hit {
             t: rayhit.ray.tfar,
             u: hit.u,
