@@ -62,8 +62,7 @@ base_flags=${RUSTFLAGS:-}
 
 echo "== instrumented build" >&2
 RUSTFLAGS="$base_flags -Cprofile-generate=$PWD/$work/raw" \
-  CARGO_TARGET_DIR="$work/instrumented" \
-  cargo build --profile release-pgo -p lumis-cli
+  cargo build --profile release-pgo -p lumis-cli --target-dir "$work/instrumented"
 lumis="$work/instrumented/release-pgo/lumis"
 
 echo "== training renders" >&2
