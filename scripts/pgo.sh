@@ -76,7 +76,8 @@ for scene in "${scenes[@]}"; do
 done
 "$profdata" merge -o "$work/merged.profdata" "$work/raw"
 # Cargo rebuilds when RUSTFLAGS change, not when a file they name does:
-# naming the profile by its content rebuilds exactly when training changed.
+# naming the profile by its content makes every new profile rebuild (two
+# trainings differ slightly: hash seeds, the progress bar's timing).
 digest=$(sha256sum "$work/merged.profdata" | cut -c1-16)
 profile="$PWD/$work/lumis-$digest.profdata"
 mv "$work/merged.profdata" "$profile"
