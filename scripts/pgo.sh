@@ -1,20 +1,16 @@
 #!/usr/bin/env bash
-# Profile-guided build of lumis (fat LTO + PGO): 8-11% less time than the
-# default release build on the Cornell box when trained on it. With a
-# profile, LLVM turns the plugin calls that one type answers (the
-# sampler's, the BSDF's, the light's) into guarded direct calls and inlines
-# them across crates, which neither PGO nor LTO does alone (README,
-# "Performance").
+# Profile-guided build of lumis (fat LTO + PGO). With a profile, LLVM turns
+# the plugin calls that one type answers (the sampler's, the BSDF's, the
+# light's) into guarded direct calls and inlines them across crates, which
+# neither PGO nor LTO does alone. What it buys, and how much less when the
+# training scenes mix plugin types: README, "Performance".
 #
 #   scripts/pgo.sh [--bench] [SCENE.toml ...]
 #
 # builds target/release-pgo/lumis trained on the given scenes (default: the
 # Cornell box), each rendered at 8 samples per pixel; with --bench it then
 # runs the Embree overhead bench (`cargo bench -p lumis-cli --bench
-# embree_overhead`) built the same way. A profile fits the scenes it was
-# trained on: trained on the Cornell box alone the bench's lumis time drops
-# 8%, trained on four scenes with other samplers, BSDFs and lights 3%,
-# because a call that several types answer stays indirect.
+# embree_overhead`) built the same way.
 #
 # Needs llvm-profdata of the LLVM that rustc uses: `rustup component add
 # llvm-tools` provides it.
@@ -91,9 +87,7 @@ cp "$work/optimised/release-pgo/lumis" target/release-pgo/lumis
 echo "built target/release-pgo/lumis" >&2
 
 if $bench; then
-  # The bench profile inherits release; give it release-pgo's settings.
-  RUSTFLAGS="$use_flags" CARGO_PROFILE_BENCH_LTO=fat \
-    CARGO_PROFILE_BENCH_CODEGEN_UNITS=1 \
-    cargo bench -p lumis-cli --bench embree_overhead \
-    --target-dir "$work/optimised"
+  # The same profile and flags: the libraries built above are reused.
+  RUSTFLAGS="$use_flags" cargo bench --profile release-pgo -p lumis-cli \
+    --bench embree_overhead --target-dir "$work/optimised"
 fi
