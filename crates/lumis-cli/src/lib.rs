@@ -22,7 +22,9 @@ pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
 
 use lumis_core::{Registry, Result};
 
-/// A registry holding every plugin that ships with lumis.
+/// A registry holding every plugin that ships with lumis; the integrators
+/// come compiled for lumis's own scene type too (see
+/// [`lumis_integrators::Specialized`]).
 pub fn builtin_registry() -> Result<Registry> {
     let mut registry = Registry::new();
     lumis_samplers::register(&mut registry)?;
@@ -30,7 +32,7 @@ pub fn builtin_registry() -> Result<Registry> {
     lumis_measured::register(&mut registry)?;
     lumis_lights::register(&mut registry)?;
     lumis_light_samplers::register(&mut registry)?;
-    lumis_integrators::register(&mut registry)?;
+    lumis_integrators::register_specialized::<lumis_scene::RenderScene>(&mut registry)?;
     Ok(registry)
 }
 

@@ -43,10 +43,15 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
     // A select, not a branch: which side `w` leaves on is data-dependent.
     let side = if w.dot(n) < 0.0 { -1.0 } else { 1.0 };
     let offset = n * (d * side);
-    let po = p + offset;
-    // The common case (every component finite and non-zero) is one integer
-    // step per component without branches; zeros and infinities take the
-    // exact next_float path.
+    step_away(p + offset, offset)
+}
+
+/// `po` moved one ulp further along `offset`, so that the offset survives
+/// the rounding of the addition that made `po`. The common case (every
+/// component finite and non-zero) is one integer step per component
+/// without branches; zeros and infinities take the exact next_float path.
+#[inline(always)]
+fn step_away(po: Vec3, offset: Vec3) -> Vec3 {
     step_away_fast(po, offset).unwrap_or_else(|| {
         Vec3::new(
             step_toward(po.x, offset.x),
@@ -160,18 +165,84 @@ impl SurfacePoint {
     #[inline]
     pub fn spawn_ray_to(&self, to: &SurfacePoint) -> Ray {
         let from = offset_ray_origin(self.p, self.p_error, self.n, to.p - self.p);
-        let end = offset_ray_origin(to.p, to.p_error, to.n, from - to.p);
-        Ray {
-            o: from,
-            d: end - from,
-            t_max: 1.0 - SHADOW_EPSILON,
+        segment(from, self.p, to)
+    }
+
+    /// Both origins a ray can leave this point from, for a point that
+    /// spawns several rays (a path vertex: its continuation and its shadow
+    /// rays).
+    #[inline(always)]
+    pub fn ray_origins(&self) -> RayOrigins {
+        let offset = self.n * self.n.abs().dot(self.p_error);
+        RayOrigins {
+            p: self.p,
+            n: self.n,
+            front: step_away(self.p + offset, offset),
+            back: step_away(self.p - offset, -offset),
         }
+    }
+}
+
+/// The two offset origins of a [`SurfacePoint`] (eq. 6.30-6.31 with either
+/// sign): the offset does not depend on the ray's direction, only which
+/// side it leaves from does. Worked out once per path vertex, as soon as the
+/// hit is known, they leave only a compare and a select between a sampled
+/// direction or light point and its ray, where [`offset_ray_origin`] puts
+/// the whole offset there. The rays are bit for bit those of
+/// [`SurfacePoint::spawn_ray`] and [`SurfacePoint::spawn_ray_to`], since
+/// negating the offset is exact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayOrigins {
+    p: Vec3,
+    n: Vec3,
+    front: Vec3,
+    back: Vec3,
+}
+
+impl RayOrigins {
+    /// The origin for a ray leaving toward `w`.
+    #[inline(always)]
+    pub fn toward(&self, w: Vec3) -> Vec3 {
+        if w.dot(self.n) < 0.0 {
+            self.back
+        } else {
+            self.front
+        }
+    }
+
+    /// As [`SurfacePoint::spawn_ray`].
+    #[inline(always)]
+    pub fn spawn_ray(&self, d: Vec3) -> Ray {
+        Ray::new(self.toward(d), d)
+    }
+
+    /// As [`SurfacePoint::spawn_ray_to`].
+    #[inline(always)]
+    pub fn spawn_ray_to(&self, to: &SurfacePoint) -> Ray {
+        segment(self.toward(to.p - self.p), self.p, to)
+    }
+}
+
+/// The shadow ray from the offset origin `from` (of the surface point `p`)
+/// to `to`, whose end is offset off its own surface. pbrt-v4 picks the
+/// end's side with `from - to.p`; `p - to.p` differs from it only when
+/// `p` lies within `from`'s offset of the plane at `to`, and it frees the
+/// end's offset from waiting on `from`: the two run side by side instead
+/// of in one chain before the shadow query.
+#[inline(always)]
+fn segment(from: Vec3, p: Vec3, to: &SurfacePoint) -> Ray {
+    let end = offset_ray_origin(to.p, to.p_error, to.n, p - to.p);
+    Ray {
+        o: from,
+        d: end - from,
+        t_max: 1.0 - SHADOW_EPSILON,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::gamma;
 
     #[test]
     fn offset_moves_to_the_side_of_w() {
@@ -309,5 +380,65 @@ mod tests {
         let r = a.spawn_ray_to(&b);
         assert!(r.o.y > 0.0);
         assert!(r.at(r.t_max).y < 2.0);
+    }
+
+    /// Uniform floats in [0, 1) from a xorshift generator.
+    fn uniform_floats(mut state: u64) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    /// A surface point with a random position, error bound and unit normal.
+    fn random_point(next: &mut impl FnMut() -> f32) -> SurfacePoint {
+        let p = Vec3::new(next(), next(), next()) * 200.0 - 100.0;
+        let n = (Vec3::new(next(), next(), next()) - 0.5).normalize_or(Vec3::Z);
+        // Error bounds as the shapes report them, up to coarse ones whose
+        // offset is large enough to matter for the side test below.
+        let p_error = gamma(7) * p.abs() * (1.0 + 1e4 * next());
+        SurfacePoint { p, p_error, n }
+    }
+
+    /// The origins worked out once per vertex give exactly the rays of the
+    /// one-off `spawn_ray` and `spawn_ray_to`, on either side.
+    #[test]
+    fn ray_origins_match_one_off_spawns() {
+        let mut next = uniform_floats(0x2545_f491_4f6c_dd1d);
+        for _ in 0..10_000 {
+            let a = random_point(&mut next);
+            let b = random_point(&mut next);
+            let d = Vec3::new(next(), next(), next()) - 0.5;
+            let origins = a.ray_origins();
+            assert_eq!(origins.spawn_ray(d), a.spawn_ray(d));
+            assert_eq!(origins.spawn_ray(-d), a.spawn_ray(-d));
+            assert_eq!(origins.spawn_ray_to(&b), a.spawn_ray_to(&b));
+        }
+    }
+
+    /// The shadow ray's end takes its side from the surface point, where
+    /// pbrt-v4 takes it from the offset origin: the same end unless the
+    /// point lies within its own offset of the plane at the end.
+    #[test]
+    fn shadow_ray_end_side_matches_pbrt_off_the_plane() {
+        let mut next = uniform_floats(0x9e37_79b9_7f4a_7c15);
+        let mut compared = 0;
+        for _ in 0..10_000 {
+            let a = random_point(&mut next);
+            let b = random_point(&mut next);
+            let from = offset_ray_origin(a.p, a.p_error, a.n, b.p - a.p);
+            let height = (a.p - b.p).dot(b.n).abs();
+            if height <= 2.0 * (from - a.p).length() {
+                continue;
+            }
+            compared += 1;
+            let pbrt_end = offset_ray_origin(b.p, b.p_error, b.n, from - b.p);
+            let r = a.spawn_ray_to(&b);
+            assert_eq!(r.o, from);
+            assert_eq!(r.d, pbrt_end - from);
+        }
+        assert!(compared > 9_000, "{compared}");
     }
 }

@@ -1,5 +1,7 @@
 //! What integrators may ask of a scene: ray queries and the lights.
 
+use std::any::Any;
+
 use crate::interaction::SurfaceInteraction;
 use crate::light::Light;
 use crate::light_sampler::LightSampler;
@@ -22,4 +24,13 @@ pub trait Scene: Sync {
     fn infinite_lights(&self) -> &[u32];
 
     fn light_sampler(&self) -> &dyn LightSampler;
+
+    /// The scene as its concrete type, for integrators that compile their
+    /// path loop for the renderer's own scene: its queries then inline into
+    /// the loop instead of returning each interaction through memory from a
+    /// virtual call. Wrappers (a recording scene in a benchmark, a test
+    /// double) keep the default and get the loop over `dyn Scene`.
+    fn as_any(&self) -> Option<&dyn Any> {
+        None
+    }
 }

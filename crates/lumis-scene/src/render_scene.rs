@@ -362,4 +362,8 @@ impl Scene for RenderScene {
     fn light_sampler(&self) -> &dyn LightSampler {
         self.light_sampler.as_ref()
     }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }

@@ -12,6 +12,7 @@ use lumis_core::{
 };
 
 use crate::estimator::{self, Estimator, SceneView, VertexPlan};
+use crate::specialize::Trace;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
@@ -45,7 +46,18 @@ impl Integrator for DirectIntegrator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
-        let scene = &SceneView::new(scene);
+        self.trace(camera_ray, &SceneView::new(scene), sampler, stats)
+    }
+}
+
+impl Trace for DirectIntegrator {
+    fn trace<S: Scene + ?Sized>(
+        &self,
+        camera_ray: &Ray,
+        scene: &SceneView<S>,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
         // What the camera sees directly counts fully (a specular "bounce").
         stats.rays += 1;
         let Some(hit) = scene.intersect(camera_ray) else {
@@ -70,11 +82,12 @@ impl Integrator for DirectIntegrator {
         } else {
             VertexPlan::UNWEIGHTED
         };
+        let origins = hit.point.ray_origins();
         if plan.light_samples > 0 {
             let u_light = sampler.get_1d_2d();
             radiance += self
                 .estimator
-                .sample_lights(&plan, &hit, wo, scene, u_light, sampler, stats);
+                .sample_lights(&plan, &hit, &origins, wo, scene, u_light, sampler, stats);
         }
         // The first BSDF sample, then the extra ones: all only look for
         // emission. A specular sample's emission is not weighted.
@@ -92,7 +105,7 @@ impl Integrator for DirectIntegrator {
                     stats.rays += 1;
                     let le = self.estimator.emission_along(
                         scene,
-                        &hit.spawn_ray(wi),
+                        &origins.spawn_ray(wi),
                         &hit.light_context(),
                         bs.pdf,
                         specular,

@@ -24,6 +24,7 @@
 //! by infinite densities.
 
 use lumis_core::bsdf::BsdfContext;
+use lumis_core::ray::RayOrigins;
 use lumis_core::{
     Light, LightIndex, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params,
     Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec2, Vec3,
@@ -73,16 +74,25 @@ pub const PARAMS: [ParamSpec; 6] = [
 /// The scene as the estimators use it: traversal plus its lights. The
 /// light list, the light sampler and the infinite lights are read from the
 /// scene once per path instead of through a virtual call at every vertex.
-#[derive(Clone, Copy)]
-pub struct SceneView<'a> {
-    pub scene: &'a dyn Scene,
+/// `S` is the concrete scene type where the integrator was compiled for it
+/// (see [`crate::Specialized`]), else `dyn Scene`.
+pub struct SceneView<'a, S: ?Sized = dyn Scene> {
+    pub scene: &'a S,
     pub lights: &'a [Box<dyn Light>],
     pub light_sampler: &'a dyn LightSampler,
     pub infinite_lights: &'a [u32],
 }
 
-impl<'a> SceneView<'a> {
-    pub fn new(scene: &'a dyn Scene) -> Self {
+impl<S: ?Sized> Clone for SceneView<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S: ?Sized> Copy for SceneView<'_, S> {}
+
+impl<'a, S: Scene + ?Sized> SceneView<'a, S> {
+    pub fn new(scene: &'a S) -> Self {
         Self {
             scene,
             lights: scene.lights(),
@@ -305,9 +315,9 @@ impl Estimator {
     /// from `prev`, on light `index` that samples that direction with
     /// `pdf_li`; the plan's scale is applied by the caller.
     #[inline]
-    pub fn bsdf_weight(
+    pub fn bsdf_weight<S: Scene + ?Sized>(
         &self,
-        scene: &SceneView,
+        scene: &SceneView<S>,
         index: u32,
         prev: &LightSampleContext,
         wi: Vec3,
@@ -331,12 +341,13 @@ impl Estimator {
     /// are drawn by the caller, which may draw them before it knows the
     /// hit; further samples draw theirs from `sampler`.
     #[allow(clippy::too_many_arguments)]
-    pub fn sample_lights(
+    pub fn sample_lights<S: Scene + ?Sized>(
         &self,
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
+        origins: &RayOrigins,
         wo: Vec3,
-        scene: &SceneView,
+        scene: &SceneView<S>,
         first: (f32, Vec2),
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
@@ -344,18 +355,19 @@ impl Estimator {
         // The first sample outside the loop: with the loop around every
         // sample the compiler hoisted (and spilled) the whole interaction
         // before it.
-        let mut sum = self.sample_one_light(hit, wo, scene, first, stats);
+        let mut sum = self.sample_one_light(hit, origins, wo, scene, first, stats);
         for _ in 1..plan.light_samples {
-            sum += self.sample_one_light(hit, wo, scene, sampler.get_1d_2d(), stats);
+            sum += self.sample_one_light(hit, origins, wo, scene, sampler.get_1d_2d(), stats);
         }
         sum * plan.light_scale
     }
 
-    fn sample_one_light(
+    fn sample_one_light<S: Scene + ?Sized>(
         &self,
         hit: &SurfaceInteraction,
+        origins: &RayOrigins,
         wo: Vec3,
-        scene: &SceneView,
+        scene: &SceneView<S>,
         (u_light, u): (f32, Vec2),
         stats: &mut RenderStats,
     ) -> Rgb {
@@ -385,7 +397,7 @@ impl Estimator {
             return Rgb::BLACK;
         }
         stats.shadow_rays += 1;
-        if scene.occluded(&hit.point.spawn_ray_to(&ls.p)) {
+        if scene.occluded(&origins.spawn_ray_to(&ls.p)) {
             return Rgb::BLACK;
         }
         stats.light_samples += 1;
@@ -396,12 +408,12 @@ impl Estimator {
     /// Emission found by `count` BSDF samples at `hit` that only look for
     /// emitters (they do not continue the path), weighted and scaled by the
     /// plan's `bsdf_scale`.
-    pub fn extra_bsdf_samples(
+    pub fn extra_bsdf_samples<S: Scene + ?Sized>(
         &self,
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
         wo: Vec3,
-        scene: &SceneView,
+        scene: &SceneView<S>,
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
@@ -432,9 +444,9 @@ impl Estimator {
     /// Weighted emission seen along a BSDF-sampled `ray` from `prev`: the
     /// emitter it hits, or the infinite lights if it escapes. The caller
     /// counts the ray and applies the plan's scale.
-    pub fn emission_along(
+    pub fn emission_along<S: Scene + ?Sized>(
         &self,
-        scene: &SceneView,
+        scene: &SceneView<S>,
         ray: &Ray,
         prev: &LightSampleContext,
         p_bsdf: f32,

@@ -4,12 +4,14 @@
 mod direct;
 mod estimator;
 mod path;
+mod specialize;
 
 pub use direct::DirectIntegrator;
-pub use estimator::{Estimator, Heuristic, MisEstimator, Strategy, VertexPlan};
+pub use estimator::{Estimator, Heuristic, MisEstimator, SceneView, Strategy, VertexPlan};
 pub use path::PathIntegrator;
+pub use specialize::{Specialized, Trace};
 
-use lumis_core::{Registry, Result};
+use lumis_core::{Registry, Result, Scene};
 
 /// Registers every integrator of this crate.
 pub fn register(registry: &mut Registry) -> Result<()> {
@@ -18,5 +20,21 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     })?;
     registry.add_integrator(direct::SPEC, |p| {
         Ok(Box::new(DirectIntegrator::from_params(p)?))
+    })
+}
+
+/// As [`register`], with each integrator's loop also compiled for the scene
+/// type `S`, so that its queries inline into the loop: the binary passes
+/// its own scene type, which this crate cannot name.
+pub fn register_specialized<S: Scene + 'static>(registry: &mut Registry) -> Result<()> {
+    registry.add_integrator(path::SPEC, |p| {
+        Ok(Box::new(Specialized::<_, S>::new(
+            PathIntegrator::from_params(p)?,
+        )))
+    })?;
+    registry.add_integrator(direct::SPEC, |p| {
+        Ok(Box::new(Specialized::<_, S>::new(
+            DirectIntegrator::from_params(p)?,
+        )))
     })
 }

@@ -9,6 +9,7 @@ use lumis_core::{
 };
 
 use crate::estimator::{self, Estimator, Heuristic, SceneView, Strategy, VertexPlan};
+use crate::specialize::Trace;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
@@ -81,7 +82,18 @@ impl Integrator for PathIntegrator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
-        let scene = &SceneView::new(scene);
+        self.trace(camera_ray, &SceneView::new(scene), sampler, stats)
+    }
+}
+
+impl Trace for PathIntegrator {
+    fn trace<S: Scene + ?Sized>(
+        &self,
+        camera_ray: &Ray,
+        scene: &SceneView<S>,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
         let mut radiance = Rgb::BLACK;
         let mut beta = Rgb::WHITE;
         let mut ray = *camera_ray;
@@ -139,7 +151,11 @@ impl Integrator for PathIntegrator {
             if segments >= self.max_depth {
                 break;
             }
-            let wo = hit.shading.to_local(hit.wo);
+            // `-ray.d` is the hit's `wo` (the `Scene::intersect` contract),
+            // still in registers: the copy in the interaction was stored in
+            // pieces and reloads as one vector, which the CPU cannot forward
+            // from the stores and waits for.
+            let wo = hit.shading.to_local(-ray.d);
             plan = if hit.bsdf_flags.is_non_specular() {
                 self.estimator.plan(sampler)
             } else {
@@ -156,11 +172,14 @@ impl Integrator for PathIntegrator {
                 ..Default::default()
             };
             let sampled = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2);
+            // Both offset origins as soon as the hit is known: the shadow
+            // rays and the continuation then only pick one.
+            let origins = hit.point.ray_origins();
             if plan.light_samples > 0 {
                 radiance += beta
                     * self
                         .estimator
-                        .sample_lights(&plan, hit, wo, scene, u_light, sampler, stats);
+                        .sample_lights(&plan, hit, &origins, wo, scene, u_light, sampler, stats);
             }
             if plan.extra_bsdf_samples > 0 {
                 radiance += beta
@@ -183,7 +202,7 @@ impl Integrator for PathIntegrator {
             }
             bsdf_pdf = bs.pdf;
             prev = hit.light_context();
-            ray = hit.spawn_ray(wi);
+            ray = origins.spawn_ray(wi);
             segments += 1;
 
             if segments > self.rr_depth {
