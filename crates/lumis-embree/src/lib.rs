@@ -15,6 +15,8 @@ mod buffer;
 mod device;
 mod record;
 mod scene;
+#[cfg(feature = "replay")]
+mod tape;
 
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 pub use device::{Device, EmbreeError};

@@ -89,6 +89,8 @@ pub struct Scene {
     device: Device,
     raw: sys::RTCScene,
     _storage: Vec<SharedStorage>,
+    #[cfg(feature = "replay")]
+    tape: crate::tape::Tape,
 }
 
 // SAFETY: a committed Embree scene is immutable and rtcIntersect1/rtcOccluded1
@@ -304,6 +306,8 @@ impl SceneBuilder {
             device,
             raw: this.raw,
             _storage: storage,
+            #[cfg(feature = "replay")]
+            tape: Default::default(),
         })
     }
 }
@@ -335,6 +339,18 @@ impl Scene {
     /// The closest hit in `[tnear, tfar]`, if any.
     #[inline]
     pub fn intersect1(&self, ray: &Ray) -> Option<Hit> {
+        #[cfg(feature = "replay")]
+        if let Some(answer) = self.tape.next_hit() {
+            return answer;
+        }
+        let hit = self.traverse(ray);
+        #[cfg(feature = "replay")]
+        self.tape.keep_hit(hit);
+        hit
+    }
+
+    #[inline(always)]
+    fn traverse(&self, ray: &Ray) -> Option<Hit> {
         let mut rayhit = RayHit::new(ray);
         // SAFETY: the scene is committed and alive; `rayhit` is an aligned
         // RTCRayHit with room for every field the runtime writes (see
@@ -358,11 +374,50 @@ impl Scene {
     /// Whether anything blocks the segment `[tnear, tfar]` (a shadow ray).
     #[inline]
     pub fn occluded1(&self, ray: &Ray) -> bool {
+        #[cfg(feature = "replay")]
+        if let Some(answer) = self.tape.next_occluded() {
+            return answer;
+        }
+        let occluded = self.traverse_occluded(ray);
+        #[cfg(feature = "replay")]
+        self.tape.keep_occluded(occluded);
+        occluded
+    }
+
+    #[inline(always)]
+    fn traverse_occluded(&self, ray: &Ray) -> bool {
         let mut raw = raw_ray(ray);
         // SAFETY: as in intersect1, with an RTCRay.
         unsafe { sys::rtcOccluded1(self.raw, &mut raw, std::ptr::null_mut()) };
         // Embree sets tfar to -inf when the ray is occluded.
         raw.tfar == f32::NEG_INFINITY
+    }
+
+    /// Records the answers of the queries that follow (feature `replay`;
+    /// see the `tape` module), forgetting earlier ones.
+    #[cfg(feature = "replay")]
+    pub fn record_queries(&mut self) {
+        self.tape.record();
+    }
+
+    /// Answers the queries that follow from the recording, in its order,
+    /// from its start; returns how many closest-hit and shadow answers it
+    /// holds.
+    #[cfg(feature = "replay")]
+    pub fn replay_queries(&mut self) -> (usize, usize) {
+        self.tape.replay()
+    }
+
+    /// Traverses every query again.
+    #[cfg(feature = "replay")]
+    pub fn stop_replay(&mut self) {
+        self.tape.stop();
+    }
+
+    /// How many closest-hit and shadow answers the replay has handed out.
+    #[cfg(feature = "replay")]
+    pub fn replayed_queries(&self) -> (usize, usize) {
+        self.tape.played()
     }
 
     /// Scene bounds as `(lower, upper)`.
@@ -435,6 +490,45 @@ mod tests {
         assert!(scene
             .intersect1(&ray([2.0, 0.0, 2.0], [0.0, 0.0, -1.0], f32::INFINITY))
             .is_none());
+    }
+
+    /// Replay answers each query with the recorded answer of the query in
+    /// the same place, whatever its ray, counts what it handed out, and
+    /// traverses again past the recording's end or once stopped.
+    #[cfg(feature = "replay")]
+    #[test]
+    fn replay_answers_queries_in_recorded_order() {
+        let device = Device::new().unwrap();
+        let mut scene = unit_quad(&device);
+        let down = [0.0, 0.0, -1.0];
+        let hit_ray = ray([0.5, -0.5, 2.0], down, f32::INFINITY);
+        let miss_ray = ray([2.0, 0.0, 2.0], down, f32::INFINITY);
+        let blocked = ray([0.0, 0.0, 1.0], down, 2.0);
+        let short = ray([0.0, 0.0, 1.0], down, 0.5);
+
+        scene.record_queries();
+        let hit = scene.intersect1(&hit_ray);
+        assert!(hit.is_some());
+        assert!(scene.intersect1(&miss_ray).is_none());
+        assert!(scene.occluded1(&blocked));
+        assert_eq!(scene.replay_queries(), (2, 1));
+
+        // The rays swapped: the answers come in the recorded order.
+        assert_eq!(scene.intersect1(&miss_ray), hit);
+        assert!(scene.occluded1(&short));
+        assert_eq!(scene.intersect1(&hit_ray), None);
+        assert_eq!(scene.replayed_queries(), (2, 1));
+        // Past the recording: traversal again.
+        assert!(!scene.occluded1(&short));
+        assert_eq!(scene.intersect1(&hit_ray), hit);
+        assert_eq!(scene.replayed_queries(), (2, 1));
+
+        // Replaying again starts over; stopping traverses.
+        assert_eq!(scene.replay_queries(), (2, 1));
+        assert_eq!(scene.intersect1(&miss_ray), hit);
+        scene.stop_replay();
+        assert!(scene.intersect1(&miss_ray).is_none());
+        assert!(!scene.occluded1(&short));
     }
 
     #[test]

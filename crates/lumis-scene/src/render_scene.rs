@@ -172,6 +172,13 @@ impl RenderScene {
         &self.embree
     }
 
+    /// The Embree scene, to record and replay its answers (feature
+    /// `replay`).
+    #[cfg(feature = "replay")]
+    pub fn embree_mut(&mut self) -> &mut lumis_embree::Scene {
+        &mut self.embree
+    }
+
     /// Bounding sphere of the geometry: `(center, radius)`.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
         bounding_sphere(&self.embree)

@@ -116,7 +116,7 @@ impl Trace for DirectIntegrator {
             }
             radiance += self
                 .estimator
-                .extra_bsdf_samples(&plan, &hit, wo, scene, sampler, stats);
+                .extra_bsdf_samples(&plan, &hit, &origins, wo, scene, sampler, stats);
         }
         radiance
     }

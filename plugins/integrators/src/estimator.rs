@@ -407,11 +407,13 @@ impl Estimator {
 
     /// Emission found by `count` BSDF samples at `hit` that only look for
     /// emitters (they do not continue the path), weighted and scaled by the
-    /// plan's `bsdf_scale`.
+    /// plan's `bsdf_scale`; their rays leave from the vertex's `origins`.
+    #[allow(clippy::too_many_arguments)]
     pub fn extra_bsdf_samples<S: Scene + ?Sized>(
         &self,
         plan: &VertexPlan,
         hit: &SurfaceInteraction,
+        origins: &RayOrigins,
         wo: Vec3,
         scene: &SceneView<S>,
         sampler: &mut dyn Sampler,
@@ -433,7 +435,7 @@ impl Estimator {
             }
             let throughput = bs.f * (bs.wi.z.abs() / bs.pdf);
             let prev = hit.light_context();
-            let ray = hit.spawn_ray(wi);
+            let ray = origins.spawn_ray(wi);
             stats.rays += 1;
             sum += throughput
                 * self.emission_along(scene, &ray, &prev, bs.pdf, bs.flags.is_specular(), stats);

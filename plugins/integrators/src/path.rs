@@ -185,7 +185,7 @@ impl Trace for PathIntegrator {
                 radiance += beta
                     * self
                         .estimator
-                        .extra_bsdf_samples(&plan, hit, wo, scene, sampler, stats);
+                        .extra_bsdf_samples(&plan, hit, &origins, wo, scene, sampler, stats);
             }
             let Some(bs) = sampled else {
                 break;

@@ -120,11 +120,15 @@ pub fn area_sample(
     if !emission.emits_toward(-n_dot) || emission.radiance.is_black() {
         return None;
     }
+    // pdf = d^2 / (|cos| A) with |cos| = |n . v| / d is d^3 / (|n . v| A):
+    // the square root and the two reciprocals run side by side instead of
+    // in one chain (square root, then a division, then another).
     let dist2 = to_light.length_squared();
     let dist = dist2.sqrt();
-    let wi = to_light / dist;
-    let cos_light = n_dot.abs() / dist;
-    let pdf = dist2 / (cos_light * area);
+    let inv_dist2 = 1.0 / dist2;
+    let inv_projected = 1.0 / (n_dot.abs() * area);
+    let wi = to_light * (dist * inv_dist2);
+    let pdf = dist2 * dist * inv_projected;
     // Also false for NaN (a zero distance) and infinity (grazing).
     if !(pdf > 0.0 && pdf < f32::INFINITY) {
         return None;
