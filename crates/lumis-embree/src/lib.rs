@@ -15,7 +15,6 @@ mod buffer;
 mod device;
 mod record;
 mod scene;
-#[cfg(feature = "replay")]
 mod tape;
 
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};

@@ -7,6 +7,7 @@ use embree4_sys as sys;
 use crate::buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 use crate::device::{Device, EmbreeError};
 use crate::record::{raw_ray, RayHit};
+use crate::tape::Tape;
 
 /// Embree's BVH build quality (`RTC_BUILD_QUALITY_*`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -89,8 +90,8 @@ pub struct Scene {
     device: Device,
     raw: sys::RTCScene,
     _storage: Vec<SharedStorage>,
-    #[cfg(feature = "replay")]
-    tape: crate::tape::Tape,
+    /// Recorded answers to replay (feature `replay`), else nothing.
+    tape: Tape,
 }
 
 // SAFETY: a committed Embree scene is immutable and rtcIntersect1/rtcOccluded1
@@ -306,8 +307,7 @@ impl SceneBuilder {
             device,
             raw: this.raw,
             _storage: storage,
-            #[cfg(feature = "replay")]
-            tape: Default::default(),
+            tape: Tape::default(),
         })
     }
 }
@@ -339,14 +339,7 @@ impl Scene {
     /// The closest hit in `[tnear, tfar]`, if any.
     #[inline]
     pub fn intersect1(&self, ray: &Ray) -> Option<Hit> {
-        #[cfg(feature = "replay")]
-        if let Some(answer) = self.tape.next_hit() {
-            return answer;
-        }
-        let hit = self.traverse(ray);
-        #[cfg(feature = "replay")]
-        self.tape.keep_hit(hit);
-        hit
+        self.tape.hit(|| self.traverse(ray))
     }
 
     #[inline(always)]
@@ -374,14 +367,7 @@ impl Scene {
     /// Whether anything blocks the segment `[tnear, tfar]` (a shadow ray).
     #[inline]
     pub fn occluded1(&self, ray: &Ray) -> bool {
-        #[cfg(feature = "replay")]
-        if let Some(answer) = self.tape.next_occluded() {
-            return answer;
-        }
-        let occluded = self.traverse_occluded(ray);
-        #[cfg(feature = "replay")]
-        self.tape.keep_occluded(occluded);
-        occluded
+        self.tape.occluded(|| self.traverse_occluded(ray))
     }
 
     #[inline(always)]

@@ -7,108 +7,148 @@
 //! Replay hands out the answers in the order they were recorded, which is
 //! the order a single-threaded render of the same scene, seed and spp asks
 //! for them. A query past the end of the recording traverses the scene.
-
-use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering::Relaxed};
-use std::sync::Mutex;
+//! Without the feature the tape is empty and every query traverses.
 
 use crate::Hit;
 
-const OFF: u8 = 0;
-const RECORDING: u8 = 1;
-const REPLAYING: u8 = 2;
+#[cfg(feature = "replay")]
+pub(crate) use recorder::Tape;
 
-/// The answers of one render's queries, in order.
+/// Without the `replay` feature: nothing to record, every query traverses.
+#[cfg(not(feature = "replay"))]
 #[derive(Debug, Default)]
-struct Answers {
-    hits: Vec<Option<Hit>>,
-    occluded: Vec<bool>,
-}
+pub(crate) struct Tape {}
 
-#[derive(Debug, Default)]
-pub(crate) struct Tape {
-    mode: AtomicU8,
-    /// Filled while recording (a lock per query, off the timed run).
-    recording: Mutex<Answers>,
-    /// Played back; only replaced through `&mut`, so reads need no lock.
-    played: Answers,
-    /// Where playback is: a relaxed load and store each, no read-modify-
-    /// write, because one thread replays.
-    next_hit: AtomicUsize,
-    next_occluded: AtomicUsize,
-}
-
+#[cfg(not(feature = "replay"))]
 impl Tape {
-    /// Forgets any answers and records the next queries' answers.
-    pub(crate) fn record(&mut self) {
-        *self.recording.get_mut().unwrap_or_else(|e| e.into_inner()) = Answers::default();
-        self.played = Answers::default();
-        *self.mode.get_mut() = RECORDING;
-    }
-
-    /// Plays the recorded answers back from the first; returns how many
-    /// closest-hit and shadow answers there are.
-    pub(crate) fn replay(&mut self) -> (usize, usize) {
-        let recording = self.recording.get_mut().unwrap_or_else(|e| e.into_inner());
-        if !recording.hits.is_empty() || !recording.occluded.is_empty() {
-            self.played = std::mem::take(recording);
-        }
-        *self.next_hit.get_mut() = 0;
-        *self.next_occluded.get_mut() = 0;
-        *self.mode.get_mut() = REPLAYING;
-        (self.played.hits.len(), self.played.occluded.len())
-    }
-
-    /// Back to traversing every query (the answers are kept for `replay`).
-    pub(crate) fn stop(&mut self) {
-        *self.mode.get_mut() = OFF;
-    }
-
-    /// How many closest-hit and shadow answers playback has handed out.
-    pub(crate) fn played(&self) -> (usize, usize) {
-        (
-            self.next_hit.load(Relaxed),
-            self.next_occluded.load(Relaxed),
-        )
+    #[inline(always)]
+    pub(crate) fn hit(&self, traverse: impl FnOnce() -> Option<Hit>) -> Option<Hit> {
+        traverse()
     }
 
     #[inline(always)]
-    pub(crate) fn next_hit(&self) -> Option<Option<Hit>> {
-        if self.mode.load(Relaxed) != REPLAYING {
-            return None;
-        }
-        let i = self.next_hit.load(Relaxed);
-        let answer = *self.played.hits.get(i)?;
-        self.next_hit.store(i + 1, Relaxed);
-        Some(answer)
+    pub(crate) fn occluded(&self, traverse: impl FnOnce() -> bool) -> bool {
+        traverse()
+    }
+}
+
+#[cfg(feature = "replay")]
+mod recorder {
+    use std::sync::atomic::{AtomicU8, AtomicUsize, Ordering::Relaxed};
+    use std::sync::Mutex;
+
+    use super::Hit;
+
+    const OFF: u8 = 0;
+    const RECORDING: u8 = 1;
+    const REPLAYING: u8 = 2;
+
+    /// The answers of one kind of query, in order.
+    #[derive(Debug, Default)]
+    struct Track<T> {
+        /// Filled while recording (a lock per query, off the timed run).
+        recording: Mutex<Vec<T>>,
+        /// Played back; only replaced through `&mut`, so reads need no lock.
+        played: Vec<T>,
+        /// Where playback is: a relaxed load and store, no read-modify-
+        /// write, because one thread replays.
+        next: AtomicUsize,
     }
 
-    #[inline(always)]
-    pub(crate) fn next_occluded(&self) -> Option<bool> {
-        if self.mode.load(Relaxed) != REPLAYING {
-            return None;
+    impl<T: Copy> Track<T> {
+        fn clear(&mut self) {
+            self.recording
+                .get_mut()
+                .unwrap_or_else(|e| e.into_inner())
+                .clear();
+            self.played.clear();
         }
-        let i = self.next_occluded.load(Relaxed);
-        let answer = *self.played.occluded.get(i)?;
-        self.next_occluded.store(i + 1, Relaxed);
-        Some(answer)
+
+        /// Rewinds, taking over what was recorded since the last rewind, if
+        /// anything; returns how many answers it plays.
+        fn rewind(&mut self) -> usize {
+            let recording = self.recording.get_mut().unwrap_or_else(|e| e.into_inner());
+            if !recording.is_empty() {
+                self.played = std::mem::take(recording);
+            }
+            *self.next.get_mut() = 0;
+            self.played.len()
+        }
+
+        #[inline(always)]
+        fn next(&self) -> Option<T> {
+            let i = self.next.load(Relaxed);
+            let answer = *self.played.get(i)?;
+            self.next.store(i + 1, Relaxed);
+            Some(answer)
+        }
+
+        #[cold]
+        fn keep(&self, answer: T) {
+            self.recording
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(answer);
+        }
     }
 
-    #[inline(always)]
-    pub(crate) fn keep_hit(&self, hit: Option<Hit>) {
-        if self.mode.load(Relaxed) == RECORDING {
-            self.lock().hits.push(hit);
-        }
+    #[derive(Debug, Default)]
+    pub(crate) struct Tape {
+        mode: AtomicU8,
+        hits: Track<Option<Hit>>,
+        occluded: Track<bool>,
     }
 
-    #[inline(always)]
-    pub(crate) fn keep_occluded(&self, occluded: bool) {
-        if self.mode.load(Relaxed) == RECORDING {
-            self.lock().occluded.push(occluded);
+    impl Tape {
+        /// Forgets any answers and records the next queries' answers.
+        pub(crate) fn record(&mut self) {
+            self.hits.clear();
+            self.occluded.clear();
+            *self.mode.get_mut() = RECORDING;
         }
-    }
 
-    #[cold]
-    fn lock(&self) -> std::sync::MutexGuard<'_, Answers> {
-        self.recording.lock().unwrap_or_else(|e| e.into_inner())
+        /// Plays the recorded answers back from the first; returns how many
+        /// closest-hit and shadow answers there are.
+        pub(crate) fn replay(&mut self) -> (usize, usize) {
+            *self.mode.get_mut() = REPLAYING;
+            (self.hits.rewind(), self.occluded.rewind())
+        }
+
+        /// Back to traversing every query (the answers are kept for
+        /// `replay`).
+        pub(crate) fn stop(&mut self) {
+            *self.mode.get_mut() = OFF;
+        }
+
+        /// How many closest-hit and shadow answers playback has handed out.
+        pub(crate) fn played(&self) -> (usize, usize) {
+            (
+                self.hits.next.load(Relaxed),
+                self.occluded.next.load(Relaxed),
+            )
+        }
+
+        #[inline(always)]
+        pub(crate) fn hit(&self, traverse: impl FnOnce() -> Option<Hit>) -> Option<Hit> {
+            self.answer(&self.hits, traverse)
+        }
+
+        #[inline(always)]
+        pub(crate) fn occluded(&self, traverse: impl FnOnce() -> bool) -> bool {
+            self.answer(&self.occluded, traverse)
+        }
+
+        #[inline(always)]
+        fn answer<T: Copy>(&self, track: &Track<T>, traverse: impl FnOnce() -> T) -> T {
+            match self.mode.load(Relaxed) {
+                REPLAYING => track.next().unwrap_or_else(traverse),
+                RECORDING => {
+                    let answer = traverse();
+                    track.keep(answer);
+                    answer
+                }
+                _ => traverse(),
+            }
+        }
     }
 }
