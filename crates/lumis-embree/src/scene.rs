@@ -96,7 +96,8 @@ pub struct Scene {
 
 // SAFETY: a committed Embree scene is immutable and rtcIntersect1/rtcOccluded1
 // are thread-safe on it (Embree 4 API docs); the shared buffers it reads are
-// owned by `_storage` and never mutated.
+// owned by `_storage` and never mutated. The other fields (`device`, `tape`)
+// are Send and Sync by themselves.
 unsafe impl Send for Scene {}
 // SAFETY: as above.
 unsafe impl Sync for Scene {}
