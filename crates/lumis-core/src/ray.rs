@@ -39,11 +39,18 @@ impl Ray {
 /// (pbrt-v4 `OffsetRayOrigin`, eq. 6.30-6.31). No scene-scale epsilon.
 #[inline]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
-    let d = n.abs().dot(p_error);
     // A select, not a branch: which side `w` leaves on is data-dependent.
+    // Scaling by +-1 is exact, so either side is the negation of the other.
     let side = if w.dot(n) < 0.0 { -1.0 } else { 1.0 };
-    let offset = n * (d * side);
+    let offset = normal_offset(p_error, n) * side;
     step_away(p + offset, offset)
+}
+
+/// The offset along `n` that clears a point's error box `p_error`
+/// (pbrt-v4 eq. 6.30: `d = |n| . p_error`), toward the front side.
+#[inline(always)]
+fn normal_offset(p_error: Vec3, n: Vec3) -> Vec3 {
+    n * n.abs().dot(p_error)
 }
 
 /// `po` moved one ulp further along `offset`, so that the offset survives
@@ -173,7 +180,7 @@ impl SurfacePoint {
     /// rays).
     #[inline(always)]
     pub fn ray_origins(&self) -> RayOrigins {
-        let offset = self.n * self.n.abs().dot(self.p_error);
+        let offset = normal_offset(self.p_error, self.n);
         RayOrigins {
             p: self.p,
             n: self.n,
