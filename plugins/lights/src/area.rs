@@ -202,10 +202,47 @@ pub trait PlanarShape: Send + Sync {
         None
     }
 
-    /// A point whose direction from `p` is uniform in the solid angle; only
-    /// called where [`PlanarShape::solid_angle`] is `Some`.
-    fn sample_solid_angle(&self, _p: Vec3, _u: Vec2) -> Option<SurfacePoint> {
-        None
+    /// A point whose direction from `p` is uniform in the solid angle the
+    /// shape subtends from there, with that solid angle; [`ByArea`] exactly
+    /// where [`PlanarShape::solid_angle`] is `None`. One call, so that the
+    /// spherical geometry is set up once per sample.
+    ///
+    /// [`ByArea`]: SolidAngleSample::ByArea
+    fn sample_solid_angle(&self, _p: Vec3, _u: Vec2) -> SolidAngleSample {
+        SolidAngleSample::ByArea
+    }
+}
+
+/// What [`PlanarShape::sample_solid_angle`] gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SolidAngleSample {
+    /// The shape samples by area from this point.
+    ByArea,
+    /// A point uniform over the solid angle `omega` (sr), or `None` where
+    /// the construction degenerates (no sample: falling back to area
+    /// sampling would disagree with `pdf_li`).
+    Uniform {
+        point: Option<SurfacePoint>,
+        omega: f32,
+    },
+}
+
+impl SolidAngleSample {
+    /// The sample of a shape seen from a point as `spherical` (its
+    /// spherical polygon and solid angle, or `None` where it samples by
+    /// area), drawn by `sample`.
+    #[inline]
+    pub fn from_spherical<T>(
+        spherical: Option<(T, f32)>,
+        sample: impl FnOnce(T) -> Option<SurfacePoint>,
+    ) -> Self {
+        match spherical {
+            Some((polygon, omega)) => SolidAngleSample::Uniform {
+                point: sample(polygon),
+                omega,
+            },
+            None => SolidAngleSample::ByArea,
+        }
     }
 }
 
@@ -253,12 +290,11 @@ impl<S: PlanarShape> AreaLight<S> {
     /// give area sampling, the default, its large stack frame.
     #[inline(never)]
     fn sample_solid_angle(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        match self.shape.solid_angle(ctx.p()) {
-            Some(omega) => {
-                let point = self.shape.sample_solid_angle(ctx.p(), u)?;
-                solid_angle_sample(ctx, point, omega, &self.emission)
+        match self.shape.sample_solid_angle(ctx.p(), u) {
+            SolidAngleSample::Uniform { point, omega } => {
+                solid_angle_sample(ctx, point?, omega, &self.emission)
             }
-            None => self.sample_area(ctx, u),
+            SolidAngleSample::ByArea => self.sample_area(ctx, u),
         }
     }
 

@@ -8,7 +8,7 @@ use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2
 
 use lumis_sampling::{SphericalRectangle, MIN_SPHERICAL_SAMPLE_AREA};
 
-use crate::area::{AreaLight, Emission, PlanarShape, Sampling, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, PlanarShape, Sampling, SolidAngleSample, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -29,6 +29,20 @@ pub struct Quad {
 
 /// The emission of a quad shape.
 pub type QuadLight = AreaLight<Quad>;
+
+impl Quad {
+    /// The spherical rectangle and its area (Urena et al. 2013, eq. 1),
+    /// when the quad is a rectangle and subtends at least
+    /// [`MIN_SPHERICAL_SAMPLE_AREA`]: below that the angle sum cancels and
+    /// area sampling is nearly as good. Skewed parallelograms always sample
+    /// by area.
+    #[inline]
+    fn spherical(&self, p: Vec3) -> Option<(SphericalRectangle, f32)> {
+        let spherical = SphericalRectangle::new(self.corner, self.edge_u, self.edge_v, p)?;
+        let omega = spherical.solid_angle();
+        (omega >= f64::from(MIN_SPHERICAL_SAMPLE_AREA)).then_some((spherical, omega as f32))
+    }
+}
 
 impl QuadLight {
     pub fn new(corner: Vec3, edge_u: Vec3, edge_v: Vec3, emission: Emission) -> Result<Self> {
@@ -107,20 +121,14 @@ impl PlanarShape for Quad {
         ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t)
     }
 
-    /// The spherical rectangle's area (Urena et al. 2013, eq. 1), when the
-    /// quad is a rectangle and subtends at least
-    /// [`MIN_SPHERICAL_SAMPLE_AREA`]: below that the angle sum cancels and
-    /// area sampling is nearly as good. Skewed parallelograms always sample
-    /// by area.
     fn solid_angle(&self, p: Vec3) -> Option<f32> {
-        let omega =
-            SphericalRectangle::new(self.corner, self.edge_u, self.edge_v, p)?.solid_angle();
-        (omega >= f64::from(MIN_SPHERICAL_SAMPLE_AREA)).then_some(omega as f32)
+        self.spherical(p).map(|(_, omega)| omega)
     }
 
-    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> Option<SurfacePoint> {
-        let st = SphericalRectangle::new(self.corner, self.edge_u, self.edge_v, p)?.sample(u);
-        Some(self.sample_point(st))
+    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> SolidAngleSample {
+        SolidAngleSample::from_spherical(self.spherical(p), |rectangle| {
+            Some(self.sample_point(rectangle.sample(u)))
+        })
     }
 }
 

@@ -8,7 +8,7 @@ use lumis_sampling::{
     warp, SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
 };
 
-use crate::area::{AreaLight, Emission, PlanarShape, Sampling, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, PlanarShape, Sampling, SolidAngleSample, EMISSION_PARAMS};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -64,6 +64,22 @@ impl TriangleLight {
 }
 
 impl Triangle {
+    /// Arvo's spherical triangle and its solid angle, where the triangle
+    /// subtends between [`MIN_SPHERICAL_SAMPLE_AREA`] (3e-4 sr: below it
+    /// the construction loses precision; a triangle of area `A` at distance
+    /// `d` subtends about `A / d^2`, so a unit triangle beyond ~40 units)
+    /// and [`MAX_SPHERICAL_SAMPLE_AREA`] (6.22 sr: a shading point almost
+    /// in a huge triangle's plane close to it, where the arcs degenerate).
+    /// Elsewhere the light samples by area (pbrt-v4 `Triangle::Sample`).
+    #[inline]
+    fn spherical(&self, p: Vec3) -> Option<(SphericalTriangle, f32)> {
+        let spherical = SphericalTriangle::new(self.p, p)?;
+        let omega = spherical.solid_angle() as f32;
+        (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA)
+            .contains(&omega)
+            .then_some((spherical, omega))
+    }
+
     /// The point with barycentrics `b`, with its error bound.
     fn point_at(&self, b: [f32; 3]) -> SurfacePoint {
         let (q0, q1, q2) = (self.p[0] * b[0], self.p[1] * b[1], self.p[2] * b[2]);
@@ -90,23 +106,14 @@ impl PlanarShape for Triangle {
         self.point_at([b.x, b.y, 1.0 - b.x - b.y])
     }
 
-    /// Arvo's spherical triangle, used where it subtends between
-    /// [`MIN_SPHERICAL_SAMPLE_AREA`] (3e-4 sr: below it the spherical excess
-    /// cancels; a triangle of area `A` at distance `d` subtends about
-    /// `A / d^2`, so a unit triangle beyond ~40 units) and
-    /// [`MAX_SPHERICAL_SAMPLE_AREA`] (6.22 sr: a shading point almost in a
-    /// huge triangle's plane close to it, where the arcs degenerate).
-    /// Elsewhere the light samples by area (pbrt-v4 `Triangle::Sample`).
     fn solid_angle(&self, p: Vec3) -> Option<f32> {
-        let omega = SphericalTriangle::new(self.p, p)?.solid_angle() as f32;
-        (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA)
-            .contains(&omega)
-            .then_some(omega)
+        self.spherical(p).map(|(_, omega)| omega)
     }
 
-    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> Option<SurfacePoint> {
-        let b = SphericalTriangle::new(self.p, p)?.sample(u)?;
-        Some(self.point_at(b))
+    fn sample_solid_angle(&self, p: Vec3, u: Vec2) -> SolidAngleSample {
+        SolidAngleSample::from_spherical(self.spherical(p), |triangle| {
+            triangle.sample(u).map(|b| self.point_at(b))
+        })
     }
 
     /// Moller-Trumbore ray/triangle test (1997, JGT 2(1)).
