@@ -3,7 +3,7 @@
 //! URIs, broken files), checked through ray queries on the loaded scene and
 //! through renders that must equal the same geometry given inline in TOML.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use lumis_core::registry::TableRef;
 use lumis_core::{BsdfContext, Location, Ray, Scene, Vec2, Vec3};
@@ -29,14 +29,12 @@ type = "diffuse"
 reflectance = 0.5
 "#;
 
-/// A fresh directory for one test's files.
-fn test_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir()
-        .join(format!("lumis-gltf-tests-{}", std::process::id()))
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory for one test's files, removed when the test ends.
+fn test_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("lumis-gltf-tests-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn try_load(dir: &Path, toml: &str) -> Result<LoadedScene, String> {
@@ -95,7 +93,8 @@ fn close(a: Vec3, b: Vec3) -> bool {
 
 #[test]
 fn node_transforms_compose_with_the_toml_transform() {
-    let dir = test_dir("transforms");
+    let tmp = test_dir("transforms");
+    let dir = tmp.path();
     // Parent translates by +5 in x, child scales by 2: the triangle spans
     // (5, 0)-(7, 0)-(5, 2).
     let asset = one_mesh(
@@ -113,8 +112,8 @@ fn node_transforms_compose_with_the_toml_transform() {
         ],
         vec![0],
     );
-    let file = gltf_writer::write(&dir, "nodes", &asset, Container::External);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "nodes", &asset, Container::External);
+    let scene = load(dir, &gltf_shape(&file, ""));
     let (p, n, _) = down(&scene, 5.4, 1.5).expect("inside the scaled, moved triangle");
     assert!(
         close(p, Vec3::new(5.4, 1.5, 0.0)) && close(n, Vec3::Z),
@@ -128,7 +127,7 @@ fn node_transforms_compose_with_the_toml_transform() {
     // The TOML transform applies on top: rotate 90 degrees about x, then
     // lift by 1 in y. The triangle now lies in the xz plane at y = 1.
     let scene = load(
-        &dir,
+        dir,
         &gltf_shape(
             &file,
             "transform = { rotate = [1.0, 0.0, 0.0, 90.0], translate = [0.0, 1.0, 0.0] }",
@@ -154,8 +153,8 @@ fn node_transforms_compose_with_the_toml_transform() {
         }],
         vec![0],
     );
-    let file = gltf_writer::write(&dir, "matrix", &asset, Container::External);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "matrix", &asset, Container::External);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert!(close(
         down(&scene, 5.4, 1.5).unwrap().0,
         Vec3::new(5.4, 1.5, 0.0)
@@ -164,7 +163,8 @@ fn node_transforms_compose_with_the_toml_transform() {
 
 #[test]
 fn a_mesh_used_by_several_nodes_is_instanced_once() {
-    let dir = test_dir("instancing");
+    let tmp = test_dir("instancing");
+    let dir = tmp.path();
     let quad = Primitive::triangles(
         vec![
             [0.0, 0.0, 0.0],
@@ -189,8 +189,8 @@ fn a_mesh_used_by_several_nodes_is_instanced_once() {
         vec![at(0.0), at(3.0), at(6.0), mirrored],
         vec![0, 1, 2, 3],
     );
-    let file = gltf_writer::write(&dir, "instances", &asset, Container::External);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "instances", &asset, Container::External);
+    let scene = load(dir, &gltf_shape(&file, ""));
     let c = scene.scene.counts();
     assert_eq!(
         (c.instances, c.prototypes, c.unique_triangles, c.triangles),
@@ -210,10 +210,10 @@ fn a_mesh_used_by_several_nodes_is_instanced_once() {
     assert!(down(&scene, 2.0, 0.5).is_none());
     // One copy of the mesh data, not four.
     let one = load(
-        &dir,
+        dir,
         &gltf_shape(
             &gltf_writer::write(
-                &dir,
+                dir,
                 "single",
                 &one_mesh(
                     asset.meshes[0].primitives[0].clone(),
@@ -255,15 +255,16 @@ fn hinge(angle_deg: f32) -> Primitive {
 
 #[test]
 fn missing_normals_are_generated_with_a_crease_angle() {
-    let dir = test_dir("normals");
+    let tmp = test_dir("normals");
+    let dir = tmp.path();
     let gentle = gltf_writer::write(
-        &dir,
+        dir,
         "gentle",
         &one_mesh(hinge(10.0), vec![mesh_node(0)], vec![0]),
         Container::External,
     );
     let sharp = gltf_writer::write(
-        &dir,
+        dir,
         "sharp",
         &one_mesh(hinge(60.0), vec![mesh_node(0)], vec![0]),
         Container::External,
@@ -271,7 +272,7 @@ fn missing_normals_are_generated_with_a_crease_angle() {
 
     // Near the fold of a gentle bend the shading normal leans toward the
     // other face.
-    let scene = load(&dir, &gltf_shape(&gentle, ""));
+    let scene = load(dir, &gltf_shape(&gentle, ""));
     assert!(scene.scene.counts().shading_normals);
     let (_, n, ns) = down(&scene, 0.0, 0.01).unwrap();
     assert!(
@@ -283,16 +284,16 @@ fn missing_normals_are_generated_with_a_crease_angle() {
     assert!(ns.dot(n) > 0.99999, "n {n}, ns {ns}");
 
     // A fold sharper than the crease angle stays sharp.
-    let scene = load(&dir, &gltf_shape(&sharp, ""));
+    let scene = load(dir, &gltf_shape(&sharp, ""));
     let (_, n, ns) = down(&scene, 0.0, 0.01).unwrap();
     assert!(close(ns, n), "n {n}, ns {ns}");
     // ...unless the crease angle allows it.
-    let scene = load(&dir, &gltf_shape(&sharp, "crease_angle = 90.0"));
+    let scene = load(dir, &gltf_shape(&sharp, "crease_angle = 90.0"));
     let (_, n, ns) = down(&scene, 0.0, 0.01).unwrap();
     assert!(ns.dot(n) < 0.99, "n {n}, ns {ns}");
 
     // crease_angle = 0: flat shading, no normals stored.
-    let scene = load(&dir, &gltf_shape(&gentle, "crease_angle = 0.0"));
+    let scene = load(dir, &gltf_shape(&gentle, "crease_angle = 0.0"));
     assert!(!scene.scene.counts().shading_normals);
     let (_, n, ns) = down(&scene, 0.0, 0.01).unwrap();
     assert_eq!(n, ns);
@@ -302,12 +303,12 @@ fn missing_normals_are_generated_with_a_crease_angle() {
     let tilted = Vec3::new(0.0, 0.6, 0.8);
     with_normals.normals = Some(vec![tilted.into(); 3]);
     let file = gltf_writer::write(
-        &dir,
+        dir,
         "given",
         &one_mesh(with_normals, vec![mesh_node(0)], vec![0]),
         Container::External,
     );
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let scene = load(dir, &gltf_shape(&file, ""));
     let (_, _, ns) = down(&scene, 0.2, 0.2).unwrap();
     assert!(close(ns, tilted), "{ns}");
 }
@@ -384,9 +385,10 @@ fn two_primitives() -> Asset {
 
 #[test]
 fn primitives_materials_and_overrides() {
-    let dir = test_dir("materials");
-    let file = gltf_writer::write(&dir, "two", &two_primitives(), Container::External);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let tmp = test_dir("materials");
+    let dir = tmp.path();
+    let file = gltf_writer::write(dir, "two", &two_primitives(), Container::External);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert_eq!(scene.scene.counts().meshes, 2);
     assert!(near(
         reflectance_at(&scene, 0.2, 0.2),
@@ -398,7 +400,7 @@ fn primitives_materials_and_overrides() {
     ));
 
     let scene = load(
-        &dir,
+        dir,
         &gltf_shape(&file, "bsdf_overrides = { red = \"white\" }"),
     );
     assert!(near(reflectance_at(&scene, 0.2, 0.2), [0.5; 3]));
@@ -407,11 +409,11 @@ fn primitives_materials_and_overrides() {
         dielectric([0.1, 0.7, 0.2])
     ));
 
-    let scene = load(&dir, &gltf_shape(&file, "bsdf = \"white\""));
+    let scene = load(dir, &gltf_shape(&file, "bsdf = \"white\""));
     assert!(near(reflectance_at(&scene, 2.2, 0.2), [0.5; 3]));
 
     let err = try_load(
-        &dir,
+        dir,
         &gltf_shape(&file, "bsdf_overrides = { blue = \"white\" }"),
     )
     .err()
@@ -423,7 +425,7 @@ fn primitives_materials_and_overrides() {
         "{err}"
     );
     let err = try_load(
-        &dir,
+        dir,
         &gltf_shape(&file, "bsdf_overrides = { red = \"chrome\" }"),
     )
     .err()
@@ -451,7 +453,8 @@ fn render_image(scene: &LoadedScene) -> Vec<f32> {
 
 #[test]
 fn glb_data_uri_and_external_buffers_load_the_same() {
-    let dir = test_dir("containers");
+    let tmp = test_dir("containers");
+    let dir = tmp.path();
     let asset = two_primitives();
     let mut images = Vec::new();
     for (name, container) in [
@@ -459,10 +462,10 @@ fn glb_data_uri_and_external_buffers_load_the_same() {
         ("embedded", Container::DataUri),
         ("binary", Container::Glb),
     ] {
-        let file = gltf_writer::write(&dir, name, &asset, container);
+        let file = gltf_writer::write(dir, name, &asset, container);
         let toml = gltf_shape(&file, "")
             + "[[light]]\ntype = \"point\"\nposition = [1.0, 0.5, 2.0]\nintensity = [4.0, 4.0, 4.0]\n";
-        let scene = load(&dir, &toml);
+        let scene = load(dir, &toml);
         assert!(
             near(
                 reflectance_at(&scene, 2.2, 0.2),
@@ -521,7 +524,8 @@ emission = {{ radiance = [3.0, 3.0, 3.0] }}
 
 #[test]
 fn a_gltf_triangle_renders_bit_for_bit_like_the_inline_one() {
-    let dir = test_dir("bit-for-bit");
+    let tmp = test_dir("bit-for-bit");
+    let dir = tmp.path();
     let mut tri = triangle();
     tri.material = Some(0);
     tri.normals = Some(vec![[0.0, 0.0, 1.0], [0.0, 0.6, 0.8], [0.6, 0.0, 0.8]]);
@@ -529,13 +533,13 @@ fn a_gltf_triangle_renders_bit_for_bit_like_the_inline_one() {
         materials: vec![Material::dielectric("grey", [0.8, 0.6, 0.4])],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "tri", &asset, Container::Glb);
+    let file = gltf_writer::write(dir, "tri", &asset, Container::Glb);
     let from_gltf = load(
-        &dir,
+        dir,
         &lit_scene(&format!("[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\n")),
     );
     let inline = load(
-        &dir,
+        dir,
         &lit_scene(
             "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n\
              indices = [0, 1, 2]\nnormals = [[0.0, 0.0, 1.0], [0.0, 0.6, 0.8], [0.6, 0.0, 0.8]]\nbsdf = \"grey\"\n",
@@ -554,7 +558,8 @@ fn a_gltf_triangle_renders_bit_for_bit_like_the_inline_one() {
 fn metals_render_as_the_conductor_they_map_to() {
     // metallic 1, roughness 0.5: a GGX conductor of alpha = 0.5^2 whose
     // reflectance is the base colour.
-    let dir = test_dir("metal");
+    let tmp = test_dir("metal");
+    let dir = tmp.path();
     let mut tri = triangle();
     tri.material = Some(0);
     let asset = Asset {
@@ -565,14 +570,14 @@ fn metals_render_as_the_conductor_they_map_to() {
         }],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "metal", &asset, Container::Glb);
+    let file = gltf_writer::write(dir, "metal", &asset, Container::Glb);
     let from_gltf = load(
-        &dir,
+        dir,
         &lit_scene(&format!("[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\n")),
     );
     assert!(from_gltf.scene.load_report().warnings.is_empty());
     let inline = load(
-        &dir,
+        dir,
         &lit_scene(
             "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n\
              indices = [0, 1, 2]\nbsdf = \"gold\"\n\
@@ -594,7 +599,8 @@ fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
     // A smooth (roughness 0) white dielectric with a pure red base colour
     // texture renders as the inline plastic whose base is red: the coat
     // still mirrors the white light.
-    let dir = test_dir("textured-coat");
+    let tmp = test_dir("textured-coat");
+    let dir = tmp.path();
     let mut tri = triangle();
     tri.material = Some(0);
     tri.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
@@ -607,9 +613,9 @@ fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
         images: vec![gltf_writer::png_rgb8(1, 1, &[[255, 0, 0]])],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "red", &asset, Container::Glb);
+    let file = gltf_writer::write(dir, "red", &asset, Container::Glb);
     let from_gltf = load(
-        &dir,
+        dir,
         &lit_scene(&format!("[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\n")),
     );
     assert!(from_gltf.scene.load_report().warnings.is_empty());
@@ -636,7 +642,7 @@ fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
     // rounding of the bilinear lookup; its green and blue are the
     // highlights of the white coat.
     let inline = load(
-        &dir,
+        dir,
         &lit_scene(&format!(
             "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\n\
              indices = [0, 1, 2]\nbsdf = \"red\"\n\
@@ -655,7 +661,8 @@ fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
 
 #[test]
 fn double_sided_materials_reflect_from_behind_as_from_the_front() {
-    let dir = test_dir("double-sided");
+    let tmp = test_dir("double-sided");
+    let dir = tmp.path();
     let mut tri = triangle();
     tri.material = Some(0);
     let asset = Asset {
@@ -665,8 +672,8 @@ fn double_sided_materials_reflect_from_behind_as_from_the_front() {
         }],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "leaf", &asset, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "leaf", &asset, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     let hit = scene
         .scene
         .intersect(&Ray::new(Vec3::new(0.2, 0.2, -10.0), Vec3::Z))
@@ -693,7 +700,8 @@ fn double_sided_materials_reflect_from_behind_as_from_the_front() {
 
 #[test]
 fn emissive_materials_become_triangle_lights() {
-    let dir = test_dir("emissive");
+    let tmp = test_dir("emissive");
+    let dir = tmp.path();
     // An emitting triangle above a white floor, facing down.
     let mut light = Primitive::triangles(
         vec![[0.0, 0.0, 1.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]],
@@ -707,7 +715,7 @@ fn emissive_materials_become_triangle_lights() {
         }],
         ..one_mesh(light, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "lamp", &asset, Container::External);
+    let file = gltf_writer::write(dir, "lamp", &asset, Container::External);
     let floor = "[[shape]]\ntype = \"quad\"\ncorner = [-1.0, -1.0, 0.0]\nedge_u = [3.0, 0.0, 0.0]\nedge_v = [0.0, 3.0, 0.0]\nbsdf = \"white\"\n";
     let scene = |shape: &str| {
         format!(
@@ -717,14 +725,14 @@ fn emissive_materials_become_triangle_lights() {
         )
     };
     let from_gltf = load(
-        &dir,
+        dir,
         &scene(&format!(
             "[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\nbsdf = \"white\"\n"
         )),
     );
     assert_eq!(from_gltf.scene.counts().area_lights, 1);
     let inline = load(
-        &dir,
+        dir,
         &scene(
             "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 1.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]]\n\
              indices = [0, 1, 2]\nbsdf = \"white\"\nemission = { radiance = [1.0, 0.9, 0.8] }\n",
@@ -740,7 +748,8 @@ fn emissive_materials_become_triangle_lights() {
 
 #[test]
 fn cameras_are_selected_by_name_or_index() {
-    let dir = test_dir("cameras");
+    let tmp = test_dir("cameras");
+    let dir = tmp.path();
     let mut asset = one_mesh(triangle(), vec![mesh_node(0)], vec![0, 1, 2]);
     asset.cameras = vec![
         Camera {
@@ -762,7 +771,7 @@ fn cameras_are_selected_by_name_or_index() {
         translation: Some([0.2, 0.3, 5.0]),
         ..Node::default()
     });
-    let file = gltf_writer::write(&dir, "cams", &asset, Container::External);
+    let file = gltf_writer::write(dir, "cams", &asset, Container::External);
     let with_camera = |camera: &str| {
         BASE.replace(
             "type = \"perspective\"\norigin = [0.0, 0.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nfov = 40.0\n",
@@ -780,7 +789,7 @@ fn cameras_are_selected_by_name_or_index() {
     let pixel = lumis_core::UVec2::new(3, 11);
     let offset = lumis_core::Vec2::new(0.25, 0.5);
     for selector in ["name = \"front\"", "index = 1"] {
-        let scene = load(&dir, &with_camera(selector));
+        let scene = load(dir, &with_camera(selector));
         let (a, b) = (
             scene.camera.generate_ray(pixel, offset),
             expected.generate_ray(pixel, offset),
@@ -790,12 +799,12 @@ fn cameras_are_selected_by_name_or_index() {
             "{selector}: {a:?} vs {b:?}"
         );
     }
-    let first = load(&dir, &with_camera(""));
+    let first = load(dir, &with_camera(""));
     assert!(close(
         first.camera.generate_ray(pixel, offset).o,
         Vec3::new(0.0, 0.0, 9.0)
     ));
-    let err = try_load(&dir, &with_camera("name = \"back\""))
+    let err = try_load(dir, &with_camera("name = \"back\""))
         .err()
         .unwrap();
     assert!(
@@ -831,10 +840,11 @@ fn assert_names(err: &str, parts: &[&str]) {
 
 #[test]
 fn broken_files_get_errors_naming_file_and_mesh() {
-    let dir = test_dir("broken");
+    let tmp = test_dir("broken");
+    let dir = tmp.path();
     let mut out_of_range = triangle();
     out_of_range.indices = Some(vec![0, 1, 7]);
-    let err = broken(&dir, "range", out_of_range);
+    let err = broken(dir, "range", out_of_range);
     assert_names(
         &err,
         &[
@@ -848,7 +858,7 @@ fn broken_files_get_errors_naming_file_and_mesh() {
 
     let mut lines = triangle();
     lines.mode = 1;
-    let err = broken(&dir, "lines", lines);
+    let err = broken(dir, "lines", lines);
     assert_names(
         &err,
         &[
@@ -861,18 +871,18 @@ fn broken_files_get_errors_naming_file_and_mesh() {
 
     let mut ragged = triangle();
     ragged.indices = Some(vec![0, 1]);
-    let err = broken(&dir, "ragged", ragged);
+    let err = broken(dir, "ragged", ragged);
     assert_names(
         &err,
         &["mesh \"broken\"", "not a whole number of triangles"],
     );
 
     // Truncated buffer: cut the .bin short.
-    let file = gltf_writer::write(&dir, "short", &two_primitives(), Container::External);
+    let file = gltf_writer::write(dir, "short", &two_primitives(), Container::External);
     let bin = dir.join("short.bin");
     let bytes = std::fs::read(&bin).unwrap();
     std::fs::write(&bin, &bytes[..bytes.len() / 2]).unwrap();
-    let err = try_load(&dir, &gltf_shape(&file, "")).err().unwrap();
+    let err = try_load(dir, &gltf_shape(&file, "")).err().unwrap();
     assert_names(
         &err,
         &["test.toml:", "short.gltf", "buffer #0", "truncated"],
@@ -880,7 +890,7 @@ fn broken_files_get_errors_naming_file_and_mesh() {
 
     // A missing .bin.
     std::fs::remove_file(&bin).unwrap();
-    let err = try_load(&dir, &gltf_shape(&file, "")).err().unwrap();
+    let err = try_load(dir, &gltf_shape(&file, "")).err().unwrap();
     assert_names(
         &err,
         &["short.gltf", "buffer #0", "cannot read", "short.bin"],
@@ -888,20 +898,18 @@ fn broken_files_get_errors_naming_file_and_mesh() {
 
     // Not glTF at all, and a missing file.
     std::fs::write(dir.join("junk.gltf"), "{ not json").unwrap();
-    let err = try_load(&dir, &gltf_shape("junk.gltf", "")).err().unwrap();
+    let err = try_load(dir, &gltf_shape("junk.gltf", "")).err().unwrap();
     assert_names(&err, &["junk.gltf", "not a valid glTF 2.0 file"]);
-    let err = try_load(&dir, &gltf_shape("nowhere.glb", ""))
-        .err()
-        .unwrap();
+    let err = try_load(dir, &gltf_shape("nowhere.glb", "")).err().unwrap();
     assert_names(&err, &["nowhere.glb", "cannot read glTF"]);
 
     // TOML errors are located too.
-    let err = try_load(&dir, &gltf_shape("range.gltf", "crease_angle = 200.0"))
+    let err = try_load(dir, &gltf_shape("range.gltf", "crease_angle = 200.0"))
         .err()
         .unwrap();
     assert_names(&err, &["test.toml:", "crease_angle", "[0, 180]"]);
     let err = try_load(
-        &dir,
+        dir,
         &gltf_shape("range.gltf", "transform = { scale = [0.0, 1.0, 1.0] }"),
     )
     .err()
@@ -911,9 +919,10 @@ fn broken_files_get_errors_naming_file_and_mesh() {
 
 #[test]
 fn accel_options_are_checked() {
-    let dir = test_dir("accel");
+    let tmp = test_dir("accel");
+    let dir = tmp.path();
     let file = gltf_writer::write(
-        &dir,
+        dir,
         "tri",
         &one_mesh(triangle(), vec![mesh_node(0)], vec![0]),
         Container::Glb,
@@ -921,11 +930,11 @@ fn accel_options_are_checked() {
     for quality in ["low", "medium", "high"] {
         let toml = gltf_shape(&file, "")
             + &format!("[accel]\nquality = \"{quality}\"\nrobust = true\ncompact = true\n");
-        let scene = load(&dir, &toml);
+        let scene = load(dir, &toml);
         assert!(down(&scene, 0.2, 0.2).is_some(), "{quality}");
     }
     let err = try_load(
-        &dir,
+        dir,
         &(gltf_shape(&file, "") + "[accel]\nquality = \"ultra\"\n"),
     )
     .err()
@@ -938,7 +947,8 @@ fn accel_options_are_checked() {
 
 #[test]
 fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
-    let dir = test_dir("textures");
+    let tmp = test_dir("textures");
+    let dir = tmp.path();
     // 2x2 texels, rows from the top: red, green / blue, white (sRGB 255 and
     // 0 are linear 1 and 0).
     let png = gltf_writer::png_rgb8(
@@ -960,8 +970,8 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
         images: vec![png],
         ..one_mesh(tri.clone(), vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "checker", &asset, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "checker", &asset, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert!(
         scene.scene.load_report().warnings.is_empty(),
         "{:?}",
@@ -992,8 +1002,8 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
         }],
         ..asset.clone()
     };
-    let file = gltf_writer::write(&dir, "shifted", &shifted, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "shifted", &shifted, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert!(
         scene.scene.load_report().warnings.is_empty(),
         "{:?}",
@@ -1017,8 +1027,8 @@ fn base_colour_textures_are_looked_up_at_the_interpolated_uv() {
         }],
         ..asset
     };
-    let file = gltf_writer::write(&dir, "no-uvs", &asset, Container::Glb);
-    let err = try_load(&dir, &gltf_shape(&file, "")).err().unwrap();
+    let file = gltf_writer::write(dir, "no-uvs", &asset, Container::Glb);
+    let err = try_load(dir, &gltf_shape(&file, "")).err().unwrap();
     assert_names(
         &err,
         &[
@@ -1044,7 +1054,8 @@ fn reflectance_at_uv(scene: &LoadedScene, x: f32, y: f32) -> [f32; 3] {
 
 #[test]
 fn what_is_not_modelled_is_reported() {
-    let dir = test_dir("warnings");
+    let tmp = test_dir("warnings");
+    let dir = tmp.path();
     let mut tri = triangle();
     tri.material = Some(0);
     let asset = Asset {
@@ -1055,8 +1066,8 @@ fn what_is_not_modelled_is_reported() {
         }],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "gold", &asset, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "gold", &asset, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     let report = scene.scene.load_report();
     assert!(
         report.warnings.iter().any(|w| w.contains("gold.glb")
@@ -1072,13 +1083,14 @@ fn what_is_not_modelled_is_reported() {
         .iter()
         .any(|l| l.starts_with("warning:") && l.contains("gold")));
     // Overridden, the material's BSDF is not used: no warning.
-    let scene = load(&dir, &gltf_shape(&file, "bsdf = \"white\""));
+    let scene = load(dir, &gltf_shape(&file, "bsdf = \"white\""));
     assert!(scene.scene.load_report().warnings.is_empty());
 }
 
 #[test]
 fn emissive_instances_get_their_own_world_space_lights() {
-    let dir = test_dir("emissive-instances");
+    let tmp = test_dir("emissive-instances");
+    let dir = tmp.path();
     let mut panel = Primitive::triangles(
         vec![
             [0.0, 0.0, 0.0],
@@ -1100,8 +1112,8 @@ fn emissive_instances_get_their_own_world_space_lights() {
         }],
         ..one_mesh(panel, vec![at(0.0), at(4.0)], vec![0, 1])
     };
-    let file = gltf_writer::write(&dir, "panels", &asset, Container::External);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "panels", &asset, Container::External);
+    let scene = load(dir, &gltf_shape(&file, ""));
     let c = scene.scene.counts();
     assert_eq!((c.instances, c.area_lights), (2, 4), "{c:?}");
     let mut seen = Vec::new();
@@ -1174,7 +1186,8 @@ fn bumps() -> Primitive {
 
 #[test]
 fn instanced_and_baked_meshes_render_alike() {
-    let dir = test_dir("instanced-vs-baked");
+    let tmp = test_dir("instanced-vs-baked");
+    let dir = tmp.path();
     let placed = [
         Node {
             translation: Some([-1.1, -0.5, 0.0]),
@@ -1189,19 +1202,19 @@ fn instanced_and_baked_meshes_render_alike() {
         },
     ];
     let instanced = gltf_writer::write(
-        &dir,
+        dir,
         "both",
         &one_mesh(bumps(), placed.to_vec(), vec![0, 1]),
         Container::Glb,
     );
     let first = gltf_writer::write(
-        &dir,
+        dir,
         "first",
         &one_mesh(bumps(), vec![placed[0].clone()], vec![0]),
         Container::Glb,
     );
     let second = gltf_writer::write(
-        &dir,
+        dir,
         "second",
         &one_mesh(bumps(), vec![placed[1].clone()], vec![0]),
         Container::Glb,
@@ -1216,14 +1229,14 @@ fn instanced_and_baked_meshes_render_alike() {
         )
     };
     let a = load(
-        &dir,
+        dir,
         &scene(&format!(
             "[[shape]]\ntype = \"gltf\"\nfile = \"{instanced}\"\nbsdf = \"white\"\n"
         )),
     );
     assert_eq!(a.scene.counts().instances, 2);
     let b = load(
-        &dir,
+        dir,
         &scene(&format!(
             "[[shape]]\ntype = \"gltf\"\nfile = \"{first}\"\nbsdf = \"white\"\n[[shape]]\ntype = \"gltf\"\nfile = \"{second}\"\nbsdf = \"white\"\n"
         )),
@@ -1261,7 +1274,8 @@ fn instanced_and_baked_meshes_render_alike() {
 
 #[test]
 fn jpeg_base_colour_textures_are_decoded() {
-    let dir = test_dir("jpeg");
+    let tmp = test_dir("jpeg");
+    let dir = tmp.path();
     let (w, h) = (16u32, 16u32);
     let rgb = [200u8, 100, 50];
     let pixels: Vec<u8> = (0..w * h).flat_map(|_| rgb).collect();
@@ -1280,8 +1294,8 @@ fn jpeg_base_colour_textures_are_decoded() {
         images: vec![jpeg],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "photo", &asset, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "photo", &asset, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert!(
         scene.scene.load_report().warnings.is_empty(),
         "{:?}",
@@ -1305,7 +1319,8 @@ fn jpeg_base_colour_textures_are_decoded() {
 
 #[test]
 fn emissive_textures_modulate_the_triangle_lights() {
-    let dir = test_dir("emissive-texture");
+    let tmp = test_dir("emissive-texture");
+    let dir = tmp.path();
     // 4x1 texels: black, black, white, white.
     let png = gltf_writer::png_rgb8(
         4,
@@ -1327,8 +1342,8 @@ fn emissive_textures_modulate_the_triangle_lights() {
         images: vec![png],
         ..one_mesh(tri, vec![mesh_node(0)], vec![0])
     };
-    let file = gltf_writer::write(&dir, "sign", &asset, Container::Glb);
-    let scene = load(&dir, &gltf_shape(&file, ""));
+    let file = gltf_writer::write(dir, "sign", &asset, Container::Glb);
+    let scene = load(dir, &gltf_shape(&file, ""));
     assert!(
         scene.scene.load_report().warnings.is_empty(),
         "{:?}",

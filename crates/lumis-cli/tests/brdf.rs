@@ -1,7 +1,6 @@
 //! `lumis brdf tabulate`, `lumis brdf precompute` and `lumis check-plugin
 //! --set` on a measured table, as a user runs them.
 
-use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn lumis(args: &[&str]) -> Output {
@@ -11,11 +10,12 @@ fn lumis(args: &[&str]) -> Output {
         .expect("lumis runs")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lumis-cli-brdf-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory for one test's files, removed when the test ends.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("lumis-cli-brdf-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn text(o: &Output) -> String {
@@ -28,7 +28,8 @@ fn text(o: &Output) -> String {
 
 #[test]
 fn tabulate_precompute_and_check_a_measured_table() {
-    let dir = scratch("flow");
+    let tmp = scratch("flow");
+    let dir = tmp.path();
     let table = dir.join("gold.binary");
     let table_arg = table.display().to_string();
     let run = lumis(&[
@@ -90,12 +91,13 @@ fn tabulate_precompute_and_check_a_measured_table() {
     let run = lumis(&["check-plugin", "--bsdf", "measured", "--samples", "1000"]);
     assert!(!run.status.success());
     assert!(text(&run).contains("'file' is required"), "{}", text(&run));
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
 fn bad_requests_fail_with_the_reason() {
-    let dir = scratch("bad");
+    let tmp = scratch("bad");
+    let dir = tmp.path();
     let out = dir.join("x.binary").display().to_string();
     let run = lumis(&[
         "brdf",
@@ -117,5 +119,5 @@ fn bad_requests_fail_with_the_reason() {
         "{}",
         text(&run)
     );
-    std::fs::remove_dir_all(&dir).unwrap();
+    std::fs::remove_dir_all(dir).unwrap();
 }

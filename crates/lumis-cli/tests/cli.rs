@@ -1,6 +1,6 @@
 //! The `lumis` binary as a user runs it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn lumis(args: &[&str]) -> Output {
@@ -18,11 +18,12 @@ fn scene(name: &str) -> String {
         .to_string()
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lumis-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory for one test's files, removed when the test ends.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("lumis-cli-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 #[test]
@@ -45,7 +46,8 @@ fn help_documents_every_flag() {
 
 #[test]
 fn renders_exr_and_png_with_a_summary() {
-    let dir = scratch("render");
+    let tmp = scratch("render");
+    let dir = tmp.path();
     let out = dir.join("box.exr");
     let result = lumis(&[
         "render",
@@ -74,7 +76,7 @@ fn renders_exr_and_png_with_a_summary() {
     assert!(image.mean()[0] > 0.0);
     assert!(dir.join("box.png").exists());
     assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
+        std::fs::read_dir(dir).unwrap().count(),
         2,
         "no temporary files left"
     );
@@ -82,7 +84,8 @@ fn renders_exr_and_png_with_a_summary() {
 
 #[test]
 fn failed_render_leaves_no_image() {
-    let dir = scratch("fail");
+    let tmp = scratch("fail");
+    let dir = tmp.path();
     let out = dir.join("missing-dir/box.exr");
     let result = lumis(&[
         "render",
@@ -101,7 +104,7 @@ fn failed_render_leaves_no_image() {
         stderr.starts_with("error:") && stderr.contains("missing-dir"),
         "{stderr}"
     );
-    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+    assert_eq!(std::fs::read_dir(dir).unwrap().count(), 0);
 }
 
 #[test]
@@ -152,7 +155,8 @@ fn check_plugin_checks_a_builtin_bsdf_and_reports_a_table() {
 
 #[test]
 fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
-    let dir = scratch("analyze");
+    let tmp = scratch("analyze");
+    let dir = tmp.path();
     let out = dir.join("out");
     let dump = dir.join("points.csv");
     let run = lumis(&[
@@ -210,7 +214,8 @@ fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
 
 #[test]
 fn samplers_analyze_rejects_unknown_sampler_and_bad_parameters() {
-    let dir = scratch("analyze-errors");
+    let tmp = scratch("analyze-errors");
+    let dir = tmp.path();
     let run = lumis(&[
         "samplers",
         "analyze",
@@ -253,7 +258,8 @@ fn write_exr(path: &Path, width: usize, height: usize, values: &[f32]) {
 
 #[test]
 fn diff_prints_known_numbers_per_region_and_refuses_other_sizes() {
-    let dir = scratch("diff");
+    let tmp = scratch("diff");
+    let dir = tmp.path();
     let (a, b, c) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("c.exr"));
     // Reference (1, 0), image (1.5, 0.1): MSE 0.13, relMSE (0.25/1.01 + 1)/2.
     write_exr(&a, 2, 1, &[1.5, 0.1]);

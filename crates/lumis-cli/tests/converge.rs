@@ -6,11 +6,12 @@ use std::sync::atomic::AtomicBool;
 
 use lumis_cli::{builtin_registry, converge, render_scene_file, ConvergeArgs, RenderArgs};
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("lumis-converge-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+/// A fresh directory for one test's files, removed when the test ends.
+fn scratch(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("lumis-converge-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn scene() -> PathBuf {
@@ -24,7 +25,8 @@ const TINY: &str = "film.resolution=[16, 16]";
 /// spp, is under 1% of the 64-spp error).
 #[test]
 fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
-    let dir = scratch("slope");
+    let tmp = scratch("slope");
+    let dir = tmp.path();
     let registry = builtin_registry().unwrap();
     let reference = dir.join("reference.exr");
     render_scene_file(
@@ -88,7 +90,8 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
 
 #[test]
 fn bad_variants_and_mismatched_reference_are_clear_errors() {
-    let dir = scratch("errors");
+    let tmp = scratch("errors");
+    let dir = tmp.path();
     let registry = builtin_registry().unwrap();
     let variants = dir.join("variants.toml");
     std::fs::write(
@@ -138,7 +141,8 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
 #[test]
 fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
     use lumis_cli::{render_reference, ReferenceArgs};
-    let dir = scratch("reference");
+    let tmp = scratch("reference");
+    let dir = tmp.path();
     let registry = builtin_registry().unwrap();
     let stop = AtomicBool::new(false);
     let args = |spp: u32, output: &str, extra: &[&str]| ReferenceArgs {

@@ -57,16 +57,18 @@ pub(crate) fn flush(w: &mut impl Write) -> Result<(), String> {
 mod tests {
     use super::*;
 
-    fn scratch(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("lumis-atomic-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    /// A fresh directory for one test's files, removed when the test ends.
+    fn scratch(name: &str) -> tempfile::TempDir {
+        tempfile::Builder::new()
+            .prefix(&format!("lumis-atomic-{name}-"))
+            .tempdir()
+            .unwrap()
     }
 
     #[test]
     fn failure_leaves_nothing_behind() {
-        let dir = scratch("fail");
+        let tmp = scratch("fail");
+        let dir = tmp.path();
         let target = dir.join("out.exr");
         let err = write_atomically(&target, |w| {
             w.write_all(b"partial").map_err(|e| e.to_string())?;
@@ -75,7 +77,7 @@ mod tests {
         assert!(err.unwrap_err().to_string().contains("render interrupted"));
         assert!(!target.exists());
         assert_eq!(
-            std::fs::read_dir(&dir).unwrap().count(),
+            std::fs::read_dir(dir).unwrap().count(),
             0,
             "temporary file removed"
         );
@@ -83,14 +85,15 @@ mod tests {
 
     #[test]
     fn failure_keeps_the_previous_file() {
-        let dir = scratch("keep");
+        let tmp = scratch("keep");
+        let dir = tmp.path();
         let target = dir.join("out.png");
         std::fs::write(&target, b"old").unwrap();
         let _ = write_atomically(&target, |_| Err("boom".into()));
         assert_eq!(std::fs::read(&target).unwrap(), b"old");
         write_atomically(&target, |w| w.write_all(b"new").map_err(|e| e.to_string())).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
-        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        assert_eq!(std::fs::read_dir(dir).unwrap().count(), 1);
     }
 
     #[test]
