@@ -128,6 +128,32 @@ fn out_of_range_values() {
 }
 
 #[test]
+fn non_finite_numbers() {
+    let err = load(&BASE.replace("reflectance = 0.5", "reflectance = nan"));
+    assert_contains(&err, &["bad.toml:16:15", "'reflectance'", "finite"]);
+    let err = load(&BASE.replace("fov = 40.0", "fov = inf"));
+    assert_contains(&err, &["bad.toml:7:7", "'fov'", "finite"]);
+    let err = load(&with(
+        "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1e39, 0.0]]\nindices = [0, 1, 2]\nbsdf = \"white\"\n",
+    ));
+    assert_contains(
+        &err,
+        &["bad.toml:19:13", "'positions'", "element 2", "32-bit float"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("nan.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n").unwrap();
+    let err = load(&with(&format!(
+        "[[shape]]\ntype = \"obj\"\nfile = {:?}\nbsdf = \"white\"\n",
+        obj.display().to_string()
+    )));
+    assert_contains(
+        &err,
+        &["bad.toml:19:8", "nan.obj", "vertex position", "not finite"],
+    );
+}
+
+#[test]
 fn mesh_index_out_of_range() {
     let err = load(&with(
         "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\nindices = [0, 1, 3]\nbsdf = \"white\"\n",

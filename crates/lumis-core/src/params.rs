@@ -170,25 +170,44 @@ pub trait FromParam: Sized {
     fn from_node(node: &Node) -> std::result::Result<Self, String>;
 }
 
+/// A finite number: TOML's `nan` and `inf` are valid floats, but no scene
+/// value means them, and a NaN would pass every range check (all its
+/// comparisons are false) and poison the render.
 fn number(node: &Node) -> std::result::Result<f64, String> {
-    match node.value {
-        Value::Float(f) => Ok(f),
-        Value::Int(i) => Ok(i as f64),
-        ref v => Err(format!("expected a number, found {}", v.type_name())),
+    let v = match node.value {
+        Value::Float(f) => f,
+        Value::Int(i) => i as f64,
+        ref v => return Err(format!("expected a number, found {}", v.type_name())),
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("expected a finite number, found {v}"))
     }
 }
 
-fn floats<const N: usize>(node: &Node) -> std::result::Result<[f32; N], String> {
-    let expected = || format!("expected an array of {N} numbers");
+/// A finite number that fits an `f32`.
+fn single(node: &Node) -> std::result::Result<f32, String> {
+    let v = number(node)?;
+    let single = v as f32;
+    if single.is_finite() {
+        Ok(single)
+    } else {
+        Err(format!("{v} is beyond the range of a 32-bit float"))
+    }
+}
+
+/// `N` numbers in an array; `expected` opens every message.
+fn floats<const N: usize>(node: &Node, expected: &str) -> std::result::Result<[f32; N], String> {
     let Value::Array(items) = &node.value else {
-        return Err(format!("{}, found {}", expected(), node.value.type_name()));
+        return Err(format!("{expected}, found {}", node.value.type_name()));
     };
     if items.len() != N {
-        return Err(format!("{}, found {} elements", expected(), items.len()));
+        return Err(format!("{expected}, found {} elements", items.len()));
     }
     let mut out = [0.0; N];
-    for (o, item) in out.iter_mut().zip(items) {
-        *o = number(item).map_err(|e| format!("{}: element {e}", expected()))? as f32;
+    for (i, (o, item)) in out.iter_mut().zip(items).enumerate() {
+        *o = single(item).map_err(|e| format!("{expected}; element {i}: {e}"))?;
     }
     Ok(out)
 }
@@ -201,7 +220,7 @@ impl FromParam for f64 {
 
 impl FromParam for f32 {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        number(node).map(|v| v as f32)
+        single(node)
     }
 }
 
@@ -242,10 +261,8 @@ impl FromParam for String {
 impl FromParam for Rgb {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
         match &node.value {
-            Value::Float(_) | Value::Int(_) => Ok(Rgb::splat(number(node)? as f32)),
-            Value::Array(_) => floats::<3>(node)
-                .map(Rgb::from)
-                .map_err(|_| "expected [r, g, b] or one number".to_string()),
+            Value::Float(_) | Value::Int(_) => Ok(Rgb::splat(single(node)?)),
+            Value::Array(_) => floats::<3>(node, "expected [r, g, b] or one number").map(Rgb::from),
             v => Err(format!(
                 "expected [r, g, b] or one number, found {}",
                 v.type_name()
@@ -256,13 +273,13 @@ impl FromParam for Rgb {
 
 impl FromParam for Vec3 {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        floats::<3>(node).map(Vec3::from)
+        floats::<3>(node, "expected an array of 3 numbers").map(Vec3::from)
     }
 }
 
 impl FromParam for Vec2 {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        floats::<2>(node).map(Vec2::from)
+        floats::<2>(node, "expected an array of 2 numbers").map(Vec2::from)
     }
 }
 
@@ -605,6 +622,34 @@ mod tests {
             err.starts_with("t.toml:1:15") && err.contains("expected [r, g, b]"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn nan_infinity_and_f32_overflow_are_refused() {
+        for (text, says) in [
+            ("reflectance = nan\n", "expected a finite number, found NaN"),
+            (
+                "reflectance = [0.5, nan, 0.5]\n",
+                "element 1: expected a finite number",
+            ),
+            ("reflectance = [0.5, 0.5, -inf]\n", "found -inf"),
+            (
+                "reflectance = 1e300\n",
+                "beyond the range of a 32-bit float",
+            ),
+        ] {
+            let t = params(text);
+            let p = Params::new("bsdf", &t, Location::Builtin, SPEC, &[]).unwrap();
+            let err = p.get::<Rgb>("reflectance").unwrap_err().to_string();
+            assert!(
+                err.starts_with("t.toml:1:15") && err.contains(says),
+                "{text}: {err}"
+            );
+        }
+        let t = params("reflectance = 0.5\nbeta = inf\n");
+        let p = Params::new("bsdf", &t, Location::Builtin, SPEC, &[]).unwrap();
+        let err = p.get::<f32>("beta").unwrap_err().to_string();
+        assert!(err.contains("'beta'") && err.contains("found inf"), "{err}");
     }
 
     #[test]

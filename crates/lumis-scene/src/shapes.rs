@@ -209,6 +209,23 @@ fn obj(params: &Params, scene_dir: &Path) -> Result<ShapeGeometry> {
         let mesh = &model.mesh;
         let base = positions.len() as u32;
         let count = mesh.positions.len() / 3;
+        for (what, values) in [
+            ("vertex position", &mesh.positions),
+            ("normal", &mesh.normals),
+        ] {
+            if let Some(bad) = values
+                .chunks_exact(3)
+                .find(|v| !v.iter().all(|c| c.is_finite()))
+            {
+                return Err(params.error(
+                    "file",
+                    format!(
+                        "'{}': {what} {bad:?} is not finite (NaN, or beyond the range of a 32-bit float)",
+                        path.display()
+                    ),
+                ));
+            }
+        }
         positions.extend(mesh.positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
         if mesh.normals.len() == mesh.positions.len() {
             normals.extend(
