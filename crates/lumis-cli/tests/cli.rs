@@ -83,6 +83,52 @@ fn renders_exr_and_png_with_a_summary() {
 }
 
 #[test]
+fn a_scene_without_lights_renders_with_a_warning() {
+    let tmp = scratch("dark");
+    let dir = tmp.path();
+    let dark = dir.join("dark.toml");
+    std::fs::write(
+        &dark,
+        "[film]\nresolution = [8, 8]\n[camera]\ntype = \"perspective\"\norigin = [0.0, 0.0, 3.0]\n\
+         target = [0.0, 0.0, 0.0]\nfov = 40.0\n[sampler]\ntype = \"independent\"\nspp = 1\n\
+         [integrator]\ntype = \"path\"\n[[bsdf]]\nname = \"white\"\ntype = \"diffuse\"\n\
+         reflectance = 0.5\n[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n\
+         bsdf = \"white\"\n",
+    )
+    .unwrap();
+    let out = dir.join("dark.exr");
+    let result = lumis(&[
+        "render",
+        dark.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(result.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: the scene has no lights"),
+        "{stderr}"
+    );
+    assert_eq!(lumis_image::read_exr(&out).unwrap().mean(), [0.0; 3]);
+    // A lit scene gets no such warning.
+    let lit = lumis(&[
+        "render",
+        &scene("cornell-box.toml"),
+        "--spp",
+        "1",
+        "--set",
+        "film.resolution=[8, 8]",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8(lit.stderr).unwrap();
+    assert!(
+        lit.status.success() && !stderr.contains("no lights"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn failed_render_leaves_no_image() {
     let tmp = scratch("fail");
     let dir = tmp.path();
