@@ -166,7 +166,7 @@ impl Trace for PathIntegrator {
             // that the next ray waits on, and issued before next-event
             // estimation it runs alongside the light sample. Moving the
             // frame change and ray offset up as well measured slower (see
-            // the README's Performance section).
+            // docs/performance-log.md).
             let bsdf_ctx = BsdfContext {
                 uv: hit.uv,
                 ..Default::default()
