@@ -169,6 +169,23 @@ fn scene_errors_exit_nonzero_with_the_location() {
             && stderr.contains("unknown key 'max_dpeth'"),
         "{stderr}"
     );
+    // A film beyond any memory is an error before rendering, not an abort
+    // (its byte count exceeds what an allocation may ask for, so the
+    // answer does not depend on the machine's memory or overcommit policy).
+    let result = lumis(&[
+        "render",
+        &scene("cornell-box.toml"),
+        "--set",
+        "film.resolution=[4000000000, 4000000000]",
+        "-q",
+    ]);
+    assert!(!result.status.success());
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(
+        stderr.starts_with("error: film resolution 4000000000x4000000000")
+            && stderr.contains("GB of memory"),
+        "{stderr}"
+    );
 }
 
 #[test]

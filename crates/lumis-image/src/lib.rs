@@ -28,6 +28,27 @@ impl Image {
         }
     }
 
+    /// A black image, or an error saying how much memory it needed where
+    /// that cannot be allocated (instead of the process aborting).
+    pub fn try_new(width: usize, height: usize) -> Result<Self, String> {
+        let too_large = || {
+            let bytes = width as f64 * height as f64 * std::mem::size_of::<[f32; 3]>() as f64;
+            format!(
+                "a {width}x{height} image needs {:.1} GB of memory, which cannot be allocated",
+                bytes * 1e-9
+            )
+        };
+        let count = width.checked_mul(height).ok_or_else(too_large)?;
+        let mut pixels = Vec::new();
+        pixels.try_reserve_exact(count).map_err(|_| too_large())?;
+        pixels.resize(count, [0.0; 3]);
+        Ok(Self {
+            width,
+            height,
+            pixels,
+        })
+    }
+
     #[inline]
     pub fn get(&self, x: usize, y: usize) -> [f32; 3] {
         self.pixels[y * self.width + x]
@@ -61,4 +82,20 @@ pub enum ImageError {
     },
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn try_new_refuses_what_cannot_be_allocated() {
+        let image = Image::try_new(3, 2).unwrap();
+        assert_eq!(image, Image::new(3, 2));
+        // The pixel count overflows; then the byte count exceeds isize::MAX.
+        for (w, h) in [(usize::MAX / 2, 3), (1 << 32, 1 << 30)] {
+            let err = Image::try_new(w, h).unwrap_err();
+            assert!(err.contains("GB of memory"), "{err}");
+        }
+    }
 }

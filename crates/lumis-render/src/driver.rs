@@ -102,6 +102,14 @@ pub fn render(
         return Err(Error::msg("spp must be at least 1"));
     }
     let resolution = camera.resolution();
+    // The film first: a resolution beyond memory fails now, with a message,
+    // not after the render with an aborted allocation.
+    let mut image = Image::try_new(resolution.x as usize, resolution.y as usize).map_err(|e| {
+        Error::msg(format!(
+            "film resolution {}x{}: {e}",
+            resolution.x, resolution.y
+        ))
+    })?;
     let tiles = tiles(resolution);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads)
@@ -151,7 +159,6 @@ pub fn render(
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
 
-    let mut image = Image::new(resolution.x as usize, resolution.y as usize);
     let mut stats = RenderStats::default();
     for (tile, (pixels, tile_stats)) in tiles.iter().zip(rendered) {
         stats += tile_stats;
