@@ -153,17 +153,17 @@ fn failed_render_leaves_no_image() {
     assert_eq!(std::fs::read_dir(dir).unwrap().count(), 0);
 }
 
+/// `lumis render` of the Cornell box with one `--set`, which must fail:
+/// its stderr.
+fn render_error(set: &str) -> String {
+    let result = lumis(&["render", &scene("cornell-box.toml"), "--set", set, "-q"]);
+    assert!(!result.status.success(), "--set {set} rendered");
+    String::from_utf8(result.stderr).unwrap()
+}
+
 #[test]
 fn scene_errors_exit_nonzero_with_the_location() {
-    let result = lumis(&[
-        "render",
-        &scene("cornell-box.toml"),
-        "--set",
-        "integrator.max_dpeth=3",
-        "-q",
-    ]);
-    assert!(!result.status.success());
-    let stderr = String::from_utf8(result.stderr).unwrap();
+    let stderr = render_error("integrator.max_dpeth=3");
     assert!(
         stderr.contains("--set integrator.max_dpeth=3")
             && stderr.contains("unknown key 'max_dpeth'"),
@@ -172,15 +172,7 @@ fn scene_errors_exit_nonzero_with_the_location() {
     // A film beyond any memory is an error before rendering, not an abort
     // (its byte count exceeds what an allocation may ask for, so the
     // answer does not depend on the machine's memory or overcommit policy).
-    let result = lumis(&[
-        "render",
-        &scene("cornell-box.toml"),
-        "--set",
-        "film.resolution=[4000000000, 4000000000]",
-        "-q",
-    ]);
-    assert!(!result.status.success());
-    let stderr = String::from_utf8(result.stderr).unwrap();
+    let stderr = render_error("film.resolution=[4000000000, 4000000000]");
     assert!(
         stderr.starts_with("error: film resolution 4000000000x4000000000")
             && stderr.contains("GB of memory"),
