@@ -53,7 +53,7 @@ impl RenderReport {
     pub fn summary(&self) -> String {
         let secs = self.seconds.max(1e-9);
         format!(
-            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} rays, {} shadow), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
+            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} closest-hit and {} shadow rays), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
             self.image.width,
             self.image.height,
             self.spp,
