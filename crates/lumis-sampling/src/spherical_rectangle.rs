@@ -2,8 +2,10 @@
 //! and King 2013, "An Area-Preserving Parametrization for Spherical
 //! Rectangles", EGSR; section 3 for the setup, section 4, eqs. 5-9 for the
 //! inversion). Computed in `f64` for the same reason as
-//! [`crate::spherical_triangle`]: the solid angle is a difference of angles
-//! near `2 pi`.
+//! [`crate::spherical_triangle`]: eq. 1's solid angle is a difference of
+//! angles near `2 pi` (here it comes from two triangles' Van Oosterom and
+//! Strackee formulas instead), and the inversion subtracts nearly equal
+//! quantities for small rectangles.
 
 use glam::{DVec3, Vec2, Vec3};
 

@@ -2,9 +2,12 @@
 //! "Stratified Sampling of Spherical Triangles", SIGGRAPH '95, section 3; in
 //! the form of pbrt-v4 `SampleSphericalTriangle`, section 6.5.4).
 //!
-//! Everything is computed in `f64`: the spherical excess `alpha + beta +
-//! gamma - pi` cancels catastrophically as the triangle shrinks, which is why
-//! lights fall back to area sampling below [`MIN_SPHERICAL_SAMPLE_AREA`].
+//! Everything is computed in `f64`. The solid angle comes from Van Oosterom
+//! and Strackee's formula rather than the spherical excess `alpha + beta +
+//! gamma - pi`, which cancels catastrophically as the triangle shrinks; the
+//! inversion still subtracts nearly equal quantities (the arc's cosines near
+//! 1), which is why lights fall back to area sampling below
+//! [`MIN_SPHERICAL_SAMPLE_AREA`].
 
 use glam::{DVec3, Vec2, Vec3};
 
