@@ -27,7 +27,7 @@ pub struct ErrorMetrics {
     pub mean_abs_rel_error: f64,
     /// mean of (a - b) / (|b| + 0.01): a bias shows up here, noise averages out.
     pub mean_signed_rel_error: f64,
-    /// 10 log10(1 / MSE) of the sRGB-encoded, [0,1]-clamped values.
+    /// 10 log10(1 / MSE) of the sRGB-encoded, `[0, 1]`-clamped values.
     pub psnr_db: f64,
     /// Channel values compared.
     pub count: usize,

@@ -1,4 +1,4 @@
-//! Test integrands on [0,1]^d with exact integrals: smooth, discontinuous,
+//! Test integrands on `[0,1]^d` with exact integrals: smooth, discontinuous,
 //! linear and oscillating, the cases that separate sampling patterns.
 
 use std::f64::consts::PI;

@@ -1,4 +1,4 @@
-//! Turn plugin interfaces into (sampler, pdf) pairs for [`crate::chi_square`].
+//! Turn plugin interfaces into (sampler, pdf) pairs for [`crate::chi_square()`].
 
 use lumis_core::{Bsdf, BsdfContext, Light, LightSampleContext, Vec2, Vec3};
 

@@ -1,6 +1,6 @@
 //! The statistical test kit of lumis.
 //!
-//! [`chi_square`] checks that a routine drawing directions is distributed
+//! [`chi_square()`] checks that a routine drawing directions is distributed
 //! exactly as the pdf it claims, with Pearson's chi-square test over a grid
 //! of equal-solid-angle bins (the approach of Mitsuba's and pbrt's sampling
 //! tests). [`adapters`] turn a BSDF's `sample_f`/`pdf` or a light's

@@ -203,11 +203,10 @@ pub trait PlanarShape: Send + Sync {
     }
 
     /// A point whose direction from `p` is uniform in the solid angle the
-    /// shape subtends from there, with that solid angle; [`ByArea`] exactly
-    /// where [`PlanarShape::solid_angle`] is `None`. One call, so that the
-    /// spherical geometry is set up once per sample.
-    ///
-    /// [`ByArea`]: SolidAngleSample::ByArea
+    /// shape subtends from there, with that solid angle;
+    /// `SolidAngleSample::ByArea` exactly where [`PlanarShape::solid_angle`]
+    /// is `None`. One call, so that the spherical geometry is set up once
+    /// per sample.
     fn sample_solid_angle(&self, _p: Vec3, _u: Vec2) -> SolidAngleSample {
         SolidAngleSample::ByArea
     }
