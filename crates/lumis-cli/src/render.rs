@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lumis_core::{Error, RenderStats, Result, Scene};
+use lumis_core::{Error, RenderStats, Result};
 use lumis_image::Image;
 use lumis_render::{render, RenderSettings};
 use lumis_scene::LoadedScene;
@@ -136,11 +136,6 @@ pub fn render_scene_file(
     if !args.quiet {
         for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
             eprintln!("{line}");
-        }
-        // As pbrt-v4 and Mitsuba do: a black image is what such a scene
-        // asks for, but rarely what its author meant.
-        if loaded.scene.lights().is_empty() {
-            eprintln!("warning: the scene has no lights (no emissive shape, [[light]] or environment): the image will be black");
         }
     }
     if args.verbose {

@@ -32,7 +32,8 @@ pub struct LoadReport {
 }
 
 impl LoadReport {
-    /// The report as lines for `lumis render` (stderr, before rendering).
+    /// The report as lines for `lumis render` (stderr, before rendering):
+    /// costs, then warnings.
     pub fn lines(&self, counts: &SceneCounts) -> Vec<String> {
         let unique = counts.unique_triangles.max(1) as f64;
         let mut lines = vec![format!(
@@ -61,6 +62,14 @@ impl LoadReport {
         }
         lines[0].push_str(&format!("; {}", self.compaction_line(counts)));
         lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
+        // As pbrt-v4 and Mitsuba do: a black image is what such a scene
+        // asks for, but rarely what its author meant.
+        if counts.area_lights + counts.delta_lights + counts.infinite_lights == 0 {
+            lines.push(
+                "warning: the scene has no lights (no emissive shape, [[light]] or environment): the image will be black"
+                    .into(),
+            );
+        }
         lines
     }
 
