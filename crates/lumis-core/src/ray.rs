@@ -226,7 +226,7 @@ impl RayOrigins {
     /// The shadow ray from this point to `to`, stopping at `t_max = 1 -
     /// SHADOW_EPSILON`. It leaves from the origin on `to`'s side, and ends
     /// at `to.p` itself where stopping short already keeps it off `to`'s
-    /// surface ([`shadow_ray_clears_end`]: all but 0.7% of the Cornell
+    /// surface (`shadow_ray_clears_end`: all but 0.7% of the Cornell
     /// box's light samples); elsewhere (grazing that surface, or an error
     /// bound large next to the distance) at `to.p` offset off the surface
     /// as pbrt-v4's `SpawnRayTo` does.
