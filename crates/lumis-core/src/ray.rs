@@ -267,13 +267,14 @@ impl RayOrigins {
 /// plane at `to.p`, up to the rounding `rho <= 2^-24 |n| . (|from| +
 /// |to.p|)` of the direction `to.p - from`; the true point lies within
 /// `delta = |n| . p_error` of that plane (pbrt-v4 eq. 6.30). So `(1 -
-/// t_max) |h| > delta + rho` suffices. `|h|` is at least `|n . (p - to.p)|
-/// - |n| . reach`, less that dot product's rounding (`gamma(3)`). Asking
+/// t_max) |h| > delta + rho` suffices. `|h|` is at least
+/// `|n . (p - to.p)| - |n| . reach`, less that dot product's rounding
+/// (`gamma(3)`). Asking
 /// for twice `delta + gamma(4) |n| . (|p| + |to.p|) + |n| . reach` covers
 /// all of it, and the rounding of `t_max` and of the test itself:
 ///
 /// ```text
-/// SHADOW_EPSILON |n . (p - to.p)| >= 2 |n| . (p_error + gamma(4) (|p| + |to.p|) + reach)
+/// SHADOW_EPSILON |n . (p - to.p)| > 2 |n| . (p_error + gamma(4) (|p| + |to.p|) + reach)
 /// ```
 ///
 /// A point without a surface (`n = 0`: point lights, environment
