@@ -1,7 +1,7 @@
 //! The Cornell box of `scenes/cornell-box.toml` against an established
 //! renderer's converged image, estimator agreement, and determinism.
 
-use lumis_core::{Light, LightSampler, Ray, Scene, SurfaceInteraction};
+use lumis_core::{Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec3};
 use lumis_image::read_exr;
 use lumis_render::{render, RenderSettings};
 use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scenes_dir};
@@ -165,4 +165,92 @@ fn concrete_and_dyn_scene_loops_agree() {
         assert_eq!(concrete.image, opaque.image, "{integrator:?}");
         assert_eq!(concrete.stats, opaque.stats, "{integrator:?}");
     }
+}
+
+/// A scene that keeps the fast BVH stores each flat-shaded triangle's
+/// shading frame (`MeshData::flat_frames`); a hit that loads it must see
+/// the surface a hit computing it from Embree's normal sees: the same
+/// point and error bound, and the same frame up to rounding. The compact
+/// build stores none, so it is the computed side. A flipped quad in the
+/// middle of the box checks that the stored frames face the same way.
+#[test]
+fn stored_flat_frames_match_frames_computed_at_the_hit() {
+    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let scene = read_scene("cornell-box.toml")
+        + "\n[[shape]]\ntype = \"quad\"\ncorner = [-0.3, -0.2, 0.2]\n\
+           edge_u = [0.5, 0.1, 0.0]\nedge_v = [0.1, 0.4, 0.3]\n\
+           bsdf = \"white\"\nflip_normals = true\n";
+    let load = |overrides: &[String]| {
+        lumis_scene::load_str(
+            &scene,
+            "test.toml",
+            "test",
+            &scenes_dir(),
+            overrides,
+            &registry,
+        )
+        .expect("the Cornell box loads")
+    };
+    let stored = load(&[]);
+    let computed = load(&["accel.compact=true".to_string()]);
+    let (stored_report, computed_report) =
+        (stored.scene.load_report(), computed.scene.load_report());
+    assert!(!stored_report.compact && computed_report.compact);
+    // 38 flat triangles, one 48-byte frame each.
+    assert_eq!(
+        stored_report.geometry_bytes - computed_report.geometry_bytes,
+        38 * std::mem::size_of::<lumis_core::math::Frame>()
+    );
+
+    let origins = [
+        Vec3::new(0.0, 0.0, 3.9),
+        Vec3::new(0.1, 0.2, 0.3),
+        Vec3::new(-0.7, -0.9, 0.8),
+        Vec3::new(0.6, 0.9, -0.6),
+    ];
+    let (mut hits, mut light_hits, mut flipped_hits) = (0, 0, 0);
+    for o in origins {
+        // Directions on a Fibonacci sphere, so every wall, both boxes and
+        // the light are hit from inside the box.
+        let n = 4000;
+        for i in 0..n {
+            let z = 1.0 - (2 * i + 1) as f32 / n as f32;
+            let phi = i as f32 * 2.399_963;
+            let r = (1.0 - z * z).sqrt();
+            let ray = Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z));
+            let (a, b) = (stored.scene.intersect(&ray), computed.scene.intersect(&ray));
+            let (Some(a), Some(b)) = (a, b) else {
+                assert!(
+                    a.is_none() && b.is_none(),
+                    "one build hit and the other did not: {ray:?}"
+                );
+                continue;
+            };
+            hits += 1;
+            light_hits += usize::from(a.light.is_some());
+            // The quad's edges cross to +z and its front is flipped.
+            let quad_normal = Vec3::new(0.5, 0.1, 0.0)
+                .cross(Vec3::new(0.1, 0.4, 0.3))
+                .normalize();
+            flipped_hits += usize::from((a.n() + quad_normal).length() < 1e-5);
+            assert_eq!(a.point.p, b.point.p);
+            assert_eq!(a.point.p_error, b.point.p_error);
+            assert_eq!((a.light, a.uv), (b.light, b.uv));
+            let close =
+                |u: lumis_core::glam::Vec3A, v: lumis_core::glam::Vec3A| (u - v).length() < 1e-6;
+            assert!((a.n() - b.n()).length() < 1e-6, "{ray:?}");
+            assert!(
+                close(a.shading.x, b.shading.x)
+                    && close(a.shading.y, b.shading.y)
+                    && close(a.shading.z, b.shading.z),
+                "{ray:?}: {:?} against {:?}",
+                a.shading,
+                b.shading
+            );
+        }
+    }
+    assert!(
+        hits > 9_000 && light_hits > 50 && flipped_hits > 50,
+        "only {hits} rays hit, {light_hits} of them the light, {flipped_hits} the flipped quad"
+    );
 }

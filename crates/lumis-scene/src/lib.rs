@@ -227,6 +227,15 @@ pub fn load_str(
     } = asm;
     report.compaction = compaction;
     report.compact = compaction.decide(counts.unique_triangles);
+    if !report.compact {
+        // Scenes that keep the fast BVH also keep flat meshes' frames; a
+        // compact scene is one whose memory matters more.
+        for geometry in &mut geometries {
+            if let Geometry::Mesh(mesh) = geometry {
+                mesh.store_flat_frames();
+            }
+        }
+    }
     let (embree, prototypes) = build_bvhs(builder, pending, &mut geometries, &mut report)?;
     report.bvh_bytes = (device.memory_in_use() - memory_before).max(0) as usize;
     report.geometry_bytes = geometry_bytes(&geometries, &prototypes);
@@ -797,6 +806,7 @@ fn add_shape(owner: &str, desc: ShapeDesc, asm: &mut Assembly) -> Result<Geometr
                 bsdf,
                 lights: light_indices,
                 orientation,
+                flat_frames: Vec::new(),
             }))
         }
         ShapeGeometry::Sphere { center, radius } => {

@@ -236,6 +236,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 bsdf: r.bsdf,
                 lights,
                 orientation: 1.0,
+                flat_frames: Vec::new(),
             };
             asm.counts.shading_normals |= mesh.normals.is_some();
             asm.builder
@@ -265,6 +266,7 @@ pub(crate) fn add(owner: &str, shape: GltfShape, asm: &mut Assembly) -> Result<(
                 bsdf: r.bsdf,
                 lights: Vec::new(),
                 orientation: 1.0,
+                flat_frames: Vec::new(),
             };
             builder
                 .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
