@@ -38,6 +38,24 @@ impl<T: Copy + Default> PaddedBuffer<T> {
     }
 }
 
+impl PaddedBuffer<Vertex> {
+    /// Vertex `i` and the 4 bytes after it, in one 16-byte load: the
+    /// spare element makes them readable for the last vertex too. Lane 3
+    /// is whatever follows (the next vertex's `x`, or the padding's 0).
+    ///
+    /// # Panics
+    /// If `i` is out of range, like indexing.
+    #[inline(always)]
+    pub fn load4(&self, i: usize) -> [f32; 4] {
+        assert!(i < self.items.len() - 1, "vertex index {i} out of range");
+        // SAFETY: `i + 1 < items.len()`, so the 16 bytes from element `i`
+        // (12 of its own, 4 of element `i + 1`) lie inside the allocation;
+        // `read_unaligned` needs no alignment, and every bit pattern is a
+        // valid `f32`.
+        unsafe { std::ptr::read_unaligned(self.items.as_ptr().add(i).cast::<[f32; 4]>()) }
+    }
+}
+
 impl<T: Copy + Default> Deref for PaddedBuffer<T> {
     type Target = [T];
     fn deref(&self) -> &[T] {
@@ -61,5 +79,14 @@ mod tests {
         assert_eq!(b.len(), 1);
         assert_eq!(b[0], [1.0, 2.0, 3.0]);
         assert!(b.byte_size() >= 24);
+    }
+
+    #[test]
+    fn vertex_loads_read_every_vertex_including_the_last() {
+        let b = PaddedBuffer::new(vec![[1.0f32, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+        assert_eq!(b.load4(0), [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(b.load4(1), [4.0, 5.0, 6.0, 0.0]);
+        let past = std::panic::catch_unwind(|| b.load4(2));
+        assert!(past.is_err(), "the padding is not a vertex");
     }
 }

@@ -214,6 +214,27 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
         [h as u32, (h >> 32) as u32]
     }
 
+    /// The seeds of a 1D request at `start` and the 2D request after it:
+    /// one test of both cache bits for the pair of hashes.
+    #[inline(always)]
+    fn scramble_seeds_1d_2d(&mut self, start: u32) -> [u32; 3] {
+        if !R::SEEDED {
+            return [0; 3];
+        }
+        let (h0, h1) = if start < SEED_CACHE as u32 - 1 && self.cached >> start & 3 == 3 {
+            (
+                self.seed_hashes[start as usize],
+                self.seed_hashes[start as usize + 1],
+            )
+        } else {
+            (
+                self.hash_seeds(start),
+                self.hash_seeds(start.wrapping_add(1)),
+            )
+        };
+        [h0 as u32, h1 as u32, (h1 >> 32) as u32]
+    }
+
     /// The first sample of a pixel to reach a dimension hashes its seeds.
     #[cold]
     #[inline(never)]
@@ -334,8 +355,7 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
             return (self.sample_1d(d), self.sample_2d(d.wrapping_add(1)));
         }
         let [r0, r1, r2] = D::reversed_coordinates(self.index, d);
-        let [s0, _] = self.scramble_seeds(d);
-        let [s1, s2] = self.scramble_seeds(d.wrapping_add(1));
+        let [s0, s1, s2] = self.scramble_seeds_1d_2d(d);
         let u = reversed_to_unit_f32(R::apply(r0, s0));
         let v = reversed_pair_to_unit_f32([R::apply(r1, s1), R::apply(r2, s2)]);
         (u, Vec2::from(v))
