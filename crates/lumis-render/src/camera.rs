@@ -1,5 +1,6 @@
 //! A pinhole perspective camera.
 
+use lumis_core::glam::Vec3A;
 use lumis_core::{Error, Ray, Result, UVec2, Vec2, Vec3};
 
 /// A pinhole camera at `origin` looking at `target`. `fov` is the full
@@ -11,8 +12,15 @@ pub struct PerspectiveCamera {
     forward: Vec3,
     right: Vec3,
     up: Vec3,
-    /// Half-extent of the image plane at distance 1, per axis.
-    half_extent: Vec2,
+    /// The image plane at distance 1 as raster coordinates see it
+    /// (pbrt-v4's raster-to-camera transform, folded into three vectors):
+    /// the direction through raster point `(x, y)` is
+    /// `top_left + x * per_pixel_x + y * per_pixel_y`, two multiply-adds
+    /// where the film-to-NDC mapping took a division and five more steps
+    /// on the path to each camera ray's query.
+    top_left: Vec3A,
+    per_pixel_x: Vec3A,
+    per_pixel_y: Vec3A,
     resolution: UVec2,
 }
 
@@ -57,7 +65,9 @@ impl PerspectiveCamera {
             forward,
             right,
             up,
-            half_extent,
+            top_left: (forward - right * half_extent.x + up * half_extent.y).into(),
+            per_pixel_x: (right * (2.0 * half_extent.x / w)).into(),
+            per_pixel_y: (up * (-2.0 * half_extent.y / h)).into(),
             resolution,
         })
     }
@@ -70,10 +80,9 @@ impl PerspectiveCamera {
     /// pixel (0, 0) is the top-left corner).
     #[inline]
     pub fn generate_ray(&self, pixel: UVec2, offset: Vec2) -> Ray {
-        let film = (pixel.as_vec2() + offset) / self.resolution.as_vec2();
-        let ndc = Vec2::new(2.0 * film.x - 1.0, 1.0 - 2.0 * film.y) * self.half_extent;
-        let d = (self.forward + self.right * ndc.x + self.up * ndc.y).normalize();
-        Ray::new(self.origin, d)
+        let raster = pixel.as_vec2() + offset;
+        let d = self.top_left + self.per_pixel_x * raster.x + self.per_pixel_y * raster.y;
+        Ray::new(self.origin, d.normalize().into())
     }
 }
 
