@@ -306,9 +306,7 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
     let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
     let p = Vec3::from(q0 + q1 + q2);
     let p_error = Vec3::from(gamma(7) * (q0.abs() + q1.abs() + q2.abs()));
-    // Embree's geometric normal is (p1 - p0) x (p2 - p0), unnormalised, in
-    // the mesh's own space (counter-clockwise = front, as here); reusing it
-    // saves recomputing the cross product.
+    // A flat triangle's frame, where the scene stored it.
     if let Some(&frame) = mesh.flat_frames.get(hit.prim_id as usize) {
         return (
             SurfacePoint {
@@ -320,6 +318,9 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
             mesh_uv(mesh, tri, b0, b1, b2),
         );
     }
+    // Embree's geometric normal is (p1 - p0) x (p2 - p0), unnormalised, in
+    // the mesh's own space (counter-clockwise = front, as here); reusing it
+    // saves recomputing the cross product.
     let n = Vec3::from(hit.ng).normalize() * mesh.orientation;
     let ns = match &mesh.normals {
         Some(ns) => {
