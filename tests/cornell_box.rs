@@ -208,6 +208,11 @@ fn stored_flat_frames_match_frames_computed_at_the_hit() {
         Vec3::new(-0.7, -0.9, 0.8),
         Vec3::new(0.6, 0.9, -0.6),
     ];
+    // The quad's edges cross to +z and its front is flipped.
+    let quad_normal = Vec3::new(0.5, 0.1, 0.0)
+        .cross(Vec3::new(0.1, 0.4, 0.3))
+        .normalize();
+    let close = |u: lumis_core::glam::Vec3A, v: lumis_core::glam::Vec3A| (u - v).length() < 1e-6;
     let (mut hits, mut light_hits, mut flipped_hits) = (0, 0, 0);
     for o in origins {
         // Directions on a Fibonacci sphere, so every wall, both boxes and
@@ -228,16 +233,10 @@ fn stored_flat_frames_match_frames_computed_at_the_hit() {
             };
             hits += 1;
             light_hits += usize::from(a.light.is_some());
-            // The quad's edges cross to +z and its front is flipped.
-            let quad_normal = Vec3::new(0.5, 0.1, 0.0)
-                .cross(Vec3::new(0.1, 0.4, 0.3))
-                .normalize();
             flipped_hits += usize::from((a.n() + quad_normal).length() < 1e-5);
             assert_eq!(a.point.p, b.point.p);
             assert_eq!(a.point.p_error, b.point.p_error);
             assert_eq!((a.light, a.uv), (b.light, b.uv));
-            let close =
-                |u: lumis_core::glam::Vec3A, v: lumis_core::glam::Vec3A| (u - v).length() < 1e-6;
             assert!((a.n() - b.n()).length() < 1e-6, "{ray:?}");
             assert!(
                 close(a.shading.x, b.shading.x)

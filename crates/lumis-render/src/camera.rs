@@ -9,9 +9,6 @@ use lumis_core::{Error, Ray, Result, UVec2, Vec2, Vec3};
 #[derive(Debug, Clone, PartialEq)]
 pub struct PerspectiveCamera {
     origin: Vec3,
-    forward: Vec3,
-    right: Vec3,
-    up: Vec3,
     /// The image plane at distance 1 as raster coordinates see it
     /// (pbrt-v4's raster-to-camera transform, folded into three vectors):
     /// the direction through raster point `(x, y)` is
@@ -62,9 +59,6 @@ impl PerspectiveCamera {
         };
         Ok(Self {
             origin,
-            forward,
-            right,
-            up,
             top_left: (forward - right * half_extent.x + up * half_extent.y).into(),
             per_pixel_x: (right * (2.0 * half_extent.x / w)).into(),
             per_pixel_y: (up * (-2.0 * half_extent.y / h)).into(),

@@ -206,12 +206,19 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
         if !R::SEEDED {
             return [0, 0];
         }
-        let h = if start < SEED_CACHE as u32 && self.cached >> start & 1 != 0 {
+        let h = self.seed_hash(start);
+        [h as u32, (h >> 32) as u32]
+    }
+
+    /// The hash behind the seeds of the request at `start`: cached, or
+    /// hashed now by the pixel's first sample to reach it.
+    #[inline(always)]
+    fn seed_hash(&mut self, start: u32) -> u64 {
+        if start < SEED_CACHE as u32 && self.cached >> start & 1 != 0 {
             self.seed_hashes[start as usize]
         } else {
             self.hash_seeds(start)
-        };
-        [h as u32, (h >> 32) as u32]
+        }
     }
 
     /// The seeds of a 1D request at `start` and the 2D request after it:
@@ -227,10 +234,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
                 self.seed_hashes[start as usize + 1],
             )
         } else {
-            (
-                self.hash_seeds(start),
-                self.hash_seeds(start.wrapping_add(1)),
-            )
+            (self.seed_hash(start), self.seed_hash(start.wrapping_add(1)))
         };
         [h0 as u32, h1 as u32, (h1 >> 32) as u32]
     }
