@@ -28,8 +28,7 @@ pub use radical_inverse::{
 };
 pub use rng::{hash_u64, hash_with, pixel_key, Pcg32};
 pub use scramble::{
-    fixed_to_unit_f32, laine_karras_permutation, owen_scramble, reverse_bits_pair,
-    reverse_bits_top24, reversed_pair_to_unit_f32, reversed_to_unit_f32, xor_scramble,
+    fixed_to_unit_f32, laine_karras_permutation, owen_scramble, reversed_to_unit_f32, xor_scramble,
 };
 pub use sobol::{
     sobol_reversed_columns, sobol_reversed_run, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS,

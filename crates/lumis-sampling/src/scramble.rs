@@ -61,36 +61,35 @@ const fn reversed_bytes() -> [u8; 256] {
     table
 }
 
-/// The top 24 bits of `x.reverse_bits()` (the low 24 bits of `x`, reversed)
-/// from three lookups in a 256-byte table. x86 has no bit-reversal
-/// instruction: `u32::reverse_bits` is a byte swap and three mask-and-shift
-/// rounds (about 15 instructions), and a float needs only 24 of its bits.
-#[inline]
-pub fn reverse_bits_top24(x: u32) -> u32 {
-    let byte = |shift: u32| REVERSED_BYTES[(x >> shift) as u8 as usize] as u32;
-    (byte(0) << 16) | (byte(8) << 8) | byte(16)
-}
+/// `REVERSED_BYTE_FRACTIONS[k][b]` is the fraction that byte `k` of a
+/// bit-reversed value contributes: `b` reversed, times `2^-8(k+1)`.
+const REVERSED_BYTE_FRACTIONS: [[f32; 256]; 3] = reversed_byte_fractions();
 
-/// `[a.reverse_bits(), b.reverse_bits()]` as one 64-bit reversal, the same
-/// instruction sequence as a single 32-bit one: reversing `a << 32 | b`
-/// puts `rev(b)` in the high half and `rev(a)` in the low one.
-#[inline]
-pub fn reverse_bits_pair(a: u32, b: u32) -> [u32; 2] {
-    let r = ((a as u64) << 32 | b as u64).reverse_bits();
-    [r as u32, (r >> 32) as u32]
+const fn reversed_byte_fractions() -> [[f32; 256]; 3] {
+    let mut table = [[0.0; 256]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let scale = 1.0 / (1u32 << (8 * (k + 1))) as f32;
+        let mut b = 0;
+        while b < 256 {
+            table[k][b] = REVERSED_BYTES[b] as f32 * scale;
+            b += 1;
+        }
+        k += 1;
+    }
+    table
 }
 
 /// The fixed-point fraction whose bit reversal is `reversed`, as an `f32` in
-/// `[0, 1)`: `fixed_to_unit_f32(reversed.reverse_bits())`, exactly.
+/// `[0, 1)`: `fixed_to_unit_f32(reversed.reverse_bits())`, exactly. Each of
+/// the low three bytes looks up its share of the fraction; the shares are
+/// multiples of `2^-24` below 1, so their sum is exact in 24 mantissa bits.
+/// Three lookups and two additions replace the bit reversal, the integer
+/// conversion and the scaling.
 #[inline]
 pub fn reversed_to_unit_f32(reversed: u32) -> f32 {
-    reverse_bits_top24(reversed) as f32 * (1.0 / 16_777_216.0)
-}
-
-/// [`reversed_to_unit_f32`] of two values, with one 64-bit reversal.
-#[inline]
-pub fn reversed_pair_to_unit_f32(reversed: [u32; 2]) -> [f32; 2] {
-    reverse_bits_pair(reversed[0], reversed[1]).map(fixed_to_unit_f32)
+    let share = |k: usize| REVERSED_BYTE_FRACTIONS[k][(reversed >> (8 * k)) as u8 as usize];
+    share(0) + share(1) + share(2)
 }
 
 #[cfg(test)]
@@ -114,30 +113,18 @@ mod tests {
     }
 
     #[test]
-    fn table_reversal_matches_reverse_bits() {
-        for x in probe_values() {
-            assert_eq!(reverse_bits_top24(x), x.reverse_bits() >> 8, "{x:#x}");
-            assert_eq!(
-                reversed_to_unit_f32(x),
-                fixed_to_unit_f32(x.reverse_bits()),
-                "{x:#x}"
-            );
-        }
+    fn byte_fractions_match_reverse_bits_exactly() {
         for b in 0..=255u8 {
             assert_eq!(REVERSED_BYTES[b as usize], b.reverse_bits());
         }
-    }
-
-    #[test]
-    fn pair_reversal_matches_reverse_bits() {
-        for (a, b) in probe_values().zip(probe_values().skip(7)) {
+        // Every pattern of the 24 bits that reach the float, then values
+        // whose ignored top byte is set.
+        for x in (0..1u32 << 24).chain(probe_values()) {
+            let expected = fixed_to_unit_f32(x.reverse_bits());
             assert_eq!(
-                reverse_bits_pair(a, b),
-                [a.reverse_bits(), b.reverse_bits()]
-            );
-            assert_eq!(
-                reversed_pair_to_unit_f32([a, b]),
-                [reversed_to_unit_f32(a), reversed_to_unit_f32(b)]
+                reversed_to_unit_f32(x).to_bits(),
+                expected.to_bits(),
+                "{x:#x}"
             );
         }
     }

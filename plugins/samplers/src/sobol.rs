@@ -7,8 +7,8 @@ use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
 use lumis_sampling::{
-    hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_pair_to_unit_f32,
-    reversed_to_unit_f32, sobol_reversed_run, xor_scramble, SOBOL_DIMENSIONS,
+    hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_to_unit_f32,
+    sobol_reversed_run, xor_scramble, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -278,15 +278,15 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     }
 
     /// Both components of a 2D request: one pass over the index bits (or
-    /// one table row), one 64-bit bit reversal.
+    /// one table row).
     #[inline(always)]
     fn sample_2d(&mut self, start: u32) -> Vec2 {
         let [r0, r1] = D::reversed_coordinates(self.index_for(start), start);
         let [s0, s1] = self.scramble_seeds(start);
-        Vec2::from(reversed_pair_to_unit_f32([
-            R::apply(r0, s0),
-            R::apply(r1, s1),
-        ]))
+        Vec2::new(
+            reversed_to_unit_f32(R::apply(r0, s0)),
+            reversed_to_unit_f32(R::apply(r1, s1)),
+        )
     }
 }
 
@@ -361,8 +361,11 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         let [r0, r1, r2] = D::reversed_coordinates(self.index, d);
         let [s0, s1, s2] = self.scramble_seeds_1d_2d(d);
         let u = reversed_to_unit_f32(R::apply(r0, s0));
-        let v = reversed_pair_to_unit_f32([R::apply(r1, s1), R::apply(r2, s2)]);
-        (u, Vec2::from(v))
+        let v = Vec2::new(
+            reversed_to_unit_f32(R::apply(r1, s1)),
+            reversed_to_unit_f32(R::apply(r2, s2)),
+        );
+        (u, v)
     }
 
     fn get_pixel_2d(&mut self) -> Vec2 {
