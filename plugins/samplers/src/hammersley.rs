@@ -4,8 +4,8 @@
 use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
-    fixed_to_unit_f32, hash_with, owen_scramble, pixel_key, scrambled_radical_inverse,
-    DigitScramble,
+    hash_with, laine_karras_permutation, pixel_key, reversed_to_unit_f32,
+    scrambled_radical_inverse, DigitScramble,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -58,9 +58,12 @@ impl HammersleySampler {
             // i / N as a 32-bit binary fraction, scrambled like the rest.
             0 => {
                 let fixed = ((self.index as u64) << 32) / self.spp as u64;
-                fixed_to_unit_f32(owen_scramble(fixed as u32, seed as u32))
+                let reversed = (fixed as u32).reverse_bits();
+                reversed_to_unit_f32(laine_karras_permutation(reversed, seed as u32))
             }
-            1 => fixed_to_unit_f32(owen_scramble(self.index.reverse_bits(), seed as u32)),
+            // The radical inverse of the index in base 2 is the index
+            // bit-reversed: in the reversed domain it is the index itself.
+            1 => reversed_to_unit_f32(laine_karras_permutation(self.index, seed as u32)),
             d => {
                 let prime = PRIMES[1 + (d as usize - 2) % (PRIME_TABLE_SIZE - 1)];
                 scrambled_radical_inverse(prime, self.index as u64, seed, DigitScramble::Owen)

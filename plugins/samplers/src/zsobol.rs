@@ -4,7 +4,9 @@
 use lumis_core::{
     ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
 };
-use lumis_sampling::{fixed_to_unit_f32, hash_u64, hash_with, owen_scramble, sobol_u32};
+use lumis_sampling::{
+    hash_u64, hash_with, laine_karras_permutation, reversed_to_unit_f32, sobol_reversed_u32,
+};
 
 use crate::spp::{read_spp, SPP_PARAM};
 
@@ -169,13 +171,15 @@ impl ZSobolSampler {
         // Bits past 32 only move points below 2^-32: the 32-bit index keeps
         // every block intact.
         let index = self.sample_index(dimension) as u32;
+        // Scrambled and converted in the bit-reversed domain, where the
+        // Sobol' columns are stored: no bit reversal on the way.
         let coordinate = |component: usize| {
-            let x = sobol_u32(index, component);
+            let reversed = sobol_reversed_u32(index, component);
             if self.owen {
                 let seed = hash_with(self.seed_key, 2 * dimension as u64 + component as u64);
-                fixed_to_unit_f32(owen_scramble(x, seed as u32))
+                reversed_to_unit_f32(laine_karras_permutation(reversed, seed as u32))
             } else {
-                fixed_to_unit_f32(x)
+                reversed_to_unit_f32(reversed)
             }
         };
         Vec2::new(coordinate(0), coordinate(1))
