@@ -31,7 +31,8 @@ pub use scramble::{
     fixed_to_unit_f32, laine_karras_permutation, owen_scramble, reversed_to_unit_f32, xor_scramble,
 };
 pub use sobol::{
-    sobol_reversed_columns, sobol_reversed_run, sobol_reversed_u32, sobol_u32, SOBOL_DIMENSIONS,
+    sobol_reversed_columns, sobol_reversed_run, sobol_reversed_tabulated, sobol_reversed_u32,
+    sobol_u32, SOBOL_DIMENSIONS,
 };
 pub use spherical_rectangle::SphericalRectangle;
 pub use spherical_triangle::{

@@ -80,15 +80,25 @@ pub fn sobol_reversed_columns<const N: usize>(mut index: u32, dims: [usize; N]) 
     x
 }
 
+/// [`sobol_reversed_run`] where [`SOBOL_PREFIX_REVERSED`] holds it (a
+/// table read), else `None`.
+#[inline(always)]
+pub fn sobol_reversed_tabulated<const N: usize>(index: u32, first: usize) -> Option<[u32; N]> {
+    let row = SOBOL_PREFIX_REVERSED.get(index as usize)?;
+    if first + N > SOBOL_PREFIX_DIMENSIONS {
+        return None;
+    }
+    Some(std::array::from_fn(|k| row[first + k]))
+}
+
 /// [`sobol_reversed_columns`] of the `N` consecutive dimensions from
 /// `first` (wrapping past the last dimension to the first): a table read for
 /// the points and dimensions of [`SOBOL_PREFIX_REVERSED`], the matrix
 /// product beyond.
 #[inline]
 pub fn sobol_reversed_run<const N: usize>(index: u32, first: usize) -> [u32; N] {
-    if (index as usize) < SOBOL_PREFIX_POINTS && first + N <= SOBOL_PREFIX_DIMENSIONS {
-        let row = &SOBOL_PREFIX_REVERSED[index as usize];
-        return std::array::from_fn(|k| row[first + k]);
+    if let Some(run) = sobol_reversed_tabulated(index, first) {
+        return run;
     }
     sobol_reversed_columns(
         index,

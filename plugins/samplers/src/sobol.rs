@@ -8,7 +8,7 @@ use lumis_core::{
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_to_unit_f32,
-    sobol_reversed_run, xor_scramble, SOBOL_DIMENSIONS,
+    sobol_reversed_run, sobol_reversed_tabulated, xor_scramble, SOBOL_DIMENSIONS,
 };
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -118,6 +118,10 @@ pub trait DimensionMapping: fmt::Debug + Clone + Send + Sync + 'static {
     /// for the `N` components of a request that starts at sampler dimension
     /// `start` (a 1D request takes one, a 2D request two).
     fn reversed_coordinates<const N: usize>(index: u32, start: u32) -> [u32; N];
+
+    /// [`Self::reversed_coordinates`] where they are a read of the
+    /// compile-time table of the first points, else `None`.
+    fn tabulated_coordinates<const N: usize>(index: u32, start: u32) -> Option<[u32; N]>;
 }
 
 /// [`Dimensions::Sobol`]: consecutive sampler dimensions are consecutive
@@ -133,6 +137,11 @@ impl DimensionMapping for SobolOrder {
     fn reversed_coordinates<const N: usize>(index: u32, start: u32) -> [u32; N] {
         sobol_reversed_run(index, start as usize % SOBOL_DIMENSIONS)
     }
+
+    #[inline(always)]
+    fn tabulated_coordinates<const N: usize>(index: u32, start: u32) -> Option<[u32; N]> {
+        sobol_reversed_tabulated(index, start as usize)
+    }
 }
 
 /// [`Dimensions::Padded`].
@@ -145,6 +154,12 @@ impl DimensionMapping for Padded {
     #[inline(always)]
     fn reversed_coordinates<const N: usize>(index: u32, _start: u32) -> [u32; N] {
         sobol_reversed_run(index, 0)
+    }
+
+    /// Never: each padded request shuffles its index first.
+    #[inline(always)]
+    fn tabulated_coordinates<const N: usize>(_index: u32, _start: u32) -> Option<[u32; N]> {
+        None
     }
 }
 
@@ -239,6 +254,41 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
         [h0 as u32, h1 as u32, (h1 >> 32) as u32]
     }
 
+    /// The 1D+2D request at `d` in the common case: its point in the
+    /// compile-time table and its seeds in the pixel's cache, else `None`.
+    /// Kept apart from the general case (the loop over the index bits, the
+    /// seed hashing), it needs fewer registers: the request saves three
+    /// callee-saved ones instead of six (lumis 0.5-1% faster).
+    #[inline(always)]
+    fn tabulated_1d_2d(&self, d: u32) -> Option<(f32, Vec2)> {
+        let reversed = D::tabulated_coordinates(self.index, d)?;
+        let seeds = if R::SEEDED {
+            if d >= SEED_CACHE as u32 - 1 || self.cached >> d & 3 != 3 {
+                return None;
+            }
+            let (h0, h1) = (
+                self.seed_hashes[d as usize],
+                self.seed_hashes[d as usize + 1],
+            );
+            [h0 as u32, h1 as u32, (h1 >> 32) as u32]
+        } else {
+            [0; 3]
+        };
+        Some(unit_1d_2d::<R>(reversed, seeds))
+    }
+
+    /// The 1D+2D request at `d` in general: in Sobol' order one table row
+    /// or one pass over the index bits for its three dimensions; padded
+    /// requests each shuffle the index their own way, so they stay two.
+    #[inline(never)]
+    fn general_1d_2d(&mut self, d: u32) -> (f32, Vec2) {
+        if D::SHUFFLED {
+            return (self.sample_1d(d), self.sample_2d(d.wrapping_add(1)));
+        }
+        let reversed = D::reversed_coordinates(self.index, d);
+        unit_1d_2d::<R>(reversed, self.scramble_seeds_1d_2d(d))
+    }
+
     /// The first sample of a pixel to reach a dimension hashes its seeds.
     #[cold]
     #[inline(never)]
@@ -288,6 +338,14 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
             reversed_to_unit_f32(R::apply(r1, s1)),
         )
     }
+}
+
+/// A 1D+2D request's numbers from its three unscrambled coordinates and
+/// their seeds.
+#[inline(always)]
+fn unit_1d_2d<R: Randomization>(reversed: [u32; 3], seeds: [u32; 3]) -> (f32, Vec2) {
+    let unit = |k: usize| reversed_to_unit_f32(R::apply(reversed[k], seeds[k]));
+    (unit(0), Vec2::new(unit(1), unit(2)))
 }
 
 impl SobolSampler {
@@ -348,24 +406,13 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
         self.sample_2d(d)
     }
 
-    /// In Sobol' order the three dimensions are consecutive coordinates of
-    /// one point: one table row, or one pass over the index bits. Padded
-    /// requests each shuffle the index their own way, so they stay two
-    /// requests.
     fn get_1d_2d(&mut self) -> (f32, Vec2) {
         let d = self.dimension;
         self.dimension = d.wrapping_add(3);
-        if D::SHUFFLED {
-            return (self.sample_1d(d), self.sample_2d(d.wrapping_add(1)));
+        match self.tabulated_1d_2d(d) {
+            Some(request) => request,
+            None => self.general_1d_2d(d),
         }
-        let [r0, r1, r2] = D::reversed_coordinates(self.index, d);
-        let [s0, s1, s2] = self.scramble_seeds_1d_2d(d);
-        let u = reversed_to_unit_f32(R::apply(r0, s0));
-        let v = Vec2::new(
-            reversed_to_unit_f32(R::apply(r1, s1)),
-            reversed_to_unit_f32(R::apply(r2, s2)),
-        );
-        (u, v)
     }
 
     fn get_pixel_2d(&mut self) -> Vec2 {

@@ -6,7 +6,7 @@ use lumis_core::doc;
 use lumis_core::registry::TableRef;
 use lumis_core::{Location, PluginKind, Registry, Sampler, UVec2};
 
-const SPP: u32 = 16;
+const SPP: u32 = 512;
 
 /// Every sampler plugin, with every value of its `randomize` and
 /// `dimensions` choices (their effect on the hot path differs).
@@ -59,10 +59,16 @@ fn fused_1d_2d_requests_match_separate_ones() {
     assert!(all.len() >= 10, "{} sampler variants", all.len());
     for (name, mut fused) in all {
         let mut separate = fused.clone_sampler();
+        // Two samples of each pixel, so that the second finds the first's
+        // cached seeds; an index past the Sobol' sampler's table of the
+        // first 256 points.
         for (pixel, index) in [
             (UVec2::new(3, 7), 0),
+            (UVec2::new(3, 7), 1),
             (UVec2::new(200, 1), 5),
+            (UVec2::new(200, 1), 14),
             (UVec2::new(9, 9), 15),
+            (UVec2::new(9, 9), 300),
         ] {
             fused.start_pixel_sample(pixel, index, 42);
             separate.start_pixel_sample(pixel, index, 42);
