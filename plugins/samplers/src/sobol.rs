@@ -236,21 +236,30 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
         }
     }
 
-    /// The seeds of a 1D request at `start` and the 2D request after it:
-    /// one test of both cache bits for the pair of hashes.
+    /// The seeds of a 1D request at `start` and the 2D request after it,
+    /// where both are cached (one test of the two cache bits), else `None`.
+    #[inline(always)]
+    fn cached_seeds_1d_2d(&self, start: u32) -> Option<[u32; 3]> {
+        if !R::SEEDED {
+            return Some([0; 3]);
+        }
+        if start >= SEED_CACHE as u32 - 1 || self.cached >> start & 3 != 3 {
+            return None;
+        }
+        let (h0, h1) = (
+            self.seed_hashes[start as usize],
+            self.seed_hashes[start as usize + 1],
+        );
+        Some([h0 as u32, h1 as u32, (h1 >> 32) as u32])
+    }
+
+    /// [`Self::cached_seeds_1d_2d`], hashing what is not cached yet.
     #[inline(always)]
     fn scramble_seeds_1d_2d(&mut self, start: u32) -> [u32; 3] {
-        if !R::SEEDED {
-            return [0; 3];
+        if let Some(seeds) = self.cached_seeds_1d_2d(start) {
+            return seeds;
         }
-        let (h0, h1) = if start < SEED_CACHE as u32 - 1 && self.cached >> start & 3 == 3 {
-            (
-                self.seed_hashes[start as usize],
-                self.seed_hashes[start as usize + 1],
-            )
-        } else {
-            (self.seed_hash(start), self.seed_hash(start.wrapping_add(1)))
-        };
+        let (h0, h1) = (self.seed_hash(start), self.seed_hash(start.wrapping_add(1)));
         [h0 as u32, h1 as u32, (h1 >> 32) as u32]
     }
 
@@ -262,18 +271,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
     #[inline(always)]
     fn tabulated_1d_2d(&self, d: u32) -> Option<(f32, Vec2)> {
         let reversed = D::tabulated_coordinates(self.index, d)?;
-        let seeds = if R::SEEDED {
-            if d >= SEED_CACHE as u32 - 1 || self.cached >> d & 3 != 3 {
-                return None;
-            }
-            let (h0, h1) = (
-                self.seed_hashes[d as usize],
-                self.seed_hashes[d as usize + 1],
-            );
-            [h0 as u32, h1 as u32, (h1 >> 32) as u32]
-        } else {
-            [0; 3]
-        };
+        let seeds = self.cached_seeds_1d_2d(d)?;
         Some(unit_1d_2d::<R>(reversed, seeds))
     }
 
