@@ -7,6 +7,8 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use crate::special::{sin_cos_quarter_turn, sin_cos_turns};
+
 /// Concentric map of the square to the unit disk (Shirley and Chiu 1997,
 /// "A Low Distortion Map Between Disk and Square"): keeps strata compact.
 /// Each wedge's angle is `pi/4 * t` for `t` in [-1, 1] (pbrt-v4's form),
@@ -33,28 +35,6 @@ fn concentric_disk_and_radius(u: Vec2) -> (Vec2, f32) {
     let (sin, cos) = sin_cos_quarter_turn(FRAC_PI_4 * (along / r));
     let (x, y) = if vertical { (sin, cos) } else { (cos, sin) };
     (r * Vec2::new(x, y), r.abs())
-}
-
-/// `(sin x, cos x)` for `|x| <= pi/4`, the only angles the concentric map
-/// needs: the Taylor polynomials of degree 9 and 10 in Horner form. Their
-/// truncation errors at pi/4 are `x^11/11! < 2e-9` and `x^12/12! < 2e-10`,
-/// far below f32's half ulp (3e-8 at 1), so the result is as accurate as
-/// libm's `sincosf` (within 2 ulp, tested) at a third of its cost on the
-/// cosine-weighted hemisphere, which every diffuse bounce takes.
-#[inline]
-pub fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
-    const S: [f32; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0];
-    const C: [f32; 5] = [
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40_320.0,
-        -1.0 / 3_628_800.0,
-    ];
-    let x2 = x * x;
-    let sin = x + x * x2 * (S[0] + x2 * (S[1] + x2 * (S[2] + x2 * S[3])));
-    let cos = 1.0 + x2 * (C[0] + x2 * (C[1] + x2 * (C[2] + x2 * (C[3] + x2 * C[4]))));
-    (sin, cos)
 }
 
 /// Cosine-weighted hemisphere by Malley's method: project the concentric
@@ -84,8 +64,8 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
 pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
     let z = u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 #[inline]
@@ -102,8 +82,8 @@ pub fn uniform_hemisphere_pdf(cos_theta: f32) -> f32 {
 pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 pub const UNIFORM_SPHERE_PDF: f32 = 0.25 * FRAC_1_PI;
@@ -124,26 +104,6 @@ mod tests {
 
     /// The polynomial sine and cosine stay within 2 ulp of the correctly
     /// rounded values over the whole quarter-turn range, including its ends.
-    #[test]
-    fn quarter_turn_sin_cos_matches_f64() {
-        let ulp = |a: f32, exact: f64| {
-            ((a as f64 - exact).abs() / (exact as f32).abs().max(f32::MIN_POSITIVE) as f64)
-                / f32::EPSILON as f64
-        };
-        let n = 200_000;
-        for i in 0..=n {
-            let x = (i as f64 / n as f64 * 2.0 - 1.0) * std::f64::consts::FRAC_PI_4;
-            let (s, c) = sin_cos_quarter_turn(x as f32);
-            let xf = x as f32 as f64;
-            if xf != 0.0 {
-                assert!(ulp(s, xf.sin()) <= 2.0, "sin({xf}) = {s}, {}", xf.sin());
-            } else {
-                assert_eq!(s, 0.0);
-            }
-            assert!(ulp(c, xf.cos()) <= 2.0, "cos({xf}) = {c}, {}", xf.cos());
-        }
-    }
-
     fn grid(n: usize) -> impl Iterator<Item = Vec2> {
         (0..n * n).map(move |i| {
             Vec2::new(
@@ -235,8 +195,8 @@ pub fn one_minus_cos_from_sin2(sin2: f32) -> f32 {
 pub fn square_to_uniform_cone(u: Vec2, h_max: f32) -> Vec3 {
     let h = u.x * h_max;
     let sin_theta = (h * (2.0 - h)).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), 1.0 - h)
+    let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, 1.0 - h)
 }
 
 /// `1 / (2 pi (1 - cos theta_max))`, the solid angle of the cone inverted.

@@ -188,38 +188,59 @@ impl Conductor {
         })
     }
 
+    /// `f` of the rough lobe from what it shares with the density.
     #[inline]
-    fn rough_f(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+    fn rough_f(&self, mf: &Microfacet, lobe: &LobeTerms, wi: Vec3) -> Rgb {
+        if lobe.d == 0.0 {
             return Rgb::BLACK;
         }
-        let Some((m, wo_m)) = half_vector(wo, wi) else {
-            return Rgb::BLACK;
-        };
-        let d = mf.d(m);
-        if d == 0.0 {
-            return Rgb::BLACK;
-        }
-        let g = mf.g(wo, wi);
-        self.scale * self.fresnel.eval(wo_m) * (d * g / (4.0 * wo.z * wi.z))
+        // Height-correlated masking-shadowing (Heitz 2014, eq. 99).
+        let g = 1.0 / (1.0 + lobe.lambda_o + mf.lambda(wi));
+        self.scale * self.fresnel.eval(lobe.wo_m) * (lobe.d * g / (4.0 * lobe.wo.z * wi.z))
     }
 
+    /// The density of the rough lobe's sampling at `wi`.
     #[inline]
-    fn rough_pdf(&self, mf: &Microfacet, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
-            return 0.0;
-        }
+    fn rough_pdf(&self, mf: &Microfacet, lobe: &LobeTerms, wi: Vec3) -> f32 {
         match self.sampling {
+            // Reflection Jacobian d(omega_m)/d(omega_i) = 1 / (4 <wo, m>)
+            // (Walter et al. 2007, eq. 14).
             LobeSampling::Model(_) => {
-                let Some((m, wo_m)) = half_vector(wo, wi) else {
-                    return 0.0;
-                };
-                // Reflection Jacobian d(omega_m)/d(omega_i) = 1 / (4 <wo, m>)
-                // (Walter et al. 2007, eq. 14).
-                mf.pdf_normal(wo, m, wo_m) / (4.0 * wo_m)
+                mf.pdf_normal_from(lobe.wo, lobe.m, lobe.wo_m, lobe.d, lobe.lambda_o)
+                    / (4.0 * lobe.wo_m)
             }
             baseline => baseline.baseline_pdf(wi.z),
         }
+    }
+}
+
+/// What `f` and `pdf` of the rough lobe share at one pair of directions
+/// (both above the surface): the half vector, `D` and `Lambda(wo)`, so
+/// that `eval` and `sample_f` compute them once.
+struct LobeTerms {
+    wo: Vec3,
+    m: Vec3,
+    wo_m: f32,
+    d: f32,
+    lambda_o: f32,
+}
+
+impl LobeTerms {
+    /// `None` where the lobe is zero: a direction at or below the horizon,
+    /// or opposite directions (no half vector).
+    #[inline]
+    fn at(mf: &Microfacet, wo: Vec3, wi: Vec3) -> Option<Self> {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return None;
+        }
+        let (m, wo_m) = half_vector(wo, wi)?;
+        Some(Self {
+            wo,
+            m,
+            wo_m,
+            d: mf.d(m),
+            lambda_o: mf.lambda(wo),
+        })
     }
 }
 
@@ -233,10 +254,10 @@ impl Bsdf for Conductor {
 
     #[inline]
     fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        match &self.microfacet {
-            Some(mf) => self.rough_f(mf, wo, wi),
-            None => Rgb::BLACK,
-        }
+        let Some(mf) = &self.microfacet else {
+            return Rgb::BLACK;
+        };
+        LobeTerms::at(mf, wo, wi).map_or(Rgb::BLACK, |lobe| self.rough_f(mf, &lobe, wi))
     }
 
     fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
@@ -264,20 +285,31 @@ impl Bsdf for Conductor {
             }
             baseline => baseline.sample_baseline(u2)?,
         };
+        let lobe = LobeTerms::at(mf, wo, wi)?;
         BsdfSample::reflection(
             wi,
             BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            |wi| self.rough_pdf(mf, wo, wi),
-            |wi| self.rough_f(mf, wo, wi),
+            |wi| self.rough_pdf(mf, &lobe, wi),
+            |wi| self.rough_f(mf, &lobe, wi),
         )
     }
 
     #[inline]
     fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        match &self.microfacet {
-            Some(mf) => self.rough_pdf(mf, wo, wi),
-            None => 0.0,
-        }
+        let Some(mf) = &self.microfacet else {
+            return 0.0;
+        };
+        LobeTerms::at(mf, wo, wi).map_or(0.0, |lobe| self.rough_pdf(mf, &lobe, wi))
+    }
+
+    #[inline]
+    fn eval(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        let Some(mf) = &self.microfacet else {
+            return (Rgb::BLACK, 0.0);
+        };
+        LobeTerms::at(mf, wo, wi).map_or((Rgb::BLACK, 0.0), |lobe| {
+            (self.rough_f(mf, &lobe, wi), self.rough_pdf(mf, &lobe, wi))
+        })
     }
 }
 

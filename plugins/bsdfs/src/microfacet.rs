@@ -11,7 +11,7 @@
 use std::f32::consts::PI;
 
 use lumis_core::{ParamSpec, ParamType, Params, Result, Vec2, Vec3};
-use lumis_sampling::special::{erf, erf_inv};
+use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
 
 /// Below this roughness (largest alpha) a lobe is narrower than a
 /// thousandth of a radian and is rendered as the delta lobe it tends to,
@@ -156,7 +156,7 @@ impl Microfacet {
                 if e > 80.0 {
                     return 0.0;
                 }
-                (-e).exp() / (norm * z2 * z2)
+                exp(-e) / (norm * z2 * z2)
             }
             // 1 / (pi alpha^2 cos^4 (1 + tan^2/alpha^2)^2), with the cos^4
             // folded into the square so that it stays finite at the horizon.
@@ -179,16 +179,17 @@ impl Microfacet {
         match self.distribution {
             // (sqrt(1 + alpha^2 tan^2) - 1) / 2 (Walter et al. 2007, eq. 35).
             Distribution::Ggx => 0.5 * ((1.0 + a2t2).sqrt() - 1.0),
-            // With a = 1 / (alpha tan): (erf(a) - 1)/2 + exp(-a^2)/(2 a sqrt(pi))
+            // With a = 1 / (alpha tan): (exp(-a^2)/(a sqrt(pi)) - erfc(a))/2
             // (Walter et al. 2007, eq. 27 before its rational fit: exact).
+            // The difference cancels by a factor 2 a^2 at large a, where
+            // Lambda < 1e-7 no longer changes G1 in f32.
             Distribution::Beckmann => {
                 if a2t2 == 0.0 {
                     return 0.0;
                 }
-                let a = 1.0 / (a2t2 as f64).sqrt();
-                let l =
-                    0.5 * (erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
-                l.max(0.0) as f32
+                let a = 1.0 / a2t2.sqrt();
+                let l = 0.5 * (exp(-a * a) * FRAC_1_SQRT_PI / a - erfc(a));
+                l.max(0.0)
             }
         }
     }
@@ -232,6 +233,23 @@ impl Microfacet {
         }
     }
 
+    /// [`Self::pdf_normal`] for `w` above the surface, from `d = D(m)` and
+    /// `lambda_w = Lambda(w)` that the caller has already evaluated (a
+    /// BSDF's `f` needs both too): the same arithmetic, so the same bits.
+    #[inline]
+    pub fn pdf_normal_from(&self, w: Vec3, m: Vec3, cos_wm: f32, d: f32, lambda_w: f32) -> f32 {
+        debug_assert!(w.z >= 0.0);
+        match self.sampling {
+            NormalSampling::Visible => {
+                if w.z == 0.0 || cos_wm <= 0.0 {
+                    return 0.0;
+                }
+                1.0 / (1.0 + lambda_w) * d * cos_wm / w.z
+            }
+            NormalSampling::Full => d * m.z.max(0.0),
+        }
+    }
+
     /// Draws a microfacet normal (upper hemisphere) for the direction `w`
     /// (flipped to the upper hemisphere if it is below).
     pub fn sample_normal(&self, w: Vec3, u: Vec2) -> Vec3 {
@@ -265,8 +283,8 @@ impl Microfacet {
             Distribution::Ggx => u1 / (1.0 - u1),
         };
         let r = r2.sqrt();
-        let phi = 2.0 * PI * u.y;
-        Self::normal_from_slope(self.alpha_x * r * phi.cos(), self.alpha_y * r * phi.sin())
+        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+        Self::normal_from_slope(self.alpha_x * r * cos_phi, self.alpha_y * r * sin_phi)
     }
 
     /// Heitz 2018, "Sampling the GGX Distribution of Visible Normals"
@@ -282,10 +300,10 @@ impl Microfacet {
         };
         let t2 = wh.cross(t1);
         let r = u.x.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let p1 = r * phi.cos();
+        let (sin_phi, cos_phi) = sin_cos_turns(u.y);
+        let p1 = r * cos_phi;
         let s = 0.5 * (1.0 + wh.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin_phi;
         let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * wh;
         Vec3::new(self.alpha_x * nh.x, self.alpha_y * nh.y, nh.z.max(1e-6)).normalize()
     }
@@ -296,14 +314,13 @@ impl Microfacet {
     /// the visible slopes there, rotate back and unstretch.
     fn sample_visible_beckmann(&self, w: Vec3, u: Vec2) -> Vec3 {
         let ws = Vec3::new(self.alpha_x * w.x, self.alpha_y * w.y, w.z).normalize();
-        let (sx, sy) = beckmann_visible_slopes(ws.z as f64, u.x as f64, u.y as f64);
+        let (sx, sy) = beckmann_visible_slopes(ws.z, u);
         let len = (ws.x * ws.x + ws.y * ws.y).sqrt();
         let (cos_phi, sin_phi) = if len > 0.0 {
             (ws.x / len, ws.y / len)
         } else {
             (1.0, 0.0)
         };
-        let (sx, sy) = (sx as f32, sy as f32);
         let rx = cos_phi * sx - sin_phi * sy;
         let ry = sin_phi * sx + cos_phi * sy;
         Self::normal_from_slope(self.alpha_x * rx, self.alpha_y * ry)
@@ -315,33 +332,35 @@ impl Microfacet {
 ///
 /// The slope `x` along the view azimuth has density proportional to
 /// `exp(-x^2) (1 - x tan theta)` for `x < cot theta` (projected area of the
-/// facet); in `b = erf(x)` its unnormalised CDF is `1 + b + tan theta
-/// exp(-x^2) / sqrt(pi)`, inverted by Newton's method safeguarded by
-/// bisection (pbrt-v3 `BeckmannSample11`, here in f64 and to 1e-10). The
-/// other slope is independent and Gaussian: `y = erfinv(2 u - 1)`.
-fn beckmann_visible_slopes(cos_theta: f64, u1: f64, u2: f64) -> (f64, f64) {
-    const EPS: f64 = 1e-9;
-    let u1 = u1.clamp(EPS, 1.0 - EPS);
-    let u2 = u2.clamp(EPS, 1.0 - EPS);
+/// facet); in `b = erf(x)` its unnormalised CDF is `F(b) = 1 + b + tan
+/// theta exp(-x^2) / sqrt(pi)`, inverted by Newton's method safeguarded by
+/// bisection (pbrt-v3 `BeckmannSample11`) from Jakob's fitted starting
+/// point `b0 = erf(cot) - (1 + erf(cot)) erf(sqrt(-ln u))` ("An Improved
+/// Visible Normal Sampling Routine for the Beckmann Distribution", 2014),
+/// which leaves two or three steps to f32 precision. The other slope is
+/// independent and Gaussian: `y = erfinv(2 u - 1)`.
+fn beckmann_visible_slopes(cos_theta: f32, u: Vec2) -> (f32, f32) {
+    const EPS: f32 = 1e-6;
+    let u1 = u.x.clamp(EPS, 1.0 - EPS);
+    let u2 = u.y.clamp(EPS, 1.0 - EPS);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     let tan_theta = sin_theta / cos_theta;
     let cot_theta = cos_theta / sin_theta; // +inf at normal incidence
-    let inv_sqrt_pi = 1.0 / std::f64::consts::PI.sqrt();
-    let tail = |x: f64| {
+    let tail = |x: f32| {
         if tan_theta == 0.0 {
             0.0
         } else {
-            inv_sqrt_pi * tan_theta * (-x * x).exp()
+            FRAC_1_SQRT_PI * tan_theta * exp(-x * x)
         }
     };
-    let (mut lo, mut hi) = (-1.0f64, erf(cot_theta));
+    let (mut lo, mut hi) = (-1.0f32, erf(cot_theta));
     let total = 1.0 + hi + tail(cot_theta);
     let target = u1 * total;
-    let mut b = (target - 1.0).clamp(lo, hi);
-    for _ in 0..100 {
-        let x = erf_inv(b);
+    let mut b = (hi - (1.0 + hi) * erf((-ln(u1)).sqrt())).clamp(lo, hi);
+    let mut x = erf_inv(b);
+    for _ in 0..32 {
         let value = 1.0 + b + tail(x) - target;
-        if value.abs() < 1e-10 * total {
+        if value.abs() <= 1e-6 * total {
             break;
         }
         if value > 0.0 {
@@ -349,7 +368,7 @@ fn beckmann_visible_slopes(cos_theta: f64, u1: f64, u2: f64) -> (f64, f64) {
         } else {
             lo = b;
         }
-        // d/db of the CDF: 1 - x tan theta (the facet's projected area).
+        // dF/db: 1 - x tan theta (the facet's projected area).
         let derivative = 1.0 - x * tan_theta;
         let newton = b - value / derivative;
         b = if derivative > 0.0 && newton > lo && newton < hi {
@@ -357,8 +376,9 @@ fn beckmann_visible_slopes(cos_theta: f64, u1: f64, u2: f64) -> (f64, f64) {
         } else {
             0.5 * (lo + hi)
         };
+        x = erf_inv(b);
     }
-    (erf_inv(b), erf_inv(2.0 * u2 - 1.0))
+    (x, erf_inv(2.0 * u2 - 1.0))
 }
 
 #[cfg(test)]
@@ -455,16 +475,15 @@ mod tests {
 
     #[test]
     fn beckmann_visible_slopes_reduce_to_gaussians_at_normal_incidence() {
-        let (x, y) = beckmann_visible_slopes(1.0, 0.5, 0.5);
-        assert!(x.abs() < 1e-9 && y.abs() < 1e-9);
+        let (x, y) = beckmann_visible_slopes(1.0, Vec2::splat(0.5));
+        assert!(x.abs() < 1e-6 && y.abs() < 1e-6, "{x} {y}");
         // At grazing incidence the slope x must stay below cot theta.
-        for u in [1e-6, 0.3, 0.999999] {
-            let c = 0.01f64;
-            let (x, _) = beckmann_visible_slopes(c, u, 0.5);
-            assert!(
-                x.is_finite() && x <= c / (1.0 - c * c).sqrt() + 1e-9,
-                "{u}: {x}"
-            );
+        for c in [1e-4f32, 0.01, 0.5] {
+            for u in [1e-6, 0.3, 0.999999] {
+                let (x, _) = beckmann_visible_slopes(c, Vec2::new(u, 0.5));
+                let cot = c / (1.0 - c * c).sqrt();
+                assert!(x.is_finite() && x <= cot * (1.0 + 1e-5), "{c} {u}: {x}");
+            }
         }
     }
 }
