@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, RenderStats, Result};
 use lumis_image::Image;
+use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
 use lumis_render::{render, RenderSettings};
 use lumis_scene::LoadedScene;
 
@@ -36,6 +37,11 @@ pub struct RenderArgs {
     /// Print what the loader decided the scene needs.
     #[arg(long, short)]
     pub verbose: bool,
+    /// Report where the render's time went: traversal, shading, sampling,
+    /// light sampling (statistical profile; the render runs a few percent
+    /// slower).
+    #[arg(long)]
+    pub stats: bool,
 }
 
 /// The outcome of a render, for the summary line and for tests.
@@ -46,6 +52,8 @@ pub struct RenderReport {
     pub spp: u32,
     pub seconds: f64,
     pub stats: RenderStats,
+    /// Time by stage, with `--stats`.
+    pub profile: Option<ProfileReport>,
 }
 
 impl RenderReport {
@@ -132,7 +140,7 @@ pub fn render_scene_file(
     args: &RenderArgs,
     registry: &lumis_core::Registry,
 ) -> Result<RenderReport> {
-    let loaded = load(args, registry)?;
+    let mut loaded = load(args, registry)?;
     if !args.quiet {
         for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
             eprintln!("{line}");
@@ -163,13 +171,29 @@ pub fn render_scene_file(
         threads: args.threads,
         progress: !args.quiet,
     };
-    let out = render(
-        &loaded.camera,
-        &loaded.scene,
-        loaded.integrator.as_ref(),
-        loaded.sampler.as_ref(),
-        &settings,
-    )?;
+    let (out, profile) = if args.stats {
+        loaded.scene = loaded.scene.into_profiled();
+        let sampler = ProfiledSampler(loaded.sampler.clone_sampler());
+        let profile = Profile::start();
+        let out = render(
+            &loaded.camera,
+            &ProfiledScene(&loaded.scene),
+            loaded.integrator.as_ref(),
+            &sampler,
+            &settings,
+        );
+        let report = profile.finish();
+        (out?, Some(report))
+    } else {
+        let out = render(
+            &loaded.camera,
+            &loaded.scene,
+            loaded.integrator.as_ref(),
+            loaded.sampler.as_ref(),
+            &settings,
+        )?;
+        (out, None)
+    };
     lumis_image::write_exr(&exr, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     lumis_image::write_png(&png, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     Ok(RenderReport {
@@ -179,6 +203,7 @@ pub fn render_scene_file(
         spp: settings.spp,
         seconds: out.seconds,
         stats: out.stats,
+        profile,
     })
 }
 

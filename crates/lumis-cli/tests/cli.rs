@@ -39,6 +39,7 @@ fn help_documents_every_flag() {
         "--set",
         "--quiet",
         "--verbose",
+        "--stats",
     ] {
         assert!(help.contains(flag), "render --help lacks {flag}:\n{help}");
     }
@@ -80,6 +81,65 @@ fn renders_exr_and_png_with_a_summary() {
         2,
         "no temporary files left"
     );
+}
+
+/// `--stats` reports the stages of the render, largest first, with shares
+/// that add up to the whole; the image is the one a plain render makes.
+#[test]
+fn stats_report_where_the_time_went() {
+    let tmp = scratch("stats");
+    let render = |name: &str, stats: bool| {
+        let out = tmp.path().join(name);
+        let mut args = vec![
+            "render",
+            "-q",
+            "--spp",
+            "16",
+            "--threads",
+            "2",
+            "--set",
+            "film.resolution=[64, 64]",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        let scene = scene("glossy-plates.toml");
+        args.insert(1, &scene);
+        if stats {
+            args.push("--stats");
+        }
+        let result = lumis(&args);
+        assert!(result.status.success(), "{result:?}");
+        (
+            String::from_utf8(result.stdout).unwrap(),
+            std::fs::read(out.with_extension("exr")).unwrap(),
+        )
+    };
+    let (profiled, profiled_image) = render("profiled.exr", true);
+    let (plain, plain_image) = render("plain.exr", false);
+    assert!(!plain.contains("time by stage"), "{plain}");
+    assert_eq!(profiled_image, plain_image, "--stats changed the image");
+    let rows: Vec<(&str, f64)> = profiled
+        .lines()
+        .skip_while(|l| !l.starts_with("time by stage"))
+        .skip(1)
+        .map(|l| {
+            let percent = l.split_whitespace().rev().nth(2).unwrap();
+            (l, percent.trim_end_matches('%').parse().unwrap())
+        })
+        .collect();
+    assert!(rows.len() >= 4, "{profiled}");
+    let total: f64 = rows.iter().map(|r| r.1).sum();
+    assert!(
+        (total - 100.0).abs() < 0.5,
+        "shares add to {total}:\n{profiled}"
+    );
+    assert!(rows.windows(2).all(|w| w[0].1 >= w[1].1), "{profiled}");
+    for stage in ["traversal", "BSDF", "light sampling", "sampler"] {
+        assert!(
+            rows.iter().any(|r| r.0.contains(stage)),
+            "no {stage} row:\n{profiled}"
+        );
+    }
 }
 
 #[test]

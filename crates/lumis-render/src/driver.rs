@@ -9,6 +9,7 @@ use lumis_image::Image;
 use rayon::prelude::*;
 
 use crate::camera::PerspectiveCamera;
+use crate::profile::{self, Stage};
 
 /// Tile edge in pixels: small enough to balance load, large enough that
 /// per-tile overhead (sampler clone, progress update) does not show.
@@ -61,6 +62,7 @@ fn render_tile(
     sampler: &mut dyn Sampler,
     settings: &RenderSettings,
 ) -> (Vec<[f32; 3]>, RenderStats) {
+    profile::enter_worker();
     let mut stats = RenderStats::default();
     let mut pixels =
         Vec::with_capacity(((tile.max.x - tile.min.x) * (tile.max.y - tile.min.y)) as usize);
@@ -71,8 +73,12 @@ fn render_tile(
             for index in 0..settings.spp {
                 sampler.start_pixel_sample(pixel, index, settings.seed);
                 // Box filter of radius 1/2: uniform over the pixel, weight 1.
-                let ray = camera.generate_ray(pixel, sampler.get_pixel_2d());
-                let l = integrator.li(&ray, scene, sampler, &mut stats);
+                let ray = profile::in_stage(Stage::CameraAndFilm, || {
+                    camera.generate_ray(pixel, sampler.get_pixel_2d())
+                });
+                let l = profile::in_stage(Stage::Integrator, || {
+                    integrator.li(&ray, scene, sampler, &mut stats)
+                });
                 stats.samples += 1;
                 if !l.is_finite() {
                     stats.nonfinite += 1;

@@ -3,6 +3,7 @@
 
 mod camera;
 mod driver;
+pub mod profile;
 
 pub use camera::PerspectiveCamera;
 pub use driver::{render, RenderOutput, RenderSettings, TILE_SIZE};

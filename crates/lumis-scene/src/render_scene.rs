@@ -41,7 +41,7 @@ pub(crate) struct MeshData {
     /// normalising Embree's normal and building a basis around it: a
     /// square root and two divisions in a row on the path from one query
     /// to the next, 4% of the Cornell box's render time, for 48 bytes per
-    /// triangle (README, "Performance").
+    /// triangle (docs/src/performance.md, "Levers").
     pub flat_frames: Vec<Frame>,
 }
 
@@ -204,6 +204,23 @@ impl RenderScene {
     #[cfg(feature = "replay")]
     pub fn embree_mut(&mut self) -> &mut lumis_embree::Scene {
         &mut self.embree
+    }
+
+    /// The scene with the profiling wrappers of `lumis_render::profile`
+    /// around every BSDF, light and the light sampler, so that a profiled
+    /// render attributes their time (`lumis render --stats`). Their values
+    /// are unchanged; only their calls cost a little more.
+    pub fn into_profiled(mut self) -> Self {
+        use lumis_render::profile::{ProfiledBsdf, ProfiledLight, ProfiledLightSampler};
+        for b in &mut self.bsdfs {
+            b.bsdf = Arc::new(ProfiledBsdf(Arc::clone(&b.bsdf)));
+        }
+        self.lights = std::mem::take(&mut self.lights)
+            .into_iter()
+            .map(|light| Box::new(ProfiledLight(light)) as Box<dyn Light>)
+            .collect();
+        self.light_sampler = Box::new(ProfiledLightSampler(self.light_sampler));
+        self
     }
 
     /// Bounding sphere of the geometry: `(center, radius)`.
