@@ -3,7 +3,9 @@
 # the plugin calls that one type answers (the sampler's, the BSDF's, the
 # light's) into guarded direct calls and inlines them across crates, which
 # neither PGO nor LTO does alone. What it buys, and how much less when the
-# training scenes mix plugin types: README, "Performance".
+# training scenes mix plugin types: docs/src/performance.md ("Levers", and
+# the profile-guided row of "Current numbers"); the runs are in
+# docs/performance-log.md ("Two rounds without renderer changes").
 #
 #   scripts/pgo.sh [--bench] [SCENE.toml ...]
 #

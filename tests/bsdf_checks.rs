@@ -37,8 +37,8 @@ fn every_builtin_bsdf_passes_the_check_suite() {
 
 /// Declared extremes whose lobes the chi-square cannot resolve, checked for
 /// everything else (finiteness, sample_f/f/pdf consistency, energy,
-/// reciprocity); `None` for every incident angle. The README's BSDF section
-/// says why:
+/// reciprocity); `None` for every incident angle. docs/src/studies/bsdfs.md
+/// ("The sweep every BSDF passes") says why:
 /// - Blinn's maximum exponent at grazing is narrower than f32 directions;
 /// - one roughness axis at its floor (1e-3) with the other at 0.1 or 1 is
 ///   a 1:100 or 1:1000 sliver, beyond the isotropic lobe zoom (the sweep

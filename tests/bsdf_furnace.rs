@@ -25,8 +25,8 @@
 //!
 //! The rendered means come from independent seeds, so their spread gives
 //! the standard error; the threshold is Student's t, Bonferroni-corrected
-//! over the cases. The albedo table of the README is printed with
-//! `-- --nocapture`.
+//! over the cases. The albedo table of docs/src/studies/bsdfs.md ("White
+//! furnace") is printed with `-- --nocapture`.
 
 use std::f64::consts::PI;
 

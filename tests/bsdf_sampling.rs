@@ -13,7 +13,8 @@
 //! highlight once in a million samples shows almost no variance in a few
 //! runs, but its image misses the highlight, which the reference shows.)
 //! The model's own sampling must win by a wide margin on the sharp plates.
-//! The README table is printed with `-- --nocapture`.
+//! The table of docs/src/studies/bsdfs.md ("What BSDF sampling buys") is
+//! printed with `-- --nocapture`.
 
 use lumis_image::Image;
 use lumis_tests::{mean_and_se, read_scene, render_toml, shape_mask};

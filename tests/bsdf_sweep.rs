@@ -111,7 +111,8 @@ fn blinn_sweep() {
     // the plane of incidence (a half vector tilted by delta moves wi
     // sideways by 2 cos theta_o delta), three f32 ulps of a unit vector, so
     // the density of the rounded directions is not the pdf and no
-    // chi-square on f32 directions can pass (README, BSDF section).
+    // chi-square on f32 directions can pass (docs/src/studies/bsdfs.md,
+    // "The sweep every BSDF passes").
     // Finiteness, sample_f/f/pdf consistency and energy are still checked.
     run_except("blinn", variants, &[("exponent 1000000", 1e-4)]);
 }

@@ -1,6 +1,7 @@
 //! Measured BRDFs end to end: tables written by `lumis brdf tabulate` match
 //! the analytic BSDFs they come from; the `measured` plugin works from a
-//! scene (paths, errors, cache); and the README's measured-results table:
+//! scene (paths, errors, cache); and the table of docs/src/studies/measured.md
+//! ("Measured results"):
 //! `scenes/measured-sphere.toml` (direct lighting, BSDF sampling only) for
 //! three tabulated BSDFs of increasing glossiness, rendered at equal spp
 //! with every strategy, relMSE and PSNR against a converged render, render

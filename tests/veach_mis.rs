@@ -113,7 +113,8 @@ fn estimators_agree_in_the_mean() {
     }
 }
 
-/// The per-plate relMSE table of the README, and the robustness of MIS.
+/// The per-plate relMSE table of docs/src/studies/mis.md ("MIS robustness on
+/// the Veach scene"), and the robustness of MIS.
 #[test]
 fn mis_power_is_robust_on_every_plate() {
     let runs = direct_runs();

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Render the reference image of scenes/cornell-box.toml with Mitsuba 3.
 
-The scene is built from the same OBJ files and numbers as
-`../shared/scenes/cornell-box/scene.json`: one-sided Lambertian walls, a
+The scene is built from the repository's own OBJ files
+(`scenes/cornell-box/*.obj`, found next to this script) and the same numbers
+as `scenes/cornell-box.toml`: one-sided Lambertian walls, a
 one-sided area emitter that also reflects as the white material, a pinhole
 camera with a box pixel filter, unidirectional path tracing with max_depth 8
 and Russian roulette from depth 5.

@@ -15,7 +15,7 @@ pub use assignments::{fixed_parameters, parameter_table};
 pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
-pub use listing::plugin_listing;
+pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
 pub use reference::{render_reference, ReferenceArgs, ReferenceMetadata};
 pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};

@@ -8,7 +8,7 @@ use lumis_check::bsdf_suite::{
     check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
 };
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, plugin_listing, precompute_table,
+    analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
     registry_with_search_path, render_reference, render_scene_file, tabulate_bsdf, AnalyzeArgs,
     ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
 };
@@ -35,6 +35,9 @@ enum Command {
         /// Also load this plugin library (repeatable).
         #[arg(long, value_name = "LIB.so")]
         load: Vec<PathBuf>,
+        /// Print the list as the book's Markdown reference (docs/src/plugins.md).
+        #[arg(long = "markdown")]
+        md: bool,
     },
     /// Statistically check BSDF plugins: chi-square of sample_f against pdf,
     /// pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
@@ -106,14 +109,21 @@ fn main() -> ExitCode {
         Command::Render(args) => registry_with_search_path().and_then(|registry| {
             render_scene_file(&args, &registry).map(|report| {
                 println!("{}", report.summary());
+                for line in report.profile.iter().flat_map(|p| p.lines()) {
+                    println!("{line}");
+                }
                 true
             })
         }),
-        Command::Plugins { load } => registry_with_search_path().and_then(|mut registry| {
+        Command::Plugins { load, md } => registry_with_search_path().and_then(|mut registry| {
             for library in &load {
                 lumis_loader::load_library(library, &mut registry)?;
             }
-            print!("{}", plugin_listing(&registry));
+            if md {
+                print!("{}", plugin_markdown(&registry));
+            } else {
+                print!("{}", plugin_listing(&registry));
+            }
             Ok(true)
         }),
         Command::CheckPlugin {

@@ -234,7 +234,8 @@ impl RayOrigins {
     /// The test is a well-predicted branch on values known before the
     /// origin is picked, so the ray's direction waits on `to.p` alone, not
     /// on an offset computed from it: the shadow query starts that much
-    /// earlier (the Cornell box 5% faster; README, Performance). pbrt-v4
+    /// earlier (the Cornell box 5% faster; docs/src/performance.md,
+    /// "Levers"). pbrt-v4
     /// picks the offset end's side with `from - to.p`; `p - to.p` differs
     /// from it only when `p` lies within `from`'s offset of the plane at
     /// `to`, and it frees the end's offset from waiting on `from`.

@@ -87,8 +87,8 @@ impl RayHit {
 /// so every query would start by waiting for its ray to reach the cache;
 /// written as whole vectors, the loads take the stores' values directly.
 /// Measured with the `embree_overhead` bench: the bare loop 1.86-1.92 s ->
-/// 1.53-1.58 s, lumis 3.99-4.35 s -> 3.74-3.92 s (README, Performance, and
-/// docs/performance-log.md).
+/// 1.53-1.58 s, lumis 3.99-4.35 s -> 3.74-3.92 s (docs/src/performance.md,
+/// "Levers", and docs/performance-log.md).
 #[inline]
 pub(crate) fn raw_ray(ray: &Ray) -> sys::RTCRay {
     #[cfg(target_arch = "x86_64")]

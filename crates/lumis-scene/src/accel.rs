@@ -12,7 +12,7 @@ use crate::as_table;
 ///
 /// The target is a peak of at most 120 bytes per unique triangle, BVH
 /// included. Measured on single meshes (`cargo bench -p lumis-tests --bench
-/// high_poly -- --sweep`, README "High-poly assets"), peak bytes per
+/// high_poly -- --sweep`, docs/src/studies/high-poly.md), peak bytes per
 /// triangle above the ~7 MB process baseline, uncompacted / compact:
 /// 179.7 / 147.9 at 82k triangles, 142.5 / 110.5 at 328k, 152.6 / 91.8 at
 /// 1.3M (Embree's uncompacted leaves copy the vertices). An uncompacted
