@@ -94,14 +94,15 @@ fn stats_report_where_the_time_went() {
             "render",
             "-q",
             "--spp",
-            "16",
+            "64",
             "--threads",
             "2",
             "--set",
-            "film.resolution=[64, 64]",
+            "film.resolution=[128, 128]",
             "-o",
             out.to_str().unwrap(),
         ];
+        // Long enough (about a second) for every stage to be sampled.
         let scene = scene("glossy-plates.toml");
         args.insert(1, &scene);
         if stats {
@@ -134,7 +135,7 @@ fn stats_report_where_the_time_went() {
         "shares add to {total}:\n{profiled}"
     );
     assert!(rows.windows(2).all(|w| w[0].1 >= w[1].1), "{profiled}");
-    for stage in ["traversal", "BSDF", "light sampling", "sampler"] {
+    for stage in ["traversal", "BSDF", "light sampling", "shadow rays"] {
         assert!(
             rows.iter().any(|r| r.0.contains(stage)),
             "no {stage} row:\n{profiled}"
