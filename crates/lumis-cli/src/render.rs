@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lumis_core::{Error, RenderStats, Result};
+use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
 use lumis_render::{render, RenderSettings};
@@ -171,29 +171,29 @@ pub fn render_scene_file(
         threads: args.threads,
         progress: !args.quiet,
     };
-    let (out, profile) = if args.stats {
+    // With --stats the scene, its plugins and the sampler run inside the
+    // profiling wrappers; the render itself is the same call.
+    if args.stats {
         loaded.scene = loaded.scene.into_profiled();
-        let sampler = ProfiledSampler(loaded.sampler.clone_sampler());
-        let profile = Profile::start();
-        let out = render(
-            &loaded.camera,
-            &ProfiledScene(&loaded.scene),
-            loaded.integrator.as_ref(),
-            &sampler,
-            &settings,
-        );
-        let report = profile.finish();
-        (out?, Some(report))
-    } else {
-        let out = render(
-            &loaded.camera,
-            &loaded.scene,
-            loaded.integrator.as_ref(),
-            loaded.sampler.as_ref(),
-            &settings,
-        )?;
-        (out, None)
+    }
+    let profiled_scene = ProfiledScene(&loaded.scene);
+    let profiled_sampler = args
+        .stats
+        .then(|| ProfiledSampler(loaded.sampler.clone_sampler()));
+    let (scene, sampler): (&dyn Scene, &dyn Sampler) = match &profiled_sampler {
+        Some(sampler) => (&profiled_scene, sampler),
+        None => (&loaded.scene, loaded.sampler.as_ref()),
     };
+    let profile = args.stats.then(Profile::start);
+    let out = render(
+        &loaded.camera,
+        scene,
+        loaded.integrator.as_ref(),
+        sampler,
+        &settings,
+    );
+    let profile = profile.map(Profile::finish);
+    let out = out?;
     lumis_image::write_exr(&exr, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     lumis_image::write_png(&png, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     Ok(RenderReport {
