@@ -142,3 +142,34 @@ fn tiny_huge_and_far_scenes_have_no_acne_or_leaks() {
         }
     }
 }
+
+/// A smooth glass sphere (IOR 1.5) under constant radiance is invisible,
+/// and with Russian roulette from the first bounce every path still
+/// returns exactly the environment's radiance: each refraction scales the
+/// throughput by `1/eta'^2` and the next one undoes it, so roulette judges
+/// the throughput with that factor taken out (pbrt-v4's `etaScale`) and
+/// never kills a path inside the glass. Judging the raw throughput would
+/// keep the mean but kill 56% of the paths inside and double the survivors
+/// (noise of the order of the radiance itself).
+#[test]
+fn roulette_does_not_kill_paths_inside_glass() {
+    let toml = SPHERE_IN_FURNACE
+        .replace(
+            "type = \"diffuse\"\nreflectance = 1.0",
+            "type = \"dielectric\"\nint_ior = 1.5",
+        )
+        .replace("max_depth = 16", "max_depth = 64\nrr_depth = 1");
+    assert!(toml.contains("dielectric") && toml.contains("rr_depth = 1"));
+    let expected = [0.5f32, 1.0, 2.0];
+    for strategy in ["bsdf", "mis"] {
+        let out = render_toml(&toml, &[&format!("integrator.strategy={strategy}")], 0);
+        for p in &out.image.pixels {
+            for c in 0..3 {
+                assert!(
+                    (p[c] - expected[c]).abs() <= 1e-4 * expected[c],
+                    "{strategy}: pixel {p:?}, expected {expected:?}"
+                );
+            }
+        }
+    }
+}

@@ -4,8 +4,8 @@
 
 use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    Integrator, LightIndex, LightSampleContext, ParamSpec, ParamType, Params, PluginKind,
-    PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, Vec2, Vec3,
+    BsdfFlags, Integrator, LightIndex, LightSampleContext, ParamSpec, ParamType, Params,
+    PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, Vec2, Vec3,
 };
 
 use crate::estimator::{self, Estimator, Heuristic, SceneView, Strategy, VertexPlan};
@@ -103,6 +103,11 @@ impl Trace for PathIntegrator {
         // How emission found by the previous vertex's BSDF sample counts.
         let mut plan = VertexPlan::UNWEIGHTED;
         let mut prev = LightSampleContext::at(ray.o);
+        // The product of eta'^2 over the refractions so far: radiance
+        // transport divides the throughput by it, and leaving the medium
+        // will multiply it back, so Russian roulette judges the throughput
+        // without it (pbrt-v4's `etaScale`).
+        let mut eta_scale = 1.0f32;
         let mut segments = 1;
         loop {
             stats.rays += 1;
@@ -196,6 +201,9 @@ impl Trace for PathIntegrator {
                 break;
             }
             beta *= bs.f * (bs.wi.z.abs() / bs.pdf);
+            if bs.flags.contains(BsdfFlags::TRANSMISSION) {
+                eta_scale *= bs.eta * bs.eta;
+            }
             specular = bs.flags.is_specular();
             if specular {
                 plan = VertexPlan::UNWEIGHTED;
@@ -206,9 +214,10 @@ impl Trace for PathIntegrator {
             segments += 1;
 
             if segments > self.rr_depth {
-                // Survive with probability max(beta) (pbrt-v4): paths that
-                // carry little weight stop early; survivors are reweighted.
-                let q = (1.0 - beta.max_component()).max(0.0);
+                // Survive with probability max(beta eta_scale) (pbrt-v4):
+                // paths that carry little weight stop early; survivors are
+                // reweighted.
+                let q = (1.0 - (beta * eta_scale).max_component()).max(0.0);
                 if sampler.get_1d() < q {
                     break;
                 }
