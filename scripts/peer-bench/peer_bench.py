@@ -34,7 +34,7 @@ recorded (`cores` column) to show both really used them.
 References (`scenes/bench/references/NAME.exr`, with NAME.meta.json, both
 gitignored) are Mitsuba `llvm_ad_rgb` renders, sampler independent, at
 `--ref-spp` (default 4096) in passes of at most 2^24 samples, keyed by a
-hash of the scene file, every file it reads and the converter version; a
+hash of the parsed scene (not its comments), every file it reads and the converter version; a
 cached reference is reused while the key matches and its spp is at least
 `--ref-spp`. The measured-BRDF scene has no Mitsuba counterpart (Mitsuba 3's
 default build has no MERL plugin): its reference is lumis's own

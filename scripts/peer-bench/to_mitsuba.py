@@ -99,7 +99,8 @@ def referenced_files(scene, scene_dir):
 def scene_hash(path, extra=""):
     scene = load_toml(path)
     h = hashlib.sha256()
-    h.update(open(path, "rb").read())
+    # The parsed scene, not its text: an edited comment keeps the reference.
+    h.update(json.dumps(scene, sort_keys=True, default=str).encode())
     for f in referenced_files(scene, os.path.dirname(os.path.abspath(path))):
         h.update(os.path.basename(f).encode())
         with open(f, "rb") as fh:

@@ -36,8 +36,8 @@ enum Command {
         #[arg(long, value_name = "LIB.so")]
         load: Vec<PathBuf>,
         /// Print the list as the book's Markdown reference (docs/src/plugins.md).
-        #[arg(long = "markdown")]
-        md: bool,
+        #[arg(long)]
+        markdown: bool,
     },
     /// Statistically check BSDF plugins: chi-square of sample_f against pdf,
     /// pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
@@ -115,17 +115,19 @@ fn main() -> ExitCode {
                 true
             })
         }),
-        Command::Plugins { load, md } => registry_with_search_path().and_then(|mut registry| {
-            for library in &load {
-                lumis_loader::load_library(library, &mut registry)?;
-            }
-            if md {
-                print!("{}", plugin_markdown(&registry));
-            } else {
-                print!("{}", plugin_listing(&registry));
-            }
-            Ok(true)
-        }),
+        Command::Plugins { load, markdown } => {
+            registry_with_search_path().and_then(|mut registry| {
+                for library in &load {
+                    lumis_loader::load_library(library, &mut registry)?;
+                }
+                if markdown {
+                    print!("{}", plugin_markdown(&registry));
+                } else {
+                    print!("{}", plugin_listing(&registry));
+                }
+                Ok(true)
+            })
+        }
         Command::CheckPlugin {
             library,
             bsdf,
