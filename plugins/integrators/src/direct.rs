@@ -5,13 +5,12 @@
 //! `DirectLightingIntegrator`): no indirect light dilutes the difference
 //! between the strategies.
 
-use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    Integrator, LightIndex, ParamSpec, Params, PluginKind, PluginSpec, Ray, RenderStats, Result,
-    Rgb, Sampler, Scene, Vec3,
+    Integrator, ParamSpec, Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler,
+    Scene,
 };
 
-use crate::estimator::{self, Estimator, SceneView, VertexPlan};
+use crate::estimator::{self, BsdfRay, Estimator, SceneView, Vertex, VertexPlan};
 use crate::specialize::Trace;
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -58,65 +57,62 @@ impl Trace for DirectIntegrator {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
-        // What the camera sees directly counts fully (a specular "bounce").
+        // What the camera sees directly counts fully (a specular "bounce");
+        // it is not counted as found by BSDF sampling.
         stats.rays += 1;
-        let Some(hit) = scene.intersect(camera_ray) else {
-            let mut le = Rgb::BLACK;
-            for &index in scene.infinite_lights {
-                le += scene.lights[index as usize].l(
-                    camera_ray.o,
-                    Vec3::ZERO,
-                    Default::default(),
-                    camera_ray.d,
-                );
-            }
-            return le;
+        let found = scene.intersect(camera_ray);
+        let (mut radiance, _) = self.estimator.emission(
+            scene,
+            camera_ray,
+            found.as_ref(),
+            &BsdfRay::camera(camera_ray.o),
+        );
+        let Some(hit) = &found else {
+            return radiance;
         };
-        let mut radiance = match hit.light.map(LightIndex::get) {
-            Some(emitter) => scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo),
-            None => Rgb::BLACK,
-        };
-        let wo = hit.shading.to_local(hit.wo);
         let plan = if hit.bsdf_flags.is_non_specular() {
             self.estimator.plan(sampler)
         } else {
             VertexPlan::UNWEIGHTED
         };
-        let origins = hit.point.ray_origins();
+        let vertex = Vertex {
+            hit,
+            origins: hit.point.ray_origins(),
+            wo: hit.shading.to_local(hit.wo),
+        };
         if plan.light_samples > 0 {
             let u_light = sampler.get_1d_2d();
             radiance += self
                 .estimator
-                .sample_lights(&plan, &hit, &origins, wo, scene, u_light, sampler, stats);
+                .sample_lights(&plan, &vertex, scene, u_light, sampler, stats);
         }
         // The first BSDF sample, then the extra ones: all only look for
         // emission. A specular sample's emission is not weighted.
         if plan.bsdf_scale > 0.0 {
-            let bsdf_ctx = BsdfContext {
-                uv: hit.uv,
-                ..Default::default()
-            };
             let (u1, u2) = sampler.get_1d_2d();
-            if let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) {
+            if let Some(bs) = hit.bsdf.sample_f(&vertex.bsdf_context(), vertex.wo, u1, u2) {
                 let wi = hit.shading.to_world(bs.wi);
                 if wi.dot(hit.n()) * bs.wi.z > 0.0 {
                     let specular = bs.flags.is_specular();
-                    let scale = if specular { 1.0 } else { plan.bsdf_scale };
+                    let from = BsdfRay {
+                        prev: hit.light_context(),
+                        pdf: bs.pdf,
+                        specular,
+                        scale: if specular { 1.0 } else { plan.bsdf_scale },
+                    };
                     stats.rays += 1;
                     let le = self.estimator.emission_along(
                         scene,
-                        &origins.spawn_ray(wi),
-                        &hit.light_context(),
-                        bs.pdf,
-                        specular,
+                        &vertex.origins.spawn_ray(wi),
+                        &from,
                         stats,
                     );
-                    radiance += bs.f * (bs.wi.z.abs() / bs.pdf) * le * scale;
+                    radiance += bs.f * (bs.wi.z.abs() / bs.pdf) * le;
                 }
             }
             radiance += self
                 .estimator
-                .extra_bsdf_samples(&plan, &hit, &origins, wo, scene, sampler, stats);
+                .extra_bsdf_samples(&plan, &vertex, scene, sampler, stats);
         }
         radiance
     }

@@ -173,6 +173,62 @@ impl VertexPlan {
     };
 }
 
+/// A path vertex as the estimator sees it: the interaction, where rays
+/// leaving it start, and `wo` in its shading frame. Built once per vertex
+/// by the integrator and read by every strategy there.
+#[derive(Clone, Copy)]
+pub struct Vertex<'a> {
+    pub hit: &'a SurfaceInteraction<'a>,
+    pub origins: RayOrigins,
+    pub wo: Vec3,
+}
+
+impl Vertex<'_> {
+    #[inline]
+    pub fn bsdf_context(&self) -> BsdfContext {
+        bsdf_context(self.hit)
+    }
+}
+
+/// What the BSDF at `hit` is evaluated with.
+#[inline]
+pub fn bsdf_context(hit: &SurfaceInteraction) -> BsdfContext {
+    BsdfContext {
+        uv: hit.uv,
+        ..Default::default()
+    }
+}
+
+/// How a ray was sampled, which is what the MIS weight of emission found
+/// along it depends on. In the path loop it is the state carried from one
+/// vertex to the next.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfRay {
+    /// The vertex the ray leaves.
+    pub prev: LightSampleContext,
+    /// The BSDF's density of the ray's direction.
+    pub pdf: f32,
+    /// A specular sample: no light sample could find its direction, so the
+    /// emission it finds is not weighted.
+    pub specular: bool,
+    /// Factor on that emission: the plan's `bsdf_scale`, or 1 where a
+    /// specular sample continues the path.
+    pub scale: f32,
+}
+
+impl BsdfRay {
+    /// A camera ray from `o`: it counts as specular, what it sees is never
+    /// weighted.
+    pub fn camera(o: Vec3) -> Self {
+        Self {
+            prev: LightSampleContext::at(o),
+            pdf: 0.0,
+            specular: true,
+            scale: 1.0,
+        }
+    }
+}
+
 /// What [`Estimator::plan`] answers: one plan for every vertex, or for the
 /// one-sample estimator a choice between its light and its BSDF plan, the
 /// light one with probability `c_g`.
@@ -335,18 +391,15 @@ impl Estimator {
         self.heuristic.weight(self.n_f, p_bsdf, self.n_g, p_light)
     }
 
-    /// Next-event estimation at `hit`: `plan.light_samples` lights chosen
+    /// Next-event estimation at `vertex`: `plan.light_samples` lights chosen
     /// by the light sampler, one point on each, weighted and scaled. The
     /// first sample's numbers `first` (light choice, point on the light)
     /// are drawn by the caller, which may draw them before it knows the
     /// hit; further samples draw theirs from `sampler`.
-    #[allow(clippy::too_many_arguments)]
     pub fn sample_lights<S: Scene + ?Sized>(
         &self,
         plan: &VertexPlan,
-        hit: &SurfaceInteraction,
-        origins: &RayOrigins,
-        wo: Vec3,
+        vertex: &Vertex,
         scene: &SceneView<S>,
         first: (f32, Vec2),
         sampler: &mut dyn Sampler,
@@ -355,22 +408,21 @@ impl Estimator {
         // The first sample outside the loop: with the loop around every
         // sample the compiler hoisted (and spilled) the whole interaction
         // before it.
-        let mut sum = self.sample_one_light(hit, origins, wo, scene, first, stats);
+        let mut sum = self.sample_one_light(vertex, scene, first, stats);
         for _ in 1..plan.light_samples {
-            sum += self.sample_one_light(hit, origins, wo, scene, sampler.get_1d_2d(), stats);
+            sum += self.sample_one_light(vertex, scene, sampler.get_1d_2d(), stats);
         }
         sum * plan.light_scale
     }
 
     fn sample_one_light<S: Scene + ?Sized>(
         &self,
-        hit: &SurfaceInteraction,
-        origins: &RayOrigins,
-        wo: Vec3,
+        vertex: &Vertex,
         scene: &SceneView<S>,
         (u_light, u): (f32, Vec2),
         stats: &mut RenderStats,
     ) -> Rgb {
+        let hit = vertex.hit;
         let ctx = hit.light_context();
         let Some(chosen) = scene.light_sampler.sample(&ctx, u_light) else {
             return Rgb::BLACK;
@@ -380,24 +432,21 @@ impl Estimator {
             return Rgb::BLACK;
         };
         let wi = hit.shading.to_local(ls.wi);
-        let bsdf_ctx = BsdfContext {
-            uv: hit.uv,
-            ..Default::default()
-        };
+        let bsdf_ctx = vertex.bsdf_context();
         // The MIS weight needs the BSDF's pdf too (one call for both), except
         // for a delta light, whose samples take weight 1.
         let delta = light.kind() == LightKind::DeltaPosition;
         let (f, p_bsdf) = if delta {
-            (hit.bsdf.f(&bsdf_ctx, wo, wi), 0.0)
+            (hit.bsdf.f(&bsdf_ctx, vertex.wo, wi), 0.0)
         } else {
-            hit.bsdf.eval(&bsdf_ctx, wo, wi)
+            hit.bsdf.eval(&bsdf_ctx, vertex.wo, wi)
         };
         let f = f * wi.z.abs();
         if f.is_black() {
             return Rgb::BLACK;
         }
         stats.shadow_rays += 1;
-        if scene.occluded(&origins.spawn_ray_to(&ls.p)) {
+        if scene.occluded(&vertex.origins.spawn_ray_to(&ls.p)) {
             return Rgb::BLACK;
         }
         stats.light_samples += 1;
@@ -405,28 +454,22 @@ impl Estimator {
         f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
     }
 
-    /// Emission found by `count` BSDF samples at `hit` that only look for
-    /// emitters (they do not continue the path), weighted and scaled by the
-    /// plan's `bsdf_scale`; their rays leave from the vertex's `origins`.
-    #[allow(clippy::too_many_arguments)]
+    /// Emission found by `plan.extra_bsdf_samples` BSDF samples at `vertex`
+    /// that only look for emitters (they do not continue the path),
+    /// weighted and scaled by the plan's `bsdf_scale`.
     pub fn extra_bsdf_samples<S: Scene + ?Sized>(
         &self,
         plan: &VertexPlan,
-        hit: &SurfaceInteraction,
-        origins: &RayOrigins,
-        wo: Vec3,
+        vertex: &Vertex,
         scene: &SceneView<S>,
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb {
+        let hit = vertex.hit;
         let mut sum = Rgb::BLACK;
         for _ in 0..plan.extra_bsdf_samples {
             let (u1, u2) = sampler.get_1d_2d();
-            let bsdf_ctx = BsdfContext {
-                uv: hit.uv,
-                ..Default::default()
-            };
-            let Some(bs) = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2) else {
+            let Some(bs) = hit.bsdf.sample_f(&vertex.bsdf_context(), vertex.wo, u1, u2) else {
                 continue;
             };
             let wi = hit.shading.to_world(bs.wi);
@@ -434,37 +477,65 @@ impl Estimator {
                 continue;
             }
             let throughput = bs.f * (bs.wi.z.abs() / bs.pdf);
-            let prev = hit.light_context();
-            let ray = origins.spawn_ray(wi);
+            let from = BsdfRay {
+                prev: hit.light_context(),
+                pdf: bs.pdf,
+                specular: bs.flags.is_specular(),
+                scale: plan.bsdf_scale,
+            };
             stats.rays += 1;
             sum += throughput
-                * self.emission_along(scene, &ray, &prev, bs.pdf, bs.flags.is_specular(), stats);
+                * self.emission_along(scene, &vertex.origins.spawn_ray(wi), &from, stats);
         }
-        sum * plan.bsdf_scale
+        sum
     }
 
-    /// Weighted emission seen along a BSDF-sampled `ray` from `prev`: the
-    /// emitter it hits, or the infinite lights if it escapes. The caller
-    /// counts the ray and applies the plan's scale.
+    /// Weighted, scaled emission seen along a BSDF-sampled `ray`, traced
+    /// here. The caller counts the ray.
     pub fn emission_along<S: Scene + ?Sized>(
         &self,
         scene: &SceneView<S>,
         ray: &Ray,
-        prev: &LightSampleContext,
-        p_bsdf: f32,
-        specular: bool,
+        from: &BsdfRay,
         stats: &mut RenderStats,
     ) -> Rgb {
+        let found = scene.intersect(ray);
+        let (le, emitters) = self.emission(scene, ray, found.as_ref(), from);
+        stats.bsdf_light_hits += emitters;
+        le
+    }
+
+    /// Emission that `ray`, sampled as `from` says, finds: the emitter it
+    /// hit (`found`, the caller's intersection), or the infinite lights if
+    /// it escaped; each weighted by [`Estimator::bsdf_weight`] and the
+    /// scale. Also returns how many emitters contributed.
+    #[inline]
+    pub fn emission<S: Scene + ?Sized>(
+        &self,
+        scene: &SceneView<S>,
+        ray: &Ray,
+        found: Option<&SurfaceInteraction>,
+        from: &BsdfRay,
+    ) -> (Rgb, u64) {
         let mut sum = Rgb::BLACK;
-        match scene.intersect(ray) {
+        let mut emitters = 0;
+        match found {
             Some(hit) => {
                 if let Some(emitter) = hit.light.map(LightIndex::get) {
                     let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
                     if !le.is_black() {
-                        let w = self.bsdf_weight(scene, emitter, prev, ray.d, p_bsdf, specular);
+                        let w = from.scale
+                            * self.bsdf_weight(
+                                scene,
+                                emitter,
+                                &from.prev,
+                                ray.d,
+                                from.pdf,
+                                from.specular,
+                            );
                         if w > 0.0 {
                             sum += le * w;
-                            stats.bsdf_light_hits += 1;
+                            emitters += 1;
                         }
                     }
                 }
@@ -473,14 +544,22 @@ impl Estimator {
                 for &index in scene.infinite_lights {
                     let light = &scene.lights[index as usize];
                     let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
-                    let w = self.bsdf_weight(scene, index, prev, ray.d, p_bsdf, specular);
+                    let w = from.scale
+                        * self.bsdf_weight(
+                            scene,
+                            index,
+                            &from.prev,
+                            ray.d,
+                            from.pdf,
+                            from.specular,
+                        );
                     if w > 0.0 && !le.is_black() {
                         sum += le * w;
-                        stats.bsdf_light_hits += 1;
+                        emitters += 1;
                     }
                 }
             }
         }
-        sum
+        (sum, emitters)
     }
 }

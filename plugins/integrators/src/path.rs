@@ -2,13 +2,14 @@
 //! importance sampling and Russian roulette (Veach 1997, ch. 9; pbrt-v4
 //! `PathIntegrator`).
 
-use lumis_core::bsdf::BsdfContext;
 use lumis_core::{
-    BsdfFlags, Integrator, LightIndex, LightSampleContext, ParamSpec, ParamType, Params,
-    PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene, Vec2, Vec3,
+    BsdfFlags, Integrator, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Ray, RenderStats,
+    Result, Rgb, Sampler, Scene, Vec2,
 };
 
-use crate::estimator::{self, Estimator, Heuristic, SceneView, Strategy, VertexPlan};
+use crate::estimator::{
+    self, bsdf_context, BsdfRay, Estimator, Heuristic, SceneView, Strategy, Vertex, VertexPlan,
+};
 use crate::specialize::Trace;
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -97,12 +98,9 @@ impl Trace for PathIntegrator {
         let mut radiance = Rgb::BLACK;
         let mut beta = Rgb::WHITE;
         let mut ray = *camera_ray;
-        // The camera ray counts as specular: what it sees is never weighted.
-        let mut specular = true;
-        let mut bsdf_pdf = 0.0;
-        // How emission found by the previous vertex's BSDF sample counts.
-        let mut plan = VertexPlan::UNWEIGHTED;
-        let mut prev = LightSampleContext::at(ray.o);
+        // How the ray to the next vertex was sampled: what weights the
+        // emission it finds.
+        let mut from = BsdfRay::camera(ray.o);
         // The product of eta'^2 over the refractions so far: radiance
         // transport divides the throughput by it, and leaving the medium
         // will multiply it back, so Russian roulette judges the throughput
@@ -125,34 +123,17 @@ impl Trace for PathIntegrator {
             // Borrowed where `intersect` wrote it, not moved out of the
             // Option: that move is a 128-byte copy per vertex.
             let found = scene.intersect(&ray);
-            let Some(hit) = &found else {
-                for &index in scene.infinite_lights {
-                    let light = &scene.lights[index as usize];
-                    let le = light.l(ray.o, Vec3::ZERO, Default::default(), ray.d);
-                    let w = plan.bsdf_scale
-                        * self
-                            .estimator
-                            .bsdf_weight(scene, index, &prev, ray.d, bsdf_pdf, specular);
-                    if w > 0.0 && !le.is_black() {
-                        radiance += beta * le * w;
-                        stats.bsdf_light_hits += u64::from(segments > 1);
-                    }
-                }
-                break;
-            };
-            if let Some(emitter) = hit.light.map(LightIndex::get) {
-                let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
-                if !le.is_black() {
-                    let w = plan.bsdf_scale
-                        * self
-                            .estimator
-                            .bsdf_weight(scene, emitter, &prev, ray.d, bsdf_pdf, specular);
-                    if w > 0.0 {
-                        radiance += beta * le * w;
-                        stats.bsdf_light_hits += u64::from(segments > 1);
-                    }
+            let (le, emitters) = self.estimator.emission(scene, &ray, found.as_ref(), &from);
+            if emitters > 0 {
+                radiance += beta * le;
+                // What the camera sees is not found by BSDF sampling.
+                if segments > 1 {
+                    stats.bsdf_light_hits += emitters;
                 }
             }
+            let Some(hit) = &found else {
+                break;
+            };
             if segments >= self.max_depth {
                 break;
             }
@@ -161,7 +142,7 @@ impl Trace for PathIntegrator {
             // pieces and reloads as one vector, which the CPU cannot forward
             // from the stores and waits for.
             let wo = hit.shading.to_local(-ray.d);
-            plan = if hit.bsdf_flags.is_non_specular() {
+            let plan = if hit.bsdf_flags.is_non_specular() {
                 self.estimator.plan(sampler)
             } else {
                 VertexPlan::UNWEIGHTED
@@ -172,25 +153,25 @@ impl Trace for PathIntegrator {
             // estimation it runs alongside the light sample. Moving the
             // frame change and ray offset up as well measured slower (see
             // docs/performance-log.md).
-            let bsdf_ctx = BsdfContext {
-                uv: hit.uv,
-                ..Default::default()
-            };
-            let sampled = hit.bsdf.sample_f(&bsdf_ctx, wo, u1, u2);
+            let sampled = hit.bsdf.sample_f(&bsdf_context(hit), wo, u1, u2);
             // Both offset origins as soon as the hit is known: the shadow
             // rays and the continuation then only pick one.
-            let origins = hit.point.ray_origins();
+            let vertex = Vertex {
+                hit,
+                origins: hit.point.ray_origins(),
+                wo,
+            };
             if plan.light_samples > 0 {
                 radiance += beta
                     * self
                         .estimator
-                        .sample_lights(&plan, hit, &origins, wo, scene, u_light, sampler, stats);
+                        .sample_lights(&plan, &vertex, scene, u_light, sampler, stats);
             }
             if plan.extra_bsdf_samples > 0 {
                 radiance += beta
                     * self
                         .estimator
-                        .extra_bsdf_samples(&plan, hit, &origins, wo, scene, sampler, stats);
+                        .extra_bsdf_samples(&plan, &vertex, scene, sampler, stats);
             }
             let Some(bs) = sampled else {
                 break;
@@ -204,13 +185,14 @@ impl Trace for PathIntegrator {
             if bs.flags.contains(BsdfFlags::TRANSMISSION) {
                 eta_scale *= bs.eta * bs.eta;
             }
-            specular = bs.flags.is_specular();
-            if specular {
-                plan = VertexPlan::UNWEIGHTED;
-            }
-            bsdf_pdf = bs.pdf;
-            prev = hit.light_context();
-            ray = origins.spawn_ray(wi);
+            let specular = bs.flags.is_specular();
+            from = BsdfRay {
+                prev: hit.light_context(),
+                pdf: bs.pdf,
+                specular,
+                scale: if specular { 1.0 } else { plan.bsdf_scale },
+            };
+            ray = vertex.origins.spawn_ray(wi);
             segments += 1;
 
             if segments > self.rr_depth {
