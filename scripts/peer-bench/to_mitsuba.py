@@ -114,6 +114,15 @@ def scene_hash(path, extra=""):
 # ---------------------------------------------------------------- BSDFs
 
 
+def isotropic_roughness(b, where, what):
+    """The roughness of a model Mitsuba has only isotropic (its smooth and
+    rough dielectric and plastic)."""
+    r = b.get("roughness", 0.0)
+    if b.get("roughness_v", r) != r:
+        raise Unsupported(f"{where}: anisotropic {what}")
+    return r
+
+
 def convert_bsdf(b, mi):
     where = f"[[bsdf]] {b.get('name')!r}"
     t = b.get("type")
@@ -154,9 +163,7 @@ def convert_bsdf(b, mi):
     if t == "dielectric":
         check_keys(b, ["name", "type", "int_ior", "ext_ior", "distribution", "roughness", "roughness_v", "sampling"], where)
         d = {"int_ior": float(b.get("int_ior", 1.5)), "ext_ior": float(b.get("ext_ior", 1.0))}
-        r = b.get("roughness", 0.0)
-        if b.get("roughness_v", r) != r:
-            raise Unsupported(f"{where}: anisotropic dielectric")
+        r = isotropic_roughness(b, where, "dielectric")
         if r < 1e-3:
             d["type"] = "dielectric"
         else:
@@ -173,9 +180,7 @@ def convert_bsdf(b, mi):
             "ext_ior": float(b.get("ext_ior", 1.0)),
             "nonlinear": bool(b.get("nonlinear", False)),
         }
-        r = b.get("roughness", 0.0)
-        if b.get("roughness_v", r) != r:
-            raise Unsupported(f"{where}: anisotropic plastic")
+        r = isotropic_roughness(b, where, "plastic")
         if r < 1e-3:
             d["type"] = "plastic"
         else:
