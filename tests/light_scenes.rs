@@ -46,7 +46,7 @@ fn agree(images: &[(String, Image)], tests_in_file: usize, what: &str) {
 }
 
 /// Comparisons made by this file, for the Bonferroni correction.
-const COMPARISONS: usize = 3 * 2 * 3 + 2 + 3 + 1 + 1;
+const COMPARISONS: usize = 3 * 2 * 3 + 2 + 3 + 1 + 1 + 2;
 
 fn strategies_agree(scene_file: &str) {
     let scene = read_scene(scene_file);
@@ -230,4 +230,60 @@ fn light_sampling_modes_agree() {
         COMPARISONS,
         "light selection",
     );
+}
+
+/// A smooth plastic plane with a black base fills the view under constant
+/// light: every pixel is the coat's Fresnel reflection of the light, found
+/// only by BSDF samples of the specular lobe. With extra BSDF samples (n_f
+/// = 3) the image must agree in the mean: the specular lobe's emission is
+/// counted once, by the sample that continues the path, not again by each
+/// extra sample, in `path` and in `direct`.
+#[test]
+fn extra_bsdf_samples_count_a_specular_lobe_once() {
+    let scene = |integrator: &str| {
+        format!(
+            r#"
+[film]
+resolution = [16, 16]
+[camera]
+type = "perspective"
+origin = [0.0, 0.0, 0.0]
+target = [0.0, 0.0, -1.0]
+fov = 40.0
+[sampler]
+type = "independent"
+spp = 16
+[integrator]
+{integrator}
+[[bsdf]]
+name = "coat"
+type = "plastic"
+diffuse_reflectance = 0.0
+[[shape]]
+type = "quad"
+corner = [-10.0, -10.0, -2.0]
+edge_u = [20.0, 0.0, 0.0]
+edge_v = [0.0, 20.0, 0.0]
+bsdf = "coat"
+[[light]]
+type = "constant"
+radiance = [1.0, 1.0, 1.0]
+"#
+        )
+    };
+    for integrator in ["type = \"path\"\nmax_depth = 2", "type = \"direct\""] {
+        let scene = scene(integrator);
+        let images = vec![
+            ("n_f = 1".to_string(), render(&scene, &["seed=41"])),
+            (
+                "n_f = 3".to_string(),
+                render(&scene, &["integrator.n_f=3", "seed=42"]),
+            ),
+        ];
+        agree(
+            &images,
+            COMPARISONS,
+            &format!("{integrator}, smooth plastic"),
+        );
+    }
 }

@@ -472,6 +472,14 @@ impl Estimator {
             let Some(bs) = hit.bsdf.sample_f(&vertex.bsdf_context(), vertex.wo, u1, u2) else {
                 continue;
             };
+            // The specular lobes' emission is the continuation's alone (it
+            // counts it with scale 1, as no light sample can find it);
+            // counted here too it would be counted 1 + (n_f - 1) P(specular)
+            // times. These samples estimate the non-specular part, with the
+            // continuation, each at 1/n_f.
+            if bs.flags.is_specular() {
+                continue;
+            }
             let wi = hit.shading.to_world(bs.wi);
             if wi.dot(hit.n()) * bs.wi.z <= 0.0 {
                 continue;
@@ -480,7 +488,7 @@ impl Estimator {
             let from = BsdfRay {
                 prev: hit.light_context(),
                 pdf: bs.pdf,
-                specular: bs.flags.is_specular(),
+                specular: false,
                 scale: plan.bsdf_scale,
             };
             stats.rays += 1;
