@@ -8,8 +8,7 @@
 
 use std::path::Path;
 
-use lumis_render::{render, RenderSettings};
-use lumis_tests::scenes_dir;
+use lumis_tests::{render_loaded, scenes_dir};
 
 #[test]
 fn every_bench_scene_renders() {
@@ -38,20 +37,7 @@ fn every_bench_scene_renders() {
         ];
         let loaded = lumis_scene::load_file(scene, &set, &registry)
             .unwrap_or_else(|e| panic!("{}: {e}", scene.display()));
-        let settings = RenderSettings {
-            spp: 4,
-            seed: loaded.seed,
-            threads: 0,
-            progress: false,
-        };
-        let out = render(
-            &loaded.camera,
-            &loaded.scene,
-            loaded.integrator.as_ref(),
-            loaded.sampler.as_ref(),
-            &settings,
-        )
-        .unwrap();
+        let out = render_loaded(&loaded, 0);
         assert_eq!(out.stats.nonfinite, 0, "{}", scene.display());
         let sum: f64 = out
             .image

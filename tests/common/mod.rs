@@ -8,6 +8,7 @@ use std::path::Path;
 use lumis_core::Registry;
 use lumis_image::Image;
 use lumis_render::{render, RenderOutput, RenderSettings};
+use lumis_scene::LoadedScene;
 
 /// Loads `toml` (relative paths resolve against `scenes/`) with overrides
 /// and renders it with the scene's own spp and seed.
@@ -33,6 +34,11 @@ pub fn render_toml_with(
         registry,
     )
     .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
+    render_loaded(&loaded, threads)
+}
+
+/// Renders a loaded scene with its own spp and seed.
+pub fn render_loaded(loaded: &LoadedScene, threads: usize) -> RenderOutput {
     let settings = RenderSettings {
         spp: loaded.sampler.samples_per_pixel(),
         seed: loaded.seed,
