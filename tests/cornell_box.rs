@@ -1,10 +1,10 @@
 //! The Cornell box of `scenes/cornell-box.toml` against an established
 //! renderer's converged image, estimator agreement, and determinism.
 
-use lumis_core::{Light, LightSampler, Ray, Scene, SurfaceInteraction, Vec3};
+use lumis_core::{Ray, Scene, Vec3};
 use lumis_image::read_exr;
 use lumis_render::{render, RenderSettings};
-use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scenes_dir};
+use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scenes_dir, Opaque};
 
 const BLOCK: usize = 32;
 
@@ -80,28 +80,6 @@ fn bit_identical_for_any_thread_count() {
         2,
     );
     assert_ne!(one.image, other_seed.image);
-}
-
-/// Delegates every query to the scene it wraps and keeps the default
-/// `as_any`, so the integrators run their loop over `dyn Scene`.
-struct Opaque<'a>(&'a dyn Scene);
-
-impl Scene for Opaque<'_> {
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
-        self.0.intersect(ray)
-    }
-    fn occluded(&self, ray: &Ray) -> bool {
-        self.0.occluded(ray)
-    }
-    fn lights(&self) -> &[Box<dyn Light>] {
-        self.0.lights()
-    }
-    fn infinite_lights(&self) -> &[u32] {
-        self.0.infinite_lights()
-    }
-    fn light_sampler(&self) -> &dyn LightSampler {
-        self.0.light_sampler()
-    }
 }
 
 /// The integrators compile their loop for lumis's own scene type and for

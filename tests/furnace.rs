@@ -9,22 +9,35 @@
 
 use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 
-/// 3 strategies x 6 scenes x 3 channels, overall false-alarm rate 1e-3.
+/// The integrators that trace paths: the scalar one and the wavefront one.
+const PATH_TRACERS: [&str; 2] = ["path", "wavefront"];
+
+/// 2 integrators x 3 strategies x 6 scenes x 3 channels, overall
+/// false-alarm rate 1e-3.
 fn z_limit() -> f64 {
-    bonferroni_z(1e-3, 54)
+    bonferroni_z(1e-3, 108)
 }
 
 fn check_uniform_image(toml: &str, strategy: &str, expected: [f64; 3]) {
-    let out = render_toml(toml, &[&format!("integrator.strategy={strategy}")], 0);
-    assert_eq!(out.stats.nonfinite, 0);
-    for (c, &want) in expected.iter().enumerate() {
-        let values: Vec<f64> = out.image.pixels.iter().map(|p| p[c] as f64).collect();
-        let (mean, se) = mean_and_se(&values);
-        let tolerance = z_limit() * se + 1e-5 * want;
-        assert!(
-            (mean - want).abs() <= tolerance,
-            "{strategy}: channel {c}: mean {mean} vs exact {want} (se {se})"
+    for integrator in PATH_TRACERS {
+        let out = render_toml(
+            toml,
+            &[
+                &format!("integrator.strategy={strategy}"),
+                &format!("integrator.type=\"{integrator}\""),
+            ],
+            0,
         );
+        assert_eq!(out.stats.nonfinite, 0);
+        for (c, &want) in expected.iter().enumerate() {
+            let values: Vec<f64> = out.image.pixels.iter().map(|p| p[c] as f64).collect();
+            let (mean, se) = mean_and_se(&values);
+            let tolerance = z_limit() * se + 1e-5 * want;
+            assert!(
+                (mean - want).abs() <= tolerance,
+                "{integrator}, {strategy}: channel {c}: mean {mean} vs exact {want} (se {se})"
+            );
+        }
     }
 }
 
@@ -161,13 +174,23 @@ fn roulette_does_not_kill_paths_inside_glass() {
         .replace("max_depth = 16", "max_depth = 64\nrr_depth = 1");
     assert!(toml.contains("dielectric") && toml.contains("rr_depth = 1"));
     let expected = [0.5f32, 1.0, 2.0];
-    for strategy in ["bsdf", "mis"] {
-        let out = render_toml(&toml, &[&format!("integrator.strategy={strategy}")], 0);
+    for (strategy, integrator) in ["bsdf", "mis"]
+        .into_iter()
+        .flat_map(|s| PATH_TRACERS.map(|i| (s, i)))
+    {
+        let out = render_toml(
+            &toml,
+            &[
+                &format!("integrator.strategy={strategy}"),
+                &format!("integrator.type=\"{integrator}\""),
+            ],
+            0,
+        );
         for p in &out.image.pixels {
             for c in 0..3 {
                 assert!(
                     (p[c] - expected[c]).abs() <= 1e-4 * expected[c],
-                    "{strategy}: pixel {p:?}, expected {expected:?}"
+                    "{integrator}, {strategy}: pixel {p:?}, expected {expected:?}"
                 );
             }
         }

@@ -46,7 +46,7 @@ fn agree(images: &[(String, Image)], tests_in_file: usize, what: &str) {
 }
 
 /// Comparisons made by this file, for the Bonferroni correction.
-const COMPARISONS: usize = 3 * 2 * 3 + 2 + 3 + 1 + 1 + 2;
+const COMPARISONS: usize = 3 * 2 * 4 + 2 + 3 + 1 + 1 + 2;
 
 fn strategies_agree(scene_file: &str) {
     let scene = read_scene(scene_file);
@@ -69,6 +69,10 @@ fn strategies_agree(scene_file: &str) {
             (
                 "mis-balance",
                 ["integrator.strategy=mis", "integrator.heuristic=balance"],
+            ),
+            (
+                "wavefront mis-power",
+                ["integrator.type=\"wavefront\"", "integrator.strategy=mis"],
             ),
         ]
         .into_iter()

@@ -96,9 +96,12 @@ fn rectangle_light_matches_form_factor() {
             "integrator.beta=3.0",
         ],
     ];
-    let z = bonferroni_z(1e-3, cases.len() + 1);
+    // Each case with the scalar and the wavefront path tracer.
+    let z = bonferroni_z(1e-3, 2 * cases.len() + 1);
     for overrides in cases {
         check(&toml, overrides, expected, z);
+        let wavefront = [overrides, &["integrator.type=\"wavefront\""]].concat();
+        check(&toml, &wavefront, expected, z);
     }
 }
 
@@ -111,5 +114,13 @@ fn point_light_matches_inverse_square_law() {
     let d2 = px * px + py * py + pz * pz;
     // L = rho/pi * I cos(theta) / d^2 with cos(theta) = py / d.
     let expected = RHO / std::f64::consts::PI * intensity * (py / d2.sqrt()) / d2;
-    check(&scene(&light), &["integrator.strategy=mis"], expected, 5.0);
+    for integrator in ["path", "wavefront"] {
+        let integrator = format!("integrator.type=\"{integrator}\"");
+        check(
+            &scene(&light),
+            &["integrator.strategy=mis", &integrator],
+            expected,
+            5.0,
+        );
+    }
 }

@@ -6,7 +6,9 @@ one interleaved run (every configuration once per repeat, in a fixed order,
 so that drift of the machine touches all rows alike), renders the scene at
 `--spp` with:
 
-- lumis, the scene's own sampler, and with `--set sampler.type=independent`;
+- lumis, the scene's own sampler, and with `--set sampler.type=independent`,
+  each with the scalar `path` integrator and with `wavefront` (unless
+  `--no-wavefront`);
 - Mitsuba 3 `llvm_ad_rgb` and `scalar_rgb`, each with the samplers
   independent, stratified, multijitter and ldsampler,
 
@@ -298,6 +300,7 @@ def main():
     ap.add_argument("--samplers", default=",".join(SAMPLERS), help="Mitsuba samplers (comma-separated)")
     ap.add_argument("--refs-only", action="store_true", help="render the missing references, then stop")
     ap.add_argument("--no-mitsuba", action="store_true", help="lumis rows only (references still need Mitsuba)")
+    ap.add_argument("--no-wavefront", action="store_true", help="no rows for lumis's wavefront integrator")
     ap.add_argument("--lumis", default=os.path.join(REPO, "target", "release", "lumis"))
     ap.add_argument("--out", default=os.path.join(REPO, "target", "peer-bench"))
     args = ap.parse_args()
@@ -339,7 +342,13 @@ def main():
         ref_mean = float(ref.mean())
         w, h = ref.shape[1], ref.shape[0]
 
-        configs = [("lumis", "-", "scene", ()), ("lumis", "-", "independent", ("sampler.type=independent",))]
+        # lumis's two path tracers: the scalar `path` the scenes name, and
+        # `wavefront` (the same estimator a wave of paths at a time).
+        configs = [("lumis", "path", "scene", ()), ("lumis", "path", "independent", ("sampler.type=independent",))]
+        if not args.no_wavefront:
+            wavefront = ('integrator.type="wavefront"',)
+            configs += [("lumis", "wavefront", "scene", wavefront),
+                        ("lumis", "wavefront", "independent", wavefront + ("sampler.type=independent",))]
         loaded = {}
         if not why_not and not args.no_mitsuba:
             for v in variants:
@@ -357,7 +366,7 @@ def main():
             seed = 1 + rep
             for renderer, variant, sampler, sets in configs:
                 if renderer == "lumis":
-                    tag = "default" if sampler == "scene" else sampler
+                    tag = variant + "-" + ("default" if sampler == "scene" else sampler)
                     r = lumis.render(path, args.spp, seed, os.path.join(args.out, f"{name}-lumis-{tag}.exr"), sets)
                     label = f"{scene_sampler} (scene)" if sampler == "scene" else sampler
                 else:
@@ -415,7 +424,7 @@ def summarise(runs, names, notes):
 
 
 def fmt_row(r):
-    name = "lumis" if r["renderer"] == "lumis" else f"Mitsuba {r['variant']}"
+    name = f"lumis {r['variant']}" if r["renderer"] == "lumis" else f"Mitsuba {r['variant']}"
     ratio = f"{r['vs_anchor']:.2f}" if r["vs_anchor"] is not None else "-"
     if r["vs_anchor"] is not None and abs(r["vs_anchor"] - 1.0) < 1e-12 and r["renderer"] == "mitsuba":
         ratio = "1.00 (anchor)"

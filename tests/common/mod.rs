@@ -5,7 +5,7 @@ pub mod gltf_writer;
 
 use std::path::Path;
 
-use lumis_core::Registry;
+use lumis_core::{Light, LightSampler, Ray, Registry, Scene, SurfaceInteraction};
 use lumis_image::Image;
 use lumis_render::{render, RenderOutput, RenderSettings};
 use lumis_scene::LoadedScene;
@@ -53,6 +53,29 @@ pub fn render_loaded(loaded: &LoadedScene, threads: usize) -> RenderOutput {
         &settings,
     )
     .expect("render succeeds")
+}
+
+/// Delegates every single-ray query to the scene it wraps and keeps the
+/// defaults of the rest: integrators run their loop over `dyn Scene`
+/// (no `as_any`), and batched queries trace ray by ray (no packets).
+pub struct Opaque<'a>(pub &'a dyn Scene);
+
+impl Scene for Opaque<'_> {
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
+        self.0.intersect(ray)
+    }
+    fn occluded(&self, ray: &Ray) -> bool {
+        self.0.occluded(ray)
+    }
+    fn lights(&self) -> &[Box<dyn Light>] {
+        self.0.lights()
+    }
+    fn infinite_lights(&self) -> &[u32] {
+        self.0.infinite_lights()
+    }
+    fn light_sampler(&self) -> &dyn LightSampler {
+        self.0.light_sampler()
+    }
 }
 
 /// The repository's `scenes/` directory.

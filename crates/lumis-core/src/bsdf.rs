@@ -138,6 +138,34 @@ pub trait Bsdf: Send + Sync {
         (self.f(ctx, wo, wi), self.pdf(ctx, wo, wi))
     }
 
+    /// [`Bsdf::sample_f`] for each lane `i` of a batch: `out[i]` is
+    /// `sample_f(&ctx[i], wo[i], u1[i], u2[i])`. The wavefront integrator
+    /// calls it once per material and wave. The default loops over
+    /// `sample_f`; an override computes the lanes together (SIMD) and must
+    /// return what `sample_f` returns up to rounding (the check kit
+    /// compares). All slices have the length of `out`.
+    fn sample_f_batch(
+        &self,
+        ctx: &[BsdfContext],
+        wo: &[Vec3],
+        u1: &[f32],
+        u2: &[Vec2],
+        out: &mut [Option<BsdfSample>],
+    ) {
+        for (i, out) in out.iter_mut().enumerate() {
+            *out = self.sample_f(&ctx[i], wo[i], u1[i], u2[i]);
+        }
+    }
+
+    /// [`Bsdf::eval`] for each lane of a batch: `out[i]` is
+    /// `eval(&ctx[i], wo[i], wi[i])`. Same contract as
+    /// [`Bsdf::sample_f_batch`].
+    fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
+        for (i, out) in out.iter_mut().enumerate() {
+            *out = self.eval(&ctx[i], wo[i], wi[i]);
+        }
+    }
+
     /// Whether `f`, `sample_f` and `pdf` read [`BsdfContext::albedo_scale`]
     /// for a diffuse part that a texture may scale without the rest (e.g.
     /// the base under a clear coat). A BSDF that does not is textured by

@@ -18,4 +18,27 @@ pub trait Integrator: Send + Sync {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb;
+
+    /// How many camera rays [`Integrator::li_batch`] wants at once; 1 (the
+    /// default): the driver calls [`Integrator::li`] ray by ray.
+    fn batch_size(&self) -> usize {
+        1
+    }
+
+    /// The estimates for a batch of camera rays: `out[i]` for `rays[i]`,
+    /// whose pixel sample `samplers[i]` has started (its camera dimensions
+    /// drawn). A wavefront integrator advances the paths together; the
+    /// default traces them one by one with `li`.
+    fn li_batch(
+        &self,
+        rays: &[Ray],
+        scene: &dyn Scene,
+        samplers: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+        out: &mut [Rgb],
+    ) {
+        for ((ray, sampler), out) in rays.iter().zip(samplers).zip(out) {
+            *out = self.li(ray, scene, sampler.as_mut(), stats);
+        }
+    }
 }

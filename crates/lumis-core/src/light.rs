@@ -59,6 +59,20 @@ pub trait Light: Send + Sync {
     /// Samples a direction toward the light from `ctx`.
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample>;
 
+    /// [`Light::sample_li`] for each lane of a batch: `out[i]` is
+    /// `sample_li(&ctx[i], u[i])`. The default loops; an override (SIMD)
+    /// must return what `sample_li` returns up to rounding.
+    fn sample_li_batch(
+        &self,
+        ctx: &[LightSampleContext],
+        u: &[Vec2],
+        out: &mut [Option<LightSample>],
+    ) {
+        for (i, out) in out.iter_mut().enumerate() {
+            *out = self.sample_li(&ctx[i], u[i]);
+        }
+    }
+
     /// Density w.r.t. solid angle with which `sample_li` from `ctx` returns
     /// the direction `wi`; zero for delta lights.
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32;

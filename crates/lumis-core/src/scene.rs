@@ -17,6 +17,24 @@ pub trait Scene: Sync {
     /// Whether anything blocks `ray` within `[0, ray.t_max]` (shadow rays).
     fn occluded(&self, ray: &Ray) -> bool;
 
+    /// [`Scene::intersect`] for each ray of a batch. The default loops; a
+    /// scene may trace the batch as SIMD packets (Embree's
+    /// `rtcIntersect4/8/16`) and must find the same hits up to rounding.
+    /// `out` has the length of `rays`.
+    fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
+        for (ray, out) in rays.iter().zip(out) {
+            *out = self.intersect(ray);
+        }
+    }
+
+    /// [`Scene::occluded`] for each ray of a batch, as
+    /// [`Scene::intersect_batch`].
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        for (ray, out) in rays.iter().zip(out) {
+            *out = self.occluded(ray);
+        }
+    }
+
     fn lights(&self) -> &[Box<dyn Light>];
 
     /// Indices into [`Scene::lights`] of the infinite lights, which escaping

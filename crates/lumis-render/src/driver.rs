@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lumis_core::{Error, Integrator, RenderStats, Result, Sampler, Scene, UVec2};
+use lumis_core::{Error, Integrator, RenderStats, Result, Rgb, Sampler, Scene, UVec2};
 use lumis_image::Image;
 use rayon::prelude::*;
 
@@ -52,46 +52,70 @@ fn tiles(resolution: UVec2) -> Vec<Tile> {
     out
 }
 
-/// Renders one tile. Each pixel's samples are summed in order on one thread,
-/// so the result does not depend on the thread count.
+/// Renders one tile. The tile's samples go to the integrator in batches of
+/// its [`Integrator::batch_size`], in order (pixel by pixel, each pixel's
+/// samples by index), one sampler per batch lane; each pixel's samples are
+/// summed in that order, so the result does not depend on the thread count
+/// or the batch size.
 fn render_tile(
     tile: &Tile,
     camera: &PerspectiveCamera,
     scene: &dyn Scene,
     integrator: &dyn Integrator,
-    sampler: &mut dyn Sampler,
+    lanes: &mut [Box<dyn Sampler>],
     settings: &RenderSettings,
 ) -> (Vec<[f32; 3]>, RenderStats) {
     profile::enter_worker();
     let mut stats = RenderStats::default();
-    let mut pixels =
-        Vec::with_capacity(((tile.max.x - tile.min.x) * (tile.max.y - tile.min.y)) as usize);
-    for y in tile.min.y..tile.max.y {
-        for x in tile.min.x..tile.max.x {
-            let pixel = UVec2::new(x, y);
-            let mut sum = [0.0f64; 3];
-            for index in 0..settings.spp {
-                sampler.start_pixel_sample(pixel, index, settings.seed);
-                // Box filter of radius 1/2: uniform over the pixel, weight 1.
-                let ray = profile::in_stage(Stage::CameraAndFilm, || {
-                    camera.generate_ray(pixel, sampler.get_pixel_2d())
-                });
-                let l = profile::in_stage(Stage::Integrator, || {
-                    integrator.li(&ray, scene, sampler, &mut stats)
-                });
-                stats.samples += 1;
-                if !l.is_finite() {
-                    stats.nonfinite += 1;
-                    continue;
-                }
-                sum[0] += l.r as f64;
-                sum[1] += l.g as f64;
-                sum[2] += l.b as f64;
+    let width = tile.max.x - tile.min.x;
+    let count = width * (tile.max.y - tile.min.y);
+    let mut sums = vec![[0.0f64; 3]; count as usize];
+    let mut rays = Vec::with_capacity(lanes.len());
+    let mut pixel_of_lane = Vec::with_capacity(lanes.len());
+    let mut radiance = vec![Rgb::BLACK; lanes.len()];
+    let mut samples = (0..count).flat_map(|i| (0..settings.spp).map(move |index| (i, index)));
+    loop {
+        rays.clear();
+        pixel_of_lane.clear();
+        for (lane, (i, index)) in lanes.iter_mut().zip(samples.by_ref()) {
+            let pixel = UVec2::new(tile.min.x + i % width, tile.min.y + i / width);
+            lane.start_pixel_sample(pixel, index, settings.seed);
+            // Box filter of radius 1/2: uniform over the pixel, weight 1.
+            rays.push(profile::in_stage(Stage::CameraAndFilm, || {
+                camera.generate_ray(pixel, lane.get_pixel_2d())
+            }));
+            pixel_of_lane.push(i as usize);
+        }
+        let n = rays.len();
+        if n == 0 {
+            break;
+        }
+        profile::in_stage(Stage::Integrator, || {
+            integrator.li_batch(
+                &rays,
+                scene,
+                &mut lanes[..n],
+                &mut stats,
+                &mut radiance[..n],
+            )
+        });
+        for (&i, l) in pixel_of_lane.iter().zip(&radiance) {
+            stats.samples += 1;
+            if !l.is_finite() {
+                stats.nonfinite += 1;
+                continue;
             }
-            let inv = 1.0 / settings.spp as f64;
-            pixels.push(sum.map(|s| (s * inv) as f32));
+            let sum = &mut sums[i];
+            sum[0] += l.r as f64;
+            sum[1] += l.g as f64;
+            sum[2] += l.b as f64;
         }
     }
+    let inv = 1.0 / settings.spp as f64;
+    let pixels = sums
+        .into_iter()
+        .map(|sum| sum.map(|s| (s * inv) as f32))
+        .collect();
     (pixels, stats)
 }
 
@@ -146,16 +170,13 @@ pub fn render(
         tiles
             .par_iter()
             .map_init(
-                || sampler.clone_sampler(),
-                |tile_sampler, tile| {
-                    let out = render_tile(
-                        tile,
-                        camera,
-                        scene,
-                        integrator,
-                        tile_sampler.as_mut(),
-                        settings,
-                    );
+                || {
+                    (0..integrator.batch_size().max(1))
+                        .map(|_| sampler.clone_sampler())
+                        .collect::<Vec<_>>()
+                },
+                |lanes, tile| {
+                    let out = render_tile(tile, camera, scene, integrator, lanes, settings);
                     progress.inc(1);
                     out
                 },

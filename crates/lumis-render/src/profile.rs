@@ -250,6 +250,19 @@ impl Bsdf for ProfiledBsdf {
     fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         in_stage(Stage::Bsdf, || self.0.eval(ctx, wo, wi))
     }
+    fn sample_f_batch(
+        &self,
+        ctx: &[BsdfContext],
+        wo: &[Vec3],
+        u1: &[f32],
+        u2: &[Vec2],
+        out: &mut [Option<BsdfSample>],
+    ) {
+        in_stage(Stage::Bsdf, || self.0.sample_f_batch(ctx, wo, u1, u2, out))
+    }
+    fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
+        in_stage(Stage::Bsdf, || self.0.eval_batch(ctx, wo, wi, out))
+    }
     fn takes_albedo_scale(&self) -> bool {
         self.0.takes_albedo_scale()
     }
@@ -264,6 +277,14 @@ impl Light for ProfiledLight {
     }
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         in_stage(Stage::LightSampling, || self.0.sample_li(ctx, u))
+    }
+    fn sample_li_batch(
+        &self,
+        ctx: &[LightSampleContext],
+        u: &[Vec2],
+        out: &mut [Option<LightSample>],
+    ) {
+        in_stage(Stage::LightSampling, || self.0.sample_li_batch(ctx, u, out))
     }
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
         in_stage(Stage::LightSampling, || self.0.pdf_li(ctx, wi))
@@ -330,6 +351,12 @@ impl Scene for ProfiledScene<'_> {
     }
     fn occluded(&self, ray: &Ray) -> bool {
         in_stage(Stage::ShadowRays, || self.0.occluded(ray))
+    }
+    fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
+        in_stage(Stage::Traversal, || self.0.intersect_batch(rays, out))
+    }
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        in_stage(Stage::ShadowRays, || self.0.occluded_batch(rays, out))
     }
     fn lights(&self) -> &[Box<dyn Light>] {
         self.0.lights()

@@ -23,11 +23,12 @@
 //! (no light sample can find their direction) take weight 1 by flags, never
 //! by infinite densities.
 
-use lumis_core::bsdf::BsdfContext;
+use lumis_core::bsdf::{BsdfContext, BsdfSample};
 use lumis_core::ray::RayOrigins;
 use lumis_core::{
-    Light, LightIndex, LightKind, LightSampleContext, LightSampler, ParamSpec, ParamType, Params,
-    Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec2, Vec3,
+    Light, LightIndex, LightKind, LightSample, LightSampleContext, LightSampler, ParamSpec,
+    ParamType, Params, Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec2,
+    Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -199,6 +200,40 @@ pub fn bsdf_context(hit: &SurfaceInteraction) -> BsdfContext {
     }
 }
 
+/// The ray that an extra BSDF sample `bs` at `vertex` traces for emission,
+/// with its throughput f cos / pdf and how it was sampled; `None` for a
+/// sample that leaks below the geometric surface, or a specular one: the
+/// specular lobes' emission is the continuation's alone (it counts it with
+/// scale 1, as no light sample can find it); counted here too it would be
+/// counted 1 + (n_f - 1) P(specular) times. Extra samples estimate the
+/// non-specular part, with the continuation, each at 1/n_f.
+#[inline]
+pub fn extra_sample_ray(
+    plan: &VertexPlan,
+    vertex: &Vertex,
+    bs: &BsdfSample,
+) -> Option<(Rgb, Ray, BsdfRay)> {
+    if bs.flags.is_specular() {
+        return None;
+    }
+    let hit = vertex.hit;
+    let wi = hit.shading.to_world(bs.wi);
+    if wi.dot(hit.n()) * bs.wi.z <= 0.0 {
+        return None;
+    }
+    let from = BsdfRay {
+        prev: hit.light_context(),
+        pdf: bs.pdf,
+        specular: false,
+        scale: plan.bsdf_scale,
+    };
+    Some((
+        bs.f * (bs.wi.z.abs() / bs.pdf),
+        vertex.origins.spawn_ray(wi),
+        from,
+    ))
+}
+
 /// How a ray was sampled, which is what the MIS weight of emission found
 /// along it depends on. In the path loop it is the state carried from one
 /// vertex to the next.
@@ -227,6 +262,16 @@ impl BsdfRay {
             scale: 1.0,
         }
     }
+}
+
+/// The random numbers of a path vertex drawn before its hit
+/// ([`Estimator::vertex_numbers`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VertexNumbers {
+    /// The continuation's BSDF sample: lobe, direction.
+    pub bsdf: (f32, Vec2),
+    /// The first light sample: which light, which point.
+    pub light: (f32, Vec2),
 }
 
 /// What [`Estimator::plan`] answers: one plan for every vertex, or for the
@@ -441,17 +486,55 @@ impl Estimator {
         } else {
             hit.bsdf.eval(&bsdf_ctx, vertex.wo, wi)
         };
-        let f = f * wi.z.abs();
-        if f.is_black() {
+        let Some(unshadowed) = self.light_contribution(chosen.pmf, &ls, delta, f, p_bsdf, wi.z)
+        else {
             return Rgb::BLACK;
-        }
+        };
         stats.shadow_rays += 1;
         if scene.occluded(&vertex.origins.spawn_ray_to(&ls.p)) {
             return Rgb::BLACK;
         }
         stats.light_samples += 1;
-        let p_light = chosen.pmf * ls.pdf;
-        f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
+        unshadowed
+    }
+
+    /// The weighted contribution of light sample `ls` (of light chosen with
+    /// probability `pmf`) if nothing blocks it, given the BSDF's value `f`
+    /// and density `p_bsdf` for its direction, whose cosine with the
+    /// shading normal is `cos_theta`; `None` where the BSDF gives it no
+    /// weight, so that no shadow ray is traced for it.
+    #[inline]
+    pub fn light_contribution(
+        &self,
+        pmf: f32,
+        ls: &LightSample,
+        delta: bool,
+        f: Rgb,
+        p_bsdf: f32,
+        cos_theta: f32,
+    ) -> Option<Rgb> {
+        let f = f * cos_theta.abs();
+        if f.is_black() {
+            return None;
+        }
+        let p_light = pmf * ls.pdf;
+        Some(f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light))
+    }
+
+    /// The numbers a path vertex draws before its hit is known: the BSDF
+    /// sample's (lobe, direction) and, where the estimator samples lights,
+    /// the first light sample's (which light, which point). Drawn before
+    /// the intersection, their latency overlaps it; BSDF-only paths keep
+    /// their dimensions.
+    #[inline]
+    pub fn vertex_numbers(&self, sampler: &mut dyn Sampler) -> VertexNumbers {
+        let bsdf = sampler.get_1d_2d();
+        let light = if self.samples_lights() {
+            sampler.get_1d_2d()
+        } else {
+            (0.0, Vec2::ZERO)
+        };
+        VertexNumbers { bsdf, light }
     }
 
     /// Emission found by `plan.extra_bsdf_samples` BSDF samples at `vertex`
@@ -472,28 +555,11 @@ impl Estimator {
             let Some(bs) = hit.bsdf.sample_f(&vertex.bsdf_context(), vertex.wo, u1, u2) else {
                 continue;
             };
-            // The specular lobes' emission is the continuation's alone (it
-            // counts it with scale 1, as no light sample can find it);
-            // counted here too it would be counted 1 + (n_f - 1) P(specular)
-            // times. These samples estimate the non-specular part, with the
-            // continuation, each at 1/n_f.
-            if bs.flags.is_specular() {
+            let Some((throughput, ray, from)) = extra_sample_ray(plan, vertex, &bs) else {
                 continue;
-            }
-            let wi = hit.shading.to_world(bs.wi);
-            if wi.dot(hit.n()) * bs.wi.z <= 0.0 {
-                continue;
-            }
-            let throughput = bs.f * (bs.wi.z.abs() / bs.pdf);
-            let from = BsdfRay {
-                prev: hit.light_context(),
-                pdf: bs.pdf,
-                specular: false,
-                scale: plan.bsdf_scale,
             };
             stats.rays += 1;
-            sum += throughput
-                * self.emission_along(scene, &vertex.origins.spawn_ray(wi), &from, stats);
+            sum += throughput * self.emission_along(scene, &ray, &from, stats);
         }
         sum
     }

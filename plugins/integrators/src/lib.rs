@@ -4,12 +4,15 @@
 mod direct;
 mod estimator;
 mod path;
+mod path_state;
 mod specialize;
+mod wavefront;
 
 pub use direct::DirectIntegrator;
 pub use estimator::{Estimator, Heuristic, MisEstimator, SceneView, Strategy, VertexPlan};
 pub use path::PathIntegrator;
 pub use specialize::{Specialized, Trace};
+pub use wavefront::WavefrontIntegrator;
 
 use lumis_core::{Registry, Result, Scene};
 
@@ -20,6 +23,9 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     })?;
     registry.add_integrator(direct::SPEC, |p| {
         Ok(Box::new(DirectIntegrator::from_params(p)?))
+    })?;
+    registry.add_integrator(wavefront::SPEC, |p| {
+        Ok(Box::new(WavefrontIntegrator::from_params(p)?))
     })
 }
 
@@ -36,5 +42,10 @@ pub fn register_specialized<S: Scene + 'static>(registry: &mut Registry) -> Resu
         Ok(Box::new(Specialized::<_, S>::new(
             DirectIntegrator::from_params(p)?,
         )))
+    })?;
+    // Its scene queries are one virtual call per wave, not per ray: it
+    // needs no loop compiled for the scene type.
+    registry.add_integrator(wavefront::SPEC, |p| {
+        Ok(Box::new(WavefrontIntegrator::from_params(p)?))
     })
 }

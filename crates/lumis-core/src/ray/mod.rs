@@ -1,5 +1,12 @@
 //! Rays and robust spawning of secondary rays (pbrt-v4, section 6.8.6).
 
+mod ulp_step;
+
+#[cfg(test)]
+use ulp_step::step_bits;
+
+use ulp_step::step_away_fast;
+
 use glam::Vec3;
 
 use crate::math::{gamma, next_float_down, next_float_up};
@@ -66,66 +73,6 @@ fn step_away(po: Vec3, offset: Vec3) -> Vec3 {
             step_toward(po.z, offset.z),
         )
     })
-}
-
-/// Every component of `po` moved one ulp toward the sign of the matching
-/// component of `offset` by [`step_bits`], or `None` when a component of
-/// `po` is zero, infinite or NaN (their step is not an integer increment).
-/// On x86-64 the three lanes go through SSE2 at once (a path vertex offsets
-/// three ray ends), with `safe_arch`'s safe wrappers of the intrinsics.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-fn step_away_fast(po: Vec3, offset: Vec3) -> Option<Vec3> {
-    use glam::Vec3A;
-    use safe_arch::*;
-    let bits = cast_to_m128i_from_m128(m128(Vec3A::from(po).into()));
-    let magnitude = bitand_m128i(bits, set_splat_i32_m128i(0x7fff_ffff));
-    let finite_non_zero = bitand_m128i(
-        cmp_gt_mask_i32_m128i(magnitude, zeroed_m128i()),
-        cmp_lt_mask_i32_m128i(magnitude, set_splat_i32_m128i(0x7f80_0000)),
-    );
-    if move_mask_m128(cast_to_m128_from_m128i(finite_non_zero)) & 0b111 != 0b111 {
-        return None;
-    }
-    let direction = m128(Vec3A::from(offset).into());
-    // step_bits, lane-wise: +1 away from zero, -1 toward it, 0 for a zero
-    // direction.
-    let toward_zero =
-        shr_imm_u32_m128i::<31>(bitxor_m128i(bits, cast_to_m128i_from_m128(direction)));
-    let step = sub_i32_m128i(set_splat_i32_m128i(1), shl_imm_u32_m128i::<1>(toward_zero));
-    let no_direction = cast_to_m128i_from_m128(cmp_eq_mask_m128(direction, zeroed_m128()));
-    let stepped = add_i32_m128i(bits, bitandnot_m128i(no_direction, step));
-    Some(Vec3A::from(cast_to_m128_from_m128i(stepped).0).into())
-}
-
-#[cfg(not(target_arch = "x86_64"))]
-#[inline(always)]
-fn step_away_fast(po: Vec3, offset: Vec3) -> Option<Vec3> {
-    let bits = po.to_array().map(f32::to_bits);
-    if bits
-        .iter()
-        .any(|&b| (b & 0x7fff_ffff).wrapping_sub(1) >= 0x7f7f_ffff)
-    {
-        return None;
-    }
-    let [x, y, z] = [
-        (bits[0], offset.x),
-        (bits[1], offset.y),
-        (bits[2], offset.z),
-    ]
-    .map(|(b, o)| f32::from_bits(step_bits(b, o)));
-    Some(Vec3::new(x, y, z))
-}
-
-/// The bits of a finite, non-zero `v` moved one ulp toward the sign of
-/// `direction` (unchanged for a zero direction): moving away from zero
-/// increments the bits, toward zero decrements them.
-#[cfg(any(test, not(target_arch = "x86_64")))]
-#[inline(always)]
-fn step_bits(bits: u32, direction: f32) -> u32 {
-    let toward_zero = (bits ^ direction.to_bits()) >> 31;
-    let step = 1u32.wrapping_sub(toward_zero << 1);
-    bits.wrapping_add(if direction == 0.0 { 0 } else { step })
 }
 
 /// `next_float_up(v)` if `direction > 0`, `next_float_down(v)` if `< 0`,

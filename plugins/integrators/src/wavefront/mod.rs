@@ -1,0 +1,460 @@
+//! `wavefront`: the `path` estimator advanced a wave of paths at a time
+//! (Laine, Karras and Aila 2013, "Megakernels Considered Harmful:
+//! Wavefront Path Tracing on GPUs"; pbrt-v4's `WavefrontPathIntegrator`).
+//!
+//! Each bounce runs as stages over every live path of the wave: draw the
+//! vertex's numbers, trace all rays ([`Scene::intersect_batch`]: SIMD
+//! packets in the renderer's scene), add the emission they find, sample
+//! every BSDF grouped by material ([`lumis_core::Bsdf::sample_f_batch`]),
+//! sample the lights grouped by light
+//! ([`lumis_core::Light::sample_li_batch`]), evaluate the BSDFs at the
+//! light samples grouped by material ([`lumis_core::Bsdf::eval_batch`]),
+//! trace all shadow rays ([`Scene::occluded_batch`]), and continue each path
+//! as `path` does ([`PathState`]). Every stage sees many independent lanes
+//! of one kind, which a plugin may compute with SIMD.
+//!
+//! The arithmetic of each path is `path`'s, in the same order, and each path
+//! draws its sampler's numbers in the same order: with plugins and a scene
+//! that keep the scalar defaults, the two integrators give the same image
+//! bit for bit; batched overrides change it only by their rounding.
+
+mod batched;
+
+use lumis_core::{
+    BsdfSample, Integrator, LightKind, LightSample, LightSampleContext, ParamSpec, ParamType,
+    Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler, Scene,
+    SurfaceInteraction, Vec2, Vec3,
+};
+
+use crate::estimator::{
+    bsdf_context, extra_sample_ray, SceneView, Vertex, VertexNumbers, VertexPlan,
+};
+use crate::path::{self, PathIntegrator};
+use crate::path_state::PathState;
+use batched::{Batcher, BsdfLane};
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Integrator,
+    name: "wavefront",
+    doc: "the path tracer run a wave of paths at a time: each bounce traces all rays as packets and calls every BSDF and light once per wave, so plugins may compute lanes with SIMD; same estimate as path",
+    params: &PARAMS,
+};
+
+const PARAMS: [ParamSpec; 9] = [
+    path::PARAMS[0],
+    path::PARAMS[1],
+    path::PARAMS[2],
+    path::PARAMS[3],
+    path::PARAMS[4],
+    path::PARAMS[5],
+    path::PARAMS[6],
+    path::PARAMS[7],
+    ParamSpec::with_default(
+        "wave_size",
+        ParamType::Int,
+        "256",
+        "camera rays (paths) advanced together; more lanes fill the batched calls better, at the cost of memory",
+    )
+    .in_range(1.0, 65536.0),
+];
+
+/// Camera rays per wave lane that one [`Integrator::li_batch`] call takes.
+const REGENERATIONS: usize = 8;
+
+pub struct WavefrontIntegrator {
+    /// The estimator's settings, and the scalar loop for a single ray.
+    path: PathIntegrator,
+    wave_size: usize,
+}
+
+impl WavefrontIntegrator {
+    pub fn new(path: PathIntegrator, wave_size: usize) -> Self {
+        Self {
+            path,
+            wave_size: wave_size.max(1),
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let wave_size = params.get_in_range("wave_size")? as usize;
+        Ok(Self::new(PathIntegrator::from_params(params)?, wave_size))
+    }
+}
+
+/// A path vertex of the wave: its lane and what `path` knows there.
+struct WaveVertex<'s> {
+    lane: usize,
+    hit: SurfaceInteraction<'s>,
+    wo: Vec3,
+    plan: VertexPlan,
+}
+
+impl<'s> WaveVertex<'s> {
+    fn vertex(&self) -> Vertex<'_> {
+        Vertex {
+            hit: &self.hit,
+            origins: self.hit.point.ray_origins(),
+            wo: self.wo,
+        }
+    }
+
+    fn bsdf_lane(&self) -> BsdfLane<'s> {
+        BsdfLane {
+            bsdf: self.hit.bsdf,
+            ctx: bsdf_context(&self.hit),
+            wo: self.wo,
+        }
+    }
+}
+
+/// A light sample of a wave vertex waiting for its shadow ray.
+#[derive(Clone, Copy)]
+struct PendingShadow {
+    vertex: usize,
+    unshadowed: Rgb,
+}
+
+/// Everything a wave keeps between stages and bounces, allocated once per
+/// wave: the paths, and the buffers each stage fills for the next.
+struct Wave<'s> {
+    paths: Vec<PathState>,
+    numbers: Vec<VertexNumbers>,
+    live: Vec<usize>,
+    rays: Vec<Ray>,
+    found: Vec<Option<SurfaceInteraction<'s>>>,
+    vertices: Vec<WaveVertex<'s>>,
+    bsdf_lanes: Vec<BsdfLane<'s>>,
+    u: Vec<(f32, Vec2)>,
+    continuations: Vec<Option<BsdfSample>>,
+    light_sums: Vec<Rgb>,
+    extra_sums: Vec<Rgb>,
+    lights: LightStage,
+    batcher: Batcher,
+}
+
+/// The buffers of one round of light samples.
+#[derive(Default)]
+struct LightStage {
+    takers: Vec<usize>,
+    chosen: Vec<SampledLight>,
+    ctx: Vec<LightSampleContext>,
+    u: Vec<Vec2>,
+    light_of: Vec<u32>,
+    samples: Vec<Option<LightSample>>,
+    sampled: Vec<usize>,
+    /// The vertex of each sampled light sample.
+    vertex_of: Vec<usize>,
+    wi: Vec<Vec3>,
+    evals: Vec<(Rgb, f32)>,
+    pending: Vec<PendingShadow>,
+    shadow_rays: Vec<Ray>,
+    blocked: Vec<bool>,
+}
+
+impl Wave<'_> {
+    /// A wave of `n` lanes over `camera_rays`, none started yet.
+    fn new(camera_rays: &[Ray], n: usize) -> Self {
+        Self {
+            paths: camera_rays.iter().map(PathState::new).collect(),
+            numbers: Vec::with_capacity(n),
+            live: Vec::with_capacity(n),
+            rays: Vec::with_capacity(n),
+            found: Vec::with_capacity(n),
+            vertices: Vec::with_capacity(n),
+            bsdf_lanes: Vec::with_capacity(n),
+            u: Vec::with_capacity(n),
+            continuations: Vec::with_capacity(n),
+            light_sums: Vec::with_capacity(n),
+            extra_sums: Vec::with_capacity(n),
+            lights: LightStage::default(),
+            batcher: Batcher::default(),
+        }
+    }
+}
+
+impl Integrator for WavefrontIntegrator {
+    /// A single ray is a wave of one: `path`'s scalar loop.
+    fn li(
+        &self,
+        ray: &Ray,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        self.path.li(ray, scene, sampler, stats)
+    }
+
+    /// Several waves' worth: a lane whose path ends takes the next camera
+    /// ray, so the wave stays full through the bounces (Laine et al. 2013,
+    /// section 4: regeneration) and its buffers serve many paths.
+    fn batch_size(&self) -> usize {
+        self.wave_size * REGENERATIONS
+    }
+
+    fn li_batch(
+        &self,
+        rays: &[Ray],
+        scene: &dyn Scene,
+        samplers: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+        out: &mut [Rgb],
+    ) {
+        let scene = SceneView::new(scene);
+        let mut wave = Wave::new(rays, self.wave_size);
+        let mut unstarted = 0..rays.len();
+        loop {
+            let room = self.wave_size - wave.live.len();
+            wave.live.extend(unstarted.by_ref().take(room));
+            if wave.live.is_empty() {
+                break;
+            }
+            self.bounce(&scene, &mut wave, samplers, stats);
+        }
+        for (out, path) in out.iter_mut().zip(&wave.paths) {
+            *out = path.radiance;
+        }
+    }
+}
+
+impl WavefrontIntegrator {
+    /// Advances every live path of `wave` by one vertex.
+    fn bounce<'s>(
+        &self,
+        scene: &SceneView<'s, dyn Scene + 's>,
+        wave: &mut Wave<'s>,
+        samplers: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+    ) {
+        let estimator = &self.path.estimator;
+        wave.numbers.clear();
+        wave.rays.clear();
+        for &lane in &wave.live {
+            wave.numbers
+                .push(estimator.vertex_numbers(samplers[lane].as_mut()));
+            wave.rays.push(wave.paths[lane].ray);
+        }
+        wave.found.clear();
+        wave.found.resize(wave.rays.len(), None);
+        stats.rays += wave.rays.len() as u64;
+        scene.scene.intersect_batch(&wave.rays, &mut wave.found);
+
+        // Emission, then the vertices where the paths go on; `numbers`
+        // follows the vertices.
+        wave.vertices.clear();
+        let mut kept = 0;
+        for (k, found) in wave.found.drain(..).enumerate() {
+            let lane = wave.live[k];
+            let path = &mut wave.paths[lane];
+            path.add_emission(
+                estimator.emission(scene, &path.ray, found.as_ref(), &path.from),
+                stats,
+            );
+            let Some(hit) = found else {
+                continue;
+            };
+            if path.segments >= self.path.max_depth {
+                continue;
+            }
+            let plan = if hit.bsdf_flags.is_non_specular() {
+                estimator.plan(samplers[lane].as_mut())
+            } else {
+                VertexPlan::UNWEIGHTED
+            };
+            wave.vertices.push(WaveVertex {
+                lane,
+                wo: hit.shading.to_local(-path.ray.d),
+                hit,
+                plan,
+            });
+            wave.numbers[kept] = wave.numbers[k];
+            kept += 1;
+        }
+        wave.numbers.truncate(kept);
+        wave.bsdf_lanes.clear();
+        wave.bsdf_lanes
+            .extend(wave.vertices.iter().map(WaveVertex::bsdf_lane));
+        wave.u.clear();
+        wave.u.extend(wave.numbers.iter().map(|n| n.bsdf));
+        wave.batcher
+            .sample_f(&wave.bsdf_lanes, &wave.u, &mut wave.continuations);
+
+        self.sample_lights(scene, wave, samplers, stats);
+        self.extra_bsdf_samples(scene, wave, samplers, stats);
+        for (k, v) in wave.vertices.iter().enumerate() {
+            let path = &mut wave.paths[v.lane];
+            if v.plan.light_samples > 0 {
+                path.radiance += path.beta * (wave.light_sums[k] * v.plan.light_scale);
+            }
+            if v.plan.extra_bsdf_samples > 0 {
+                path.radiance += path.beta * wave.extra_sums[k];
+            }
+        }
+
+        wave.live.clear();
+        for (v, sampled) in wave.vertices.iter().zip(&wave.continuations) {
+            let Some(bs) = sampled else {
+                continue;
+            };
+            let path = &mut wave.paths[v.lane];
+            let sampler = samplers[v.lane].as_mut();
+            if path.continue_path(&v.vertex(), bs, &v.plan, self.path.rr_depth, sampler) {
+                wave.live.push(v.lane);
+            }
+        }
+    }
+
+    /// Next-event estimation at every vertex of the wave: into
+    /// `wave.light_sums`, the unscaled sum of its plan's light samples (as
+    /// `Estimator::sample_lights` before its scale), taken in rounds of one
+    /// sample per vertex.
+    fn sample_lights<'s>(
+        &self,
+        scene: &SceneView<'s, dyn Scene + 's>,
+        wave: &mut Wave<'s>,
+        samplers: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+    ) {
+        let estimator = &self.path.estimator;
+        let vertices = &wave.vertices;
+        let stage = &mut wave.lights;
+        wave.light_sums.clear();
+        wave.light_sums.resize(vertices.len(), Rgb::BLACK);
+        let rounds = vertices.iter().map(|v| v.plan.light_samples).max();
+        for round in 0..rounds.unwrap_or(0) {
+            // Choose a light at every vertex taking a sample this round.
+            stage.takers.clear();
+            stage.chosen.clear();
+            stage.ctx.clear();
+            stage.u.clear();
+            for (k, v) in vertices.iter().enumerate() {
+                if v.plan.light_samples <= round {
+                    continue;
+                }
+                let (u_light, u_point) = if round == 0 {
+                    wave.numbers[k].light
+                } else {
+                    samplers[v.lane].get_1d_2d()
+                };
+                let here = v.hit.light_context();
+                if let Some(light) = scene.light_sampler.sample(&here, u_light) {
+                    stage.takers.push(k);
+                    stage.chosen.push(light);
+                    stage.ctx.push(here);
+                    stage.u.push(u_point);
+                }
+            }
+            stage.light_of.clear();
+            stage.light_of.extend(stage.chosen.iter().map(|c| c.index));
+            wave.batcher.sample_li(
+                scene.lights,
+                &stage.light_of,
+                &stage.ctx,
+                &stage.u,
+                &mut stage.samples,
+            );
+
+            // The BSDF at each sampled direction.
+            stage.sampled.clear();
+            stage.vertex_of.clear();
+            stage.wi.clear();
+            for (j, ls) in stage.samples.iter().enumerate() {
+                if let Some(ls) = ls {
+                    let k = stage.takers[j];
+                    stage.sampled.push(j);
+                    stage.vertex_of.push(k);
+                    stage.wi.push(vertices[k].hit.shading.to_local(ls.wi));
+                }
+            }
+            wave.batcher.eval(
+                &wave.bsdf_lanes,
+                &stage.vertex_of,
+                &stage.wi,
+                &mut stage.evals,
+            );
+
+            stage.pending.clear();
+            stage.shadow_rays.clear();
+            for ((&j, &(f, p_bsdf)), wi) in stage.sampled.iter().zip(&stage.evals).zip(&stage.wi) {
+                let k = stage.takers[j];
+                let Some(ls) = &stage.samples[j] else {
+                    continue;
+                };
+                let chosen = stage.chosen[j];
+                let delta = scene.lights[chosen.index as usize].kind() == LightKind::DeltaPosition;
+                let p_bsdf = if delta { 0.0 } else { p_bsdf };
+                if let Some(unshadowed) =
+                    estimator.light_contribution(chosen.pmf, ls, delta, f, p_bsdf, wi.z)
+                {
+                    stage.pending.push(PendingShadow {
+                        vertex: k,
+                        unshadowed,
+                    });
+                    stage
+                        .shadow_rays
+                        .push(vertices[k].vertex().origins.spawn_ray_to(&ls.p));
+                }
+            }
+            stage.blocked.clear();
+            stage.blocked.resize(stage.shadow_rays.len(), false);
+            stats.shadow_rays += stage.shadow_rays.len() as u64;
+            scene
+                .scene
+                .occluded_batch(&stage.shadow_rays, &mut stage.blocked);
+            for (p, &blocked) in stage.pending.iter().zip(&stage.blocked) {
+                if !blocked {
+                    stats.light_samples += 1;
+                    wave.light_sums[p.vertex] += p.unshadowed;
+                }
+            }
+        }
+    }
+
+    /// Into `wave.extra_sums`, the emission found by every vertex's extra
+    /// BSDF samples (as `Estimator::extra_bsdf_samples`), in rounds of one
+    /// per vertex. Only `n_f > 1` takes them, so the buffers are the
+    /// round's own.
+    fn extra_bsdf_samples<'s>(
+        &self,
+        scene: &SceneView<'s, dyn Scene + 's>,
+        wave: &mut Wave<'s>,
+        samplers: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+    ) {
+        let estimator = &self.path.estimator;
+        let vertices = &wave.vertices;
+        wave.extra_sums.clear();
+        wave.extra_sums.resize(vertices.len(), Rgb::BLACK);
+        let rounds = vertices.iter().map(|v| v.plan.extra_bsdf_samples).max();
+        for round in 0..rounds.unwrap_or(0) {
+            let takers: Vec<usize> = (0..vertices.len())
+                .filter(|&k| vertices[k].plan.extra_bsdf_samples > round)
+                .collect();
+            let u: Vec<(f32, Vec2)> = takers
+                .iter()
+                .map(|&k| samplers[vertices[k].lane].get_1d_2d())
+                .collect();
+            let lanes: Vec<BsdfLane> = takers.iter().map(|&k| wave.bsdf_lanes[k].clone()).collect();
+            let mut bsdf_samples = Vec::new();
+            wave.batcher.sample_f(&lanes, &u, &mut bsdf_samples);
+            let mut traced = Vec::new();
+            for (&k, bs) in takers.iter().zip(&bsdf_samples) {
+                let v = &vertices[k];
+                if let Some(ray) = bs
+                    .as_ref()
+                    .and_then(|bs| extra_sample_ray(&v.plan, &v.vertex(), bs))
+                {
+                    traced.push((k, ray));
+                }
+            }
+            let rays: Vec<Ray> = traced.iter().map(|(_, (_, ray, _))| *ray).collect();
+            let mut found = vec![None; rays.len()];
+            stats.rays += rays.len() as u64;
+            scene.scene.intersect_batch(&rays, &mut found);
+            for ((k, (throughput, ray, from)), found) in traced.iter().zip(&found) {
+                let (le, emitters) = estimator.emission(scene, ray, found.as_ref(), from);
+                stats.bsdf_light_hits += emitters;
+                wave.extra_sums[*k] += *throughput * le;
+            }
+        }
+    }
+}
