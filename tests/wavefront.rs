@@ -75,9 +75,9 @@ fn same_image_as_path_bit_for_bit() {
     }
 }
 
-/// With the renderer's own scene (packet traversal) and the built-in
-/// plugins' batched overrides, the wavefront image has the same mean as
-/// `path`'s, block by block, on a diffuse and a glossy scene.
+/// With Embree packets (`[accel] packets`) and the built-in plugins'
+/// batched overrides, the wavefront image has the same mean as `path`'s,
+/// block by block, on a diffuse and a glossy scene.
 #[test]
 fn same_mean_as_path_with_packets_and_simd() {
     let scenes = [
@@ -92,7 +92,15 @@ fn same_mean_as_path_with_packets_and_simd() {
         let path = render_toml(&scene, &[&common[..], &["seed=1"]].concat(), 0);
         let wavefront = render_toml(
             &scene,
-            &[&common[..], &["seed=2", "integrator.type=\"wavefront\""]].concat(),
+            &[
+                &common[..],
+                &[
+                    "seed=2",
+                    "integrator.type=\"wavefront\"",
+                    "accel.packets=true",
+                ],
+            ]
+            .concat(),
             0,
         );
         assert_eq!(wavefront.stats.nonfinite, 0);

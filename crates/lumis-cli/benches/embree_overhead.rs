@@ -124,6 +124,21 @@ fn main() {
         dependent_best = dependent_best.min(start.elapsed().as_secs_f64());
         std::hint::black_box(hits);
     }
+    // Packets against single rays, on the same rays grouped by kind (in
+    // the recorded order within each kind: eight consecutive closest-hit
+    // rays are mostly one pixel's samples at one depth).
+    let mut by_kind = rays.clone();
+    by_kind.sort_by_key(|r| r.shadow);
+    let (mut single_best, mut packet_best) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..repeats {
+        let start = Instant::now();
+        let single = bare::trace(loaded.scene.embree(), &by_kind);
+        single_best = single_best.min(start.elapsed().as_secs_f64());
+        let start = Instant::now();
+        let packed = bare::trace_packets(loaded.scene.embree(), &by_kind);
+        packet_best = packet_best.min(start.elapsed().as_secs_f64());
+        assert_eq!(single, packed, "packets find what single rays find");
+    }
     let stats = stats.unwrap();
     assert_eq!(
         stats.total_rays(),
@@ -163,6 +178,11 @@ fn main() {
     println!(
         "ratio lumis/dependent bare rays per second: {:.3}",
         lumis_rate / (n / dependent_best)
+    );
+    println!(
+        "bare loop over the rays grouped by kind: single rays {single_best:.3} s, packets of {} {packet_best:.3} s, ratio packets/single rays per second {:.3}",
+        lumis_embree::PACKET,
+        single_best / packet_best
     );
 
     // With the `replay` feature: the same render answering every query from

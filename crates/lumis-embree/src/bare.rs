@@ -1,10 +1,11 @@
 //! A bare Embree ray loop: the baseline that lumis's throughput is measured
 //! against. Each ray costs exactly one `rtcIntersect1` or `rtcOccluded1`
-//! call on the raw scene, nothing else.
+//! call on the raw scene, nothing else; or, for packets, one lane of an
+//! `rtcIntersect8` or `rtcOccluded8` call.
 
 use embree4_sys as sys;
 
-use crate::record::{raw_ray, RayHit};
+use crate::record::{raw_ray, RayHit, PACKET};
 use crate::scene::{Ray, Scene};
 
 /// A recorded query: a closest-hit ray or a shadow ray.
@@ -60,6 +61,40 @@ fn trace_impl(scene: &Scene, rays: &[BareRay], dependent: bool) -> u64 {
             hits += u64::from(rayhit.found());
             previous = rayhit.ray.tfar.to_bits();
         }
+    }
+    hits
+}
+
+/// As [`trace`], with runs of consecutive rays of one kind traced in
+/// packets of eight ([`Scene::intersect_packets`],
+/// [`Scene::occluded_packets`]).
+pub fn trace_packets(scene: &Scene, rays: &[BareRay]) -> u64 {
+    let mut hits = 0;
+    let mut start = 0;
+    while start < rays.len() {
+        let shadow = rays[start].shadow;
+        let end = (start..rays.len().min(start + PACKET))
+            .find(|&i| rays[i].shadow != shadow)
+            .unwrap_or(rays.len().min(start + PACKET));
+        let packet: Vec<Ray> = rays[start..end]
+            .iter()
+            .map(|r| Ray {
+                org: r.org,
+                dir: r.dir,
+                tnear: 0.0,
+                tfar: r.tfar,
+            })
+            .collect();
+        if shadow {
+            let mut out = [false; PACKET];
+            scene.occluded_packets(&packet, &mut out[..packet.len()]);
+            hits += out.iter().filter(|&&o| o).count() as u64;
+        } else {
+            let mut out = [None; PACKET];
+            scene.intersect_packets(&packet, &mut out[..packet.len()]);
+            hits += out.iter().filter(|o| o.is_some()).count() as u64;
+        }
+        start = end;
     }
     hits
 }

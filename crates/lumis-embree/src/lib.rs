@@ -2,8 +2,9 @@
 //!
 //! It covers what lumis needs and nothing more: a device whose errors become
 //! Rust errors, a scene built from triangle meshes and spheres whose buffers
-//! are shared with Embree (no second copy), and the two single-ray queries,
-//! `intersect1` for closest hits and `occluded1` for shadow rays.
+//! are shared with Embree (no second copy), and the two queries, closest hit
+//! and occlusion, for single rays (`intersect1`, `occluded1`) and packets
+//! of eight (`intersect_packets`, `occluded_packets`).
 //!
 //! All `unsafe` code of lumis lives in this crate; each block says why it is
 //! sound.
@@ -19,6 +20,7 @@ mod tape;
 
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 pub use device::{Device, EmbreeError};
+pub use record::PACKET;
 pub use scene::{BuildQuality, Hit, Ray, Scene, SceneBuilder, SceneOptions};
 
 /// The geometry id Embree reports when nothing was hit.

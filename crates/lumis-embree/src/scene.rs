@@ -6,7 +6,7 @@ use embree4_sys as sys;
 
 use crate::buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 use crate::device::{Device, EmbreeError};
-use crate::record::{raw_ray, RayHit};
+use crate::record::{raw_packet, raw_ray, RayHit, RayHit8, Valid8, PACKET};
 use crate::tape::Tape;
 
 /// Embree's BVH build quality (`RTC_BUILD_QUALITY_*`).
@@ -380,6 +380,77 @@ impl Scene {
         raw.tfar == f32::NEG_INFINITY
     }
 
+    /// [`Scene::intersect1`] for each ray, traced in packets of eight
+    /// (`rtcIntersect8`). `out` has the length of `rays`.
+    pub fn intersect_packets(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
+        // The tape records and replays one query at a time.
+        if self.tape.active() {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = self.intersect1(ray);
+            }
+            return;
+        }
+        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let valid = Valid8::first(rays.len());
+            let mut packet = RayHit8::new(rays);
+            // SAFETY: the scene is committed and alive; `valid` and `packet`
+            // are 32-byte aligned, `packet` has room for every field the
+            // runtime writes (see `record`), and lanes past `rays` are
+            // switched off by `valid`; null arguments select the defaults.
+            unsafe {
+                sys::rtcIntersect8(
+                    valid.0.as_ptr(),
+                    self.raw,
+                    packet.as_raw(),
+                    std::ptr::null_mut(),
+                )
+            };
+            let (ray, hit) = (&packet.ray, &packet.hit);
+            for (i, out) in out.iter_mut().enumerate() {
+                *out = (hit.geomID[i] != sys::RTC_INVALID_GEOMETRY_ID).then(|| Hit {
+                    t: ray.tfar[i],
+                    u: hit.u[i],
+                    v: hit.v[i],
+                    ng: [hit.Ng_x[i], hit.Ng_y[i], hit.Ng_z[i]],
+                    geom_id: hit.geomID[i],
+                    prim_id: hit.primID[i],
+                    inst_id: hit.instID[0][i],
+                });
+            }
+        }
+    }
+
+    /// [`Scene::occluded1`] for each ray, traced in packets of eight
+    /// (`rtcOccluded8`). `out` has the length of `rays`.
+    pub fn occluded_packets(&self, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
+        if self.tape.active() {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = self.occluded1(ray);
+            }
+            return;
+        }
+        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let valid = Valid8::first(rays.len());
+            let mut packet = raw_packet(rays);
+            // SAFETY: as in `intersect_packets`, with an RTCRay8 (whose
+            // layout no runtime version changed).
+            unsafe {
+                sys::rtcOccluded8(
+                    valid.0.as_ptr(),
+                    self.raw,
+                    &mut packet,
+                    std::ptr::null_mut(),
+                )
+            };
+            for (i, out) in out.iter_mut().enumerate() {
+                // Embree sets tfar to -inf where the ray is occluded.
+                *out = packet.tfar[i] == f32::NEG_INFINITY;
+            }
+        }
+    }
+
     /// Records the answers of the queries that follow (feature `replay`;
     /// see the `tape` module), forgetting earlier ones.
     #[cfg(feature = "replay")]
@@ -555,6 +626,82 @@ mod tests {
             )
             .unwrap_err();
         assert!(err.message.contains("out of range"), "{err}");
+    }
+
+    /// Packets of eight find what single rays find, for closest hits and
+    /// occlusion, on meshes, spheres and instances, with limited and
+    /// unlimited segments and with a last packet that is not full.
+    #[test]
+    fn packets_answer_as_single_rays() {
+        let device = Device::new().unwrap();
+        let prototype = Arc::new(unit_quad(&device));
+        let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        let mut moved = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+        moved[9] = 1.5;
+        builder.add_instance(prototype, &moved).unwrap();
+        builder
+            .add_triangle_mesh(
+                Arc::new(vec![[-2.0, -2.0, -1.0], [2.0, -2.0, -1.0], [0.0, 2.0, -1.0]].into()),
+                Arc::new(vec![[0, 1, 2]].into()),
+            )
+            .unwrap();
+        builder
+            .add_spheres(Arc::new(vec![[-1.0, 0.5, 0.5, 0.6]].into()))
+            .unwrap();
+        let scene = builder.commit().unwrap();
+        // A fixed low-discrepancy spray of rays from around the scene.
+        let fraction = |i: u32, a: f32| (i as f32 * a).fract();
+        let rays: Vec<Ray> = (0..2000u32)
+            .map(|i| {
+                let org = [
+                    4.0 * fraction(i, 0.618_034) - 2.0,
+                    4.0 * fraction(i, 0.414_214) - 2.0,
+                    3.0,
+                ];
+                let dir = [
+                    0.8 * fraction(i, 0.732_051) - 0.4,
+                    0.8 * fraction(i, 0.236_068) - 0.4,
+                    -1.0,
+                ];
+                let tfar = if i % 3 == 0 { 3.5 } else { f32::INFINITY };
+                ray(org, dir, tfar)
+            })
+            .collect();
+        let (mut hits, mut blocked) = (0, 0);
+        let mut kinds = std::collections::BTreeSet::new();
+        for n in [0, 1, 7, 9, 33, rays.len()] {
+            let rays = &rays[..n];
+            let mut packed = vec![None; n];
+            scene.intersect_packets(rays, &mut packed);
+            let mut occluded = vec![false; n];
+            scene.occluded_packets(rays, &mut occluded);
+            for (i, r) in rays.iter().enumerate() {
+                let single = scene.intersect1(r);
+                match (single, packed[i]) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => {
+                        assert_eq!(
+                            (a.geom_id, a.prim_id, a.inst_id),
+                            (b.geom_id, b.prim_id, b.inst_id),
+                            "ray {i}"
+                        );
+                        for (x, y) in [(a.t, b.t), (a.u, b.u), (a.v, b.v)] {
+                            assert!((x - y).abs() <= 1e-5 * x.abs().max(1.0), "ray {i}");
+                        }
+                        hits += 1;
+                        kinds.insert((a.inst_id, a.geom_id));
+                    }
+                    (a, b) => panic!("ray {i}: single {a:?}, packet {b:?}"),
+                }
+                assert_eq!(scene.occluded1(r), occluded[i], "ray {i}");
+                blocked += usize::from(occluded[i]);
+            }
+        }
+        // The spray finds the instance, the mesh and the sphere, and misses
+        // too; a segment is blocked exactly where it has a hit.
+        assert_eq!(kinds.len(), 3, "{kinds:?}");
+        assert!(hits > 500 && hits < 2000, "{hits}");
+        assert_eq!(blocked, hits);
     }
 
     #[test]

@@ -30,6 +30,12 @@ impl Tape {
     pub(crate) fn occluded(&self, traverse: impl FnOnce() -> bool) -> bool {
         traverse()
     }
+
+    /// Whether queries are being recorded or replayed: never.
+    #[inline(always)]
+    pub(crate) fn active(&self) -> bool {
+        false
+    }
 }
 
 #[cfg(feature = "replay")]
@@ -136,6 +142,13 @@ mod recorder {
         #[inline(always)]
         pub(crate) fn occluded(&self, traverse: impl FnOnce() -> bool) -> bool {
             self.answer(&self.occluded, traverse)
+        }
+
+        /// Whether queries are being recorded or replayed, which the
+        /// tape does one query at a time.
+        #[inline(always)]
+        pub(crate) fn active(&self) -> bool {
+            self.mode.load(Relaxed) != OFF
         }
 
         #[inline(always)]

@@ -79,6 +79,12 @@ const ACCEL_PARAMS: &[ParamSpec] = &[
         "\"auto\"",
         "true, false or \"auto\". RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed; \"auto\": from 250000 unique triangles on",
     ),
+    ParamSpec::with_default(
+        "packets",
+        ParamType::Bool,
+        "false",
+        "trace the batches of the wavefront integrator as Embree packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray; off by default: slower on the bench suite's rays",
+    ),
 ];
 
 /// What `[accel]` asks for; compaction is decided once the scene's
@@ -88,6 +94,8 @@ pub(crate) struct AccelOptions {
     /// Quality and robustness; `compact` is set at the build.
     pub embree: SceneOptions,
     pub compaction: Compaction,
+    /// Batched queries as Embree packets.
+    pub packets: bool,
 }
 
 /// Reads `[accel]` (all defaults when absent).
@@ -109,6 +117,7 @@ pub(crate) fn accel_options(root: &Table) -> Result<AccelOptions> {
             compact: false,
         },
         compaction: params.get("compact")?,
+        packets: params.get("packets")?,
     };
     params.finish()?;
     Ok(options)
@@ -121,6 +130,14 @@ mod tests {
     fn parse(accel: &str) -> std::result::Result<AccelOptions, String> {
         let root = lumis_core::doc::parse(&format!("[accel]\n{accel}"), "s.toml").unwrap();
         accel_options(&root).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn packets_are_off_unless_asked_for() {
+        assert!(!parse("").unwrap().packets);
+        assert!(parse("packets = true").unwrap().packets);
+        let err = parse("packets = \"yes\"").unwrap_err();
+        assert!(err.contains("packets"), "{err}");
     }
 
     #[test]

@@ -258,6 +258,7 @@ pub fn load_str(
         light_sampler,
         counts,
         report,
+        packets: accel.packets,
     };
     Ok(LoadedScene {
         name: name.to_string(),

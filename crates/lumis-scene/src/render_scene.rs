@@ -8,7 +8,7 @@ use lumis_core::ray::SurfacePoint;
 use lumis_core::{
     Bsdf, BsdfFlags, Light, LightIndex, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3,
 };
-use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID};
+use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID, PACKET};
 
 pub use crate::report::LoadReport;
 
@@ -182,6 +182,8 @@ pub struct RenderScene {
     pub(crate) light_sampler: Box<dyn LightSampler>,
     pub(crate) counts: SceneCounts,
     pub(crate) report: LoadReport,
+    /// `[accel] packets`: batched queries as Embree packets.
+    pub(crate) packets: bool,
 }
 
 impl RenderScene {
@@ -262,6 +264,14 @@ pub(crate) fn bounding_sphere(scene: &lumis_embree::Scene) -> (Vec3, f32) {
     let center = 0.5 * (lo + hi);
     (center, (hi - center).length())
 }
+
+/// Fills the unused lanes of a packet (which Embree skips).
+const NO_RAY: lumis_embree::Ray = lumis_embree::Ray {
+    org: [0.0; 3],
+    dir: [0.0, 0.0, 1.0],
+    tnear: 0.0,
+    tfar: 0.0,
+};
 
 #[inline]
 fn to_embree(ray: &Ray) -> lumis_embree::Ray {
@@ -371,26 +381,22 @@ fn mesh_uv(mesh: &MeshData, tri: Triangle, b0: f32, b1: f32, b2: f32) -> Vec2 {
     }
 }
 
-impl Scene for RenderScene {
-    #[inline]
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
-        debug_assert!(
-            (ray.d.length() - 1.0).abs() < 1e-3,
-            "intersect expects a unit direction"
-        );
-        let hit = self.embree.intersect1(&to_embree(ray))?;
+impl RenderScene {
+    /// The interaction where `ray` found `hit`.
+    #[inline(always)]
+    fn interaction_at(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction<'_> {
         let wo = -ray.d;
         if hit.inst_id != INVALID_ID {
-            return Some(self.instance_hit(&hit, wo));
+            return self.instance_hit(hit, wo);
         }
         match &self.geometries[hit.geom_id as usize] {
             Geometry::Mesh(mesh) => {
-                let (point, shading, uv) = mesh_hit(mesh, &hit);
+                let (point, shading, uv) = mesh_hit(mesh, hit);
                 let light = mesh
                     .lights
                     .get(hit.prim_id as usize)
                     .and_then(|&i| LightIndex::new(i));
-                Some(self.interaction(point, shading, uv, wo, mesh.bsdf, light))
+                self.interaction(point, shading, uv, wo, mesh.bsdf, light)
             }
             Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
             Geometry::Sphere {
@@ -413,21 +419,68 @@ impl Scene for RenderScene {
                     (phi * 0.5 * std::f32::consts::FRAC_1_PI).rem_euclid(1.0),
                     outward.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
                 );
-                Some(self.interaction(
+                self.interaction(
                     SurfacePoint { p, p_error, n },
                     Frame::from_z(n),
                     uv,
                     wo,
                     *bsdf,
                     light.and_then(LightIndex::new),
-                ))
+                )
             }
         }
+    }
+}
+
+impl Scene for RenderScene {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
+        debug_assert!(
+            (ray.d.length() - 1.0).abs() < 1e-3,
+            "intersect expects a unit direction"
+        );
+        let hit = self.embree.intersect1(&to_embree(ray))?;
+        Some(self.interaction_at(ray, &hit))
     }
 
     #[inline]
     fn occluded(&self, ray: &Ray) -> bool {
         self.embree.occluded1(&to_embree(ray))
+    }
+
+    /// Ray by ray, or with `[accel] packets` as Embree packets of eight.
+    fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
+        if !self.packets {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = self.intersect(ray);
+            }
+            return;
+        }
+        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let queries: [lumis_embree::Ray; PACKET] =
+                std::array::from_fn(|i| rays.get(i).map_or(NO_RAY, to_embree));
+            let mut hits = [None; PACKET];
+            self.embree
+                .intersect_packets(&queries[..rays.len()], &mut hits[..rays.len()]);
+            for ((ray, hit), out) in rays.iter().zip(&hits).zip(out) {
+                *out = hit.as_ref().map(|hit| self.interaction_at(ray, hit));
+            }
+        }
+    }
+
+    /// As [`Scene::intersect_batch`].
+    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        if !self.packets {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = self.occluded(ray);
+            }
+            return;
+        }
+        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            let queries: [lumis_embree::Ray; PACKET] =
+                std::array::from_fn(|i| rays.get(i).map_or(NO_RAY, to_embree));
+            self.embree.occluded_packets(&queries[..rays.len()], out);
+        }
     }
 
     fn lights(&self) -> &[Box<dyn Light>] {
