@@ -22,7 +22,7 @@ use lumis_core::params::ParamDefault;
 use lumis_core::registry::TableRef;
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginKind, PluginSpec, Registry,
-    Result, TransportMode, Vec2, Vec3,
+    Result, Rgb, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -234,6 +234,7 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
     };
     let reciprocal = !bsdf.flags().contains(BsdfFlags::TRANSMISSION);
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+    let mut lanes = BatchLanes::default();
     for _ in 0..samples {
         let u1 = rng.next_f32();
         let u2 = Vec2::new(rng.next_f32(), rng.next_f32());
@@ -288,6 +289,10 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
         let radiance = BsdfContext::default();
         let (f, pdf) = (bsdf.f(&radiance, wo, wi), bsdf.pdf(&radiance, wo, wi));
         let (eval_f, eval_pdf) = bsdf.eval(&radiance, wo, wi);
+        if lanes.wi.len() < BatchLanes::MAX {
+            lanes.u.push((u1, u2));
+            lanes.wi.push(wi);
+        }
         if eval_f != f || eval_pdf.to_bits() != pdf.to_bits() {
             note(format!(
                 "eval() = ({eval_f:?}, {eval_pdf}) but (f(), pdf()) = ({f:?}, {pdf}) at wi = {wi:?}"
@@ -296,6 +301,9 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
         if !f.is_finite() || f.min_component() < 0.0 || !pdf.is_finite() || pdf < 0.0 {
             note(format!("f() = {f:?}, pdf() = {pdf} at wi = {wi:?}"));
         }
+    }
+    for problem in check_batches(bsdf, wo, &lanes) {
+        note(problem);
     }
     let n = samples as f64;
     let albedo = sum / n;
@@ -306,6 +314,68 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
         ));
     }
     (albedo, se, problems)
+}
+
+/// The lanes the batched methods are checked on: the value check's
+/// random numbers and directions.
+#[derive(Default)]
+struct BatchLanes {
+    u: Vec<(f32, Vec2)>,
+    wi: Vec<Vec3>,
+}
+
+impl BatchLanes {
+    /// Enough lanes for every SIMD width and a partial last chunk.
+    const MAX: usize = 1021;
+}
+
+/// `sample_f_batch` and `eval_batch` against `sample_f` and `eval`, lane
+/// by lane: the same samples and values up to rounding (a relative 1e-4,
+/// and `None` exactly where the scalar method gives none).
+fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
+    let n = lanes.wi.len();
+    let ctx = vec![BsdfContext::default(); n];
+    let wos = vec![wo; n];
+    let u1: Vec<f32> = lanes.u.iter().map(|u| u.0).collect();
+    let u2: Vec<Vec2> = lanes.u.iter().map(|u| u.1).collect();
+    let mut samples = vec![None; n];
+    bsdf.sample_f_batch(&ctx, &wos, &u1, &u2, &mut samples);
+    let mut evals = vec![(Rgb::BLACK, 0.0); n];
+    bsdf.eval_batch(&ctx, &wos, &lanes.wi, &mut evals);
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()) || a == b;
+    let close_rgb = |a: Rgb, b: Rgb| close(a.r, b.r) && close(a.g, b.g) && close(a.b, b.b);
+    let mut problems = Vec::new();
+    for i in 0..n {
+        let scalar = bsdf.sample_f(&ctx[i], wo, u1[i], u2[i]);
+        let agree = match (&scalar, &samples[i]) {
+            (None, None) => true,
+            (Some(a), Some(b)) => {
+                close_rgb(a.f, b.f)
+                    && close(a.pdf, b.pdf)
+                    && (a.wi - b.wi).abs().max_element() <= 1e-4
+                    && a.flags == b.flags
+            }
+            _ => false,
+        };
+        if !agree {
+            problems.push(format!(
+                "sample_f_batch lane {i} of {n} gave {:?} but sample_f gave {scalar:?} (wo = {wo:?})",
+                samples[i]
+            ));
+        }
+        let (f, pdf) = bsdf.eval(&ctx[i], wo, lanes.wi[i]);
+        let (bf, bpdf) = evals[i];
+        if !(close_rgb(f, bf) && close(pdf, bpdf)) {
+            problems.push(format!(
+                "eval_batch lane {i} of {n} gave ({bf:?}, {bpdf}) but eval gave ({f:?}, {pdf}) at wi = {:?}",
+                lanes.wi[i]
+            ));
+        }
+        if problems.len() >= 2 {
+            break;
+        }
+    }
+    problems
 }
 
 /// Runs every check over the sweep of the plugin's declared parameters
@@ -518,7 +588,7 @@ pub fn write_histogram_png(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::ParamSpec;
+    use lumis_core::{BsdfSample, ParamSpec};
 
     const SPEC: PluginSpec = PluginSpec {
         kind: PluginKind::Bsdf,
@@ -565,5 +635,99 @@ mod tests {
                 "missing {want} in {labels:?}"
             );
         }
+    }
+
+    /// A Lambertian BSDF whose batched methods can be made wrong.
+    struct Lambert {
+        wrong_eval_batch: bool,
+        wrong_sample_batch: bool,
+    }
+
+    impl Bsdf for Lambert {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::DIFFUSE_REFLECTION
+        }
+        fn f(&self, _: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+            if wo.z > 0.0 && wi.z > 0.0 {
+                Rgb::splat(std::f32::consts::FRAC_1_PI)
+            } else {
+                Rgb::BLACK
+            }
+        }
+        fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _: f32, u: Vec2) -> Option<BsdfSample> {
+            let wi = warp::square_to_cosine_hemisphere(u);
+            BsdfSample::reflection(
+                wi,
+                BsdfFlags::DIFFUSE_REFLECTION,
+                |wi| self.pdf(ctx, wo, wi),
+                |wi| self.f(ctx, wo, wi),
+            )
+        }
+        fn pdf(&self, _: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+            if wo.z > 0.0 && wi.z > 0.0 {
+                wi.z * std::f32::consts::FRAC_1_PI
+            } else {
+                0.0
+            }
+        }
+        fn sample_f_batch(
+            &self,
+            ctx: &[BsdfContext],
+            wo: &[Vec3],
+            u1: &[f32],
+            u2: &[Vec2],
+            out: &mut [Option<BsdfSample>],
+        ) {
+            for (i, out) in out.iter_mut().enumerate() {
+                // The wrong override drops the last lane of each eight.
+                *out = if self.wrong_sample_batch && i % 8 == 7 {
+                    None
+                } else {
+                    self.sample_f(&ctx[i], wo[i], u1[i], u2[i])
+                };
+            }
+        }
+        fn eval_batch(
+            &self,
+            ctx: &[BsdfContext],
+            wo: &[Vec3],
+            wi: &[Vec3],
+            out: &mut [(Rgb, f32)],
+        ) {
+            for (i, out) in out.iter_mut().enumerate() {
+                let (f, pdf) = self.eval(&ctx[i], wo[i], wi[i]);
+                // The wrong override forgets the cosine in the pdf.
+                *out = if self.wrong_eval_batch {
+                    (f, pdf.min(std::f32::consts::FRAC_1_PI * 0.999))
+                } else {
+                    (f, pdf)
+                };
+            }
+        }
+    }
+
+    #[test]
+    fn wrong_batched_overrides_are_reported() {
+        let wo = direction(0.6, 0.3);
+        let check = |wrong_eval_batch, wrong_sample_batch| {
+            let bsdf = Lambert {
+                wrong_eval_batch,
+                wrong_sample_batch,
+            };
+            check_values(&bsdf, wo, 4000, 7).2
+        };
+        assert!(check(false, false).is_empty(), "{:?}", check(false, false));
+        let eval = check(true, false);
+        assert!(
+            eval.iter().any(|p| p.starts_with("eval_batch lane")),
+            "{eval:?}"
+        );
+        let sample = check(false, true);
+        assert!(
+            sample
+                .iter()
+                .any(|p| p.starts_with("sample_f_batch lane 7")),
+            "{sample:?}"
+        );
     }
 }

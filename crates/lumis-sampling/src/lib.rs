@@ -11,6 +11,7 @@ pub mod permutation;
 pub mod poisson_disk;
 pub mod primes;
 pub mod radical_inverse;
+pub mod real;
 pub mod rng;
 pub mod scramble;
 pub mod sobol;

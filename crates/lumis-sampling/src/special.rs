@@ -14,6 +14,8 @@
 
 use std::f32::consts::{FRAC_2_SQRT_PI, FRAC_PI_2, LOG2_E};
 
+use crate::real::Real;
+
 /// Adding and subtracting `1.5 * 2^23` rounds an f32 of magnitude below
 /// `2^22` to the nearest integer (ties to even): `round()` would be a
 /// library call on baseline x86-64, which lacks `roundss`.
@@ -27,12 +29,6 @@ const LN2_LO: f32 = -2.121_944_4e-4;
 /// `1 / sqrt(pi)`, the constant of the Gaussian and of `erf`'s derivative.
 pub const FRAC_1_SQRT_PI: f32 = 0.564_189_6;
 
-/// `2^k` for integer `k` in `[-126, 127]`, from its exponent bits.
-#[inline(always)]
-fn pow2i(k: i32) -> f32 {
-    f32::from_bits(((k + 127) as u32) << 23)
-}
-
 /// `e^x`. Maximum error 1 ulp (measured: see the tests); overflows to
 /// infinity above `ln(f32::MAX)` and flushes to zero below `-103.98`, with
 /// gradual underflow in between.
@@ -42,7 +38,7 @@ fn pow2i(k: i32) -> f32 {
 /// `r^8 / 8! < 6e-9`), scaled by `2^k` in two steps so that subnormal
 /// results need no branch.
 #[inline]
-pub fn exp(x: f32) -> f32 {
+pub fn exp<F: Real>(x: F) -> F {
     const C: [f32; 7] = [
         1.0 / 2.0,
         1.0 / 6.0,
@@ -52,28 +48,28 @@ pub fn exp(x: f32) -> f32 {
         1.0 / 5040.0,
         1.0 / 40_320.0,
     ];
-    if x.is_nan() {
-        return x;
+    const OVERFLOW: f32 = 88.722_84;
+    const UNDERFLOW: f32 = -103.98;
+    let s = F::splat;
+    let special = |y: F| {
+        let y = F::select(x.gt(s(OVERFLOW)), s(f32::INFINITY), y);
+        let y = F::select(x.lt(s(UNDERFLOW)), s(0.0), y);
+        F::select(x.is_nan(), x, y)
+    };
+    if F::all(x.is_nan() | x.gt(s(OVERFLOW)) | x.lt(s(UNDERFLOW))) {
+        return special(x);
     }
-    if x > 88.722_84 {
-        return f32::INFINITY;
+    // Worked on `x` clamped to the finite range; overflow, underflow and
+    // NaN lanes are selected at the end.
+    let xc = x.max(s(UNDERFLOW)).min(s(OVERFLOW));
+    let k = (xc * s(LOG2_E) + s(ROUND_MAGIC)) - s(ROUND_MAGIC);
+    let r = (xc - k * s(LN2_HI)) - k * s(LN2_LO);
+    let mut p = s(C[6]);
+    for &c in C[..6].iter().rev() {
+        p = s(c) + r * p;
     }
-    if x < -103.98 {
-        return 0.0;
-    }
-    let k = (x * LOG2_E + ROUND_MAGIC) - ROUND_MAGIC;
-    let r = (x - k * LN2_HI) - k * LN2_LO;
-    let p = C[6];
-    let p = C[5] + r * p;
-    let p = C[4] + r * p;
-    let p = C[3] + r * p;
-    let p = C[2] + r * p;
-    let p = C[1] + r * p;
-    let p = C[0] + r * p;
-    let er = 1.0 + (r + r * r * p);
-    let k = k as i32;
-    let half = k >> 1;
-    er * pow2i(half) * pow2i(k - half)
+    let er = s(1.0) + (r + r * r * p);
+    special(er.mul_pow2(k))
 }
 
 /// The natural logarithm. Maximum error 1 ulp (measured); `-inf` at 0,
@@ -127,7 +123,7 @@ pub fn ln(x: f32) -> f32 {
 /// rounded value and the rounding error so that the exponent keeps its
 /// precision where `z^2` is large.
 #[inline]
-pub fn erfc(x: f32) -> f32 {
+pub fn erfc<F: Real>(x: F) -> F {
     const P: [f32; 10] = [
         -1.265_512_2,
         1.000_023_7,
@@ -140,36 +136,35 @@ pub fn erfc(x: f32) -> f32 {
         -0.822_152_23,
         0.170_872_77,
     ];
+    let s = F::splat;
     let z = x.abs();
-    if z > 10.06 {
-        // Below the smallest subnormal (and no NaN from infinite z).
-        return if x > 0.0 { 0.0 } else { 2.0 };
+    // Beyond 10.06, below the smallest subnormal (and no NaN from an
+    // infinite z).
+    let far = z.gt(s(10.06));
+    let sided = |r: F| F::select(x.ge(s(0.0)), r, s(2.0) - r);
+    if F::all(far) {
+        return sided(s(0.0));
     }
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let mut p = P[9];
+    let t = s(1.0) / (s(1.0) + s(0.5) * z);
+    let mut p = s(P[9]);
     for &c in P[..9].iter().rev() {
-        p = c + t * p;
+        p = s(c) + t * p;
     }
     // The exponent p - z^2 to twice f32's precision: e^(a + b) = e^a (1 +
     // b) for the rounding errors b of the square and of the difference.
     let z2 = z * z;
     let z2_err = two_product_error(z, z, z2);
     let (exponent, exponent_err) = two_sum(p, -z2);
-    let r = t * exp(exponent) * (1.0 + (exponent_err - z2_err));
-    if x >= 0.0 {
-        r
-    } else {
-        2.0 - r
-    }
+    let r = t * exp(exponent) * (s(1.0) + (exponent_err - z2_err));
+    sided(F::select(far, s(0.0), r))
 }
 
 /// `a * b - p` for `p = fl(a * b)`, exactly (Dekker 1971, by Veltkamp's
 /// splitting; no `fma`).
 #[inline(always)]
-fn two_product_error(a: f32, b: f32, p: f32) -> f32 {
-    const SPLIT: f32 = 4097.0; // 2^12 + 1
-    let split = |v: f32| {
-        let c = SPLIT * v;
+fn two_product_error<F: Real>(a: F, b: F, p: F) -> F {
+    let split = |v: F| {
+        let c = F::splat(4097.0) * v; // 2^12 + 1
         let hi = c - (c - v);
         (hi, v - hi)
     };
@@ -181,7 +176,7 @@ fn two_product_error(a: f32, b: f32, p: f32) -> f32 {
 /// `(s, e)` with `s = fl(a + b)` and `a + b = s + e` exactly (Knuth's
 /// two-sum, TAOCP vol. 2, 4.2.2).
 #[inline(always)]
-fn two_sum(a: f32, b: f32) -> (f32, f32) {
+fn two_sum<F: Real>(a: F, b: F) -> (F, F) {
     let s = a + b;
     let bb = s - a;
     (s, (a - (s - bb)) + (b - bb))
@@ -320,6 +315,45 @@ pub fn sin_cos_turns(t: f32) -> (f32, f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::real::F32x4;
+
+    /// The generic functions on four SIMD lanes give the scalar results bit
+    /// for bit, over every binade of both signs and the special values.
+    #[test]
+    fn lanes_match_the_scalar_functions_bit_for_bit() {
+        let mut xs: Vec<f32> = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0]
+            .into_iter()
+            .chain([
+                88.722_84,
+                88.73,
+                -103.98,
+                -103.99,
+                10.06,
+                10.07,
+                f32::MAX,
+                f32::MIN_POSITIVE,
+            ])
+            .collect();
+        xs.extend(sweep(1e-30, 200.0, 9_973));
+        xs.extend(sweep(-1e-30, -200.0, 9_973));
+        let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        for chunk in xs.chunks(4) {
+            let lanes = F32x4::new(std::array::from_fn(|i| chunk[i % chunk.len()]));
+            for (f, simd, name) in [
+                (exp::<f32> as fn(f32) -> f32, exp::<F32x4>(lanes), "exp"),
+                (erfc::<f32>, erfc::<F32x4>(lanes), "erfc"),
+            ] {
+                for (i, &x) in chunk.iter().enumerate() {
+                    let lane = simd.to_array()[i];
+                    assert!(
+                        same(lane, f(x)),
+                        "{name}({x}): lane {lane}, scalar {}",
+                        f(x)
+                    );
+                }
+            }
+        }
+    }
 
     /// Every `stride`-th f32 bit pattern in `[lo, hi]` (both finite, same
     /// sign), and the ends.

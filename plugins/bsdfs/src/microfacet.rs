@@ -11,6 +11,7 @@
 use std::f32::consts::PI;
 
 use lumis_core::{ParamSpec, ParamType, Params, Result, Vec2, Vec3};
+use lumis_sampling::real::Real;
 use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
 
 /// Below this roughness (largest alpha) a lobe is narrower than a
@@ -132,66 +133,82 @@ impl Microfacet {
         self.alpha_x.max(self.alpha_y) < SMOOTH_THRESHOLD
     }
 
-    /// `(x^2/alpha_x^2 + y^2/alpha_y^2)`: the stretched squared slope of `m`
-    /// times `cos^2 theta_m`.
-    #[inline]
-    fn stretched_sin2(&self, m: Vec3) -> f32 {
-        let (x, y) = (m.x / self.alpha_x, m.y / self.alpha_y);
-        x * x + y * y
-    }
-
     /// The normal distribution `D(m)`; zero below the surface.
     #[inline]
     pub fn d(&self, m: Vec3) -> f32 {
-        let z2 = m.z * m.z;
-        if m.z <= 0.0 {
-            return 0.0;
+        self.d_lanes([m.x, m.y, m.z])
+    }
+
+    /// [`Self::d`] of the normal with components `m`, lane by lane.
+    #[inline]
+    pub fn d_lanes<F: Real>(&self, [mx, my, mz]: [F; 3]) -> F {
+        let s = F::splat;
+        let below = mz.le(s(0.0));
+        if F::all(below) {
+            return s(0.0);
         }
-        let s = self.stretched_sin2(m);
-        let norm = PI * self.alpha_x * self.alpha_y;
-        match self.distribution {
+        let z2 = mz * mz;
+        // (x^2/alpha_x^2 + y^2/alpha_y^2): the stretched squared slope of m
+        // times cos^2 theta_m.
+        let (x, y) = (mx / s(self.alpha_x), my / s(self.alpha_y));
+        let stretched_sin2 = x * x + y * y;
+        let norm = s(PI * self.alpha_x * self.alpha_y);
+        let d = match self.distribution {
             // exp(-tan^2/alpha^2) / (pi alpha^2 cos^4).
             Distribution::Beckmann => {
-                let e = s / z2;
-                if e > 80.0 {
-                    return 0.0;
+                let e = stretched_sin2 / z2;
+                let negligible = e.gt(s(80.0));
+                if F::all(negligible | below) {
+                    return s(0.0);
                 }
-                exp(-e) / (norm * z2 * z2)
+                F::select(negligible, s(0.0), exp(-e) / (norm * z2 * z2))
             }
             // 1 / (pi alpha^2 cos^4 (1 + tan^2/alpha^2)^2), with the cos^4
             // folded into the square so that it stays finite at the horizon.
             Distribution::Ggx => {
-                let t = z2 + s;
-                1.0 / (norm * t * t)
+                let t = z2 + stretched_sin2;
+                s(1.0) / (norm * t * t)
             }
-        }
+        };
+        F::select(below, s(0.0), d)
     }
 
     /// Smith's `Lambda(w)`, the same above and below the surface.
     #[inline]
     pub fn lambda(&self, w: Vec3) -> f32 {
-        let z2 = w.z * w.z;
-        let (x, y) = (w.x * self.alpha_x, w.y * self.alpha_y);
+        self.lambda_lanes([w.x, w.y, w.z])
+    }
+
+    /// [`Self::lambda`] of the direction with components `w`, lane by lane.
+    #[inline]
+    pub fn lambda_lanes<F: Real>(&self, [wx, wy, wz]: [F; 3]) -> F {
+        let s = F::splat;
+        let z2 = wz * wz;
+        let (x, y) = (wx * s(self.alpha_x), wy * s(self.alpha_y));
         let a2t2 = (x * x + y * y) / z2; // alpha^2 tan^2 theta
-        if !a2t2.is_finite() {
-            return f32::INFINITY;
+                                         // Grazing (or degenerate) directions are fully masked.
+        let finite = a2t2.abs().lt(s(f32::INFINITY));
+        if F::all(!finite) {
+            return s(f32::INFINITY);
         }
-        match self.distribution {
+        let lambda = match self.distribution {
             // (sqrt(1 + alpha^2 tan^2) - 1) / 2 (Walter et al. 2007, eq. 35).
-            Distribution::Ggx => 0.5 * ((1.0 + a2t2).sqrt() - 1.0),
+            Distribution::Ggx => s(0.5) * ((s(1.0) + a2t2).sqrt() - s(1.0)),
             // With a = 1 / (alpha tan): (exp(-a^2)/(a sqrt(pi)) - erfc(a))/2
             // (Walter et al. 2007, eq. 27 before its rational fit: exact).
             // The difference cancels by a factor 2 a^2 at large a, where
             // Lambda < 1e-7 no longer changes G1 in f32.
             Distribution::Beckmann => {
-                if a2t2 == 0.0 {
-                    return 0.0;
+                let normal = a2t2.eq(s(0.0));
+                if F::all(normal | !finite) {
+                    return F::select(finite, s(0.0), s(f32::INFINITY));
                 }
-                let a = 1.0 / a2t2.sqrt();
-                let l = 0.5 * (exp(-a * a) * FRAC_1_SQRT_PI / a - erfc(a));
-                l.max(0.0)
+                let a = s(1.0) / a2t2.sqrt();
+                let l = s(0.5) * (exp(-a * a) * s(FRAC_1_SQRT_PI) / a - erfc(a));
+                F::select(normal, s(0.0), l.max(s(0.0)))
             }
-        }
+        };
+        F::select(finite, lambda, s(f32::INFINITY))
     }
 
     /// Smith masking `G1(w) = 1 / (1 + Lambda(w))`.
