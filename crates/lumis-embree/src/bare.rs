@@ -1,11 +1,12 @@
 //! A bare Embree ray loop: the baseline that lumis's throughput is measured
 //! against. Each ray costs exactly one `rtcIntersect1` or `rtcOccluded1`
 //! call on the raw scene, nothing else; or, for packets, one lane of an
-//! `rtcIntersect8` or `rtcOccluded8` call.
+//! `rtcIntersect4/8/16` or `rtcOccluded4/8/16` call.
 
 use embree4_sys as sys;
 
-use crate::record::{raw_ray, RayHit, PACKET};
+use crate::packet::{Packets, MAX_PACKET};
+use crate::record::{raw_ray, RayHit};
 use crate::scene::{Ray, Scene};
 
 /// A recorded query: a closest-hit ray or a shadow ray.
@@ -65,36 +66,41 @@ fn trace_impl(scene: &Scene, rays: &[BareRay], dependent: bool) -> u64 {
     hits
 }
 
-/// As [`trace`], with runs of consecutive rays of one kind traced in
-/// packets of eight ([`Scene::intersect_packets`],
-/// [`Scene::occluded_packets`]).
-pub fn trace_packets(scene: &Scene, rays: &[BareRay]) -> u64 {
+/// As [`trace`], with each run of consecutive rays of one kind traced as
+/// packets ([`Scene::intersect_packets`], [`Scene::occluded_packets`]); a
+/// packet never spans two runs, so a run whose length is not a multiple of
+/// the width ends in a partial packet.
+pub fn trace_packets(scene: &Scene, packets: Packets, rays: &[BareRay]) -> u64 {
     let mut hits = 0;
-    let mut start = 0;
-    while start < rays.len() {
-        let shadow = rays[start].shadow;
-        let end = (start..rays.len().min(start + PACKET))
-            .find(|&i| rays[i].shadow != shadow)
-            .unwrap_or(rays.len().min(start + PACKET));
-        let packet: Vec<Ray> = rays[start..end]
-            .iter()
-            .map(|r| Ray {
-                org: r.org,
-                dir: r.dir,
+    for run in rays.chunk_by(|a, b| a.shadow == b.shadow) {
+        // Staged MAX_PACKET rays at a time on the stack: whole packets of
+        // every width.
+        for chunk in run.chunks(MAX_PACKET) {
+            let n = chunk.len();
+            let mut queries = [Ray {
+                org: [0.0; 3],
+                dir: [0.0; 3],
                 tnear: 0.0,
-                tfar: r.tfar,
-            })
-            .collect();
-        if shadow {
-            let mut out = [false; PACKET];
-            scene.occluded_packets(&packet, &mut out[..packet.len()]);
-            hits += out.iter().filter(|&&o| o).count() as u64;
-        } else {
-            let mut out = [None; PACKET];
-            scene.intersect_packets(&packet, &mut out[..packet.len()]);
-            hits += out.iter().filter(|o| o.is_some()).count() as u64;
+                tfar: 0.0,
+            }; MAX_PACKET];
+            for (q, r) in queries.iter_mut().zip(chunk) {
+                *q = Ray {
+                    org: r.org,
+                    dir: r.dir,
+                    tnear: 0.0,
+                    tfar: r.tfar,
+                };
+            }
+            if chunk[0].shadow {
+                let mut out = [false; MAX_PACKET];
+                scene.occluded_packets(packets, &queries[..n], &mut out[..n]);
+                hits += out.iter().filter(|&&o| o).count() as u64;
+            } else {
+                let mut out = [None; MAX_PACKET];
+                scene.intersect_packets(packets, &queries[..n], &mut out[..n]);
+                hits += out.iter().filter(|o| o.is_some()).count() as u64;
+            }
         }
-        start = end;
     }
     hits
 }

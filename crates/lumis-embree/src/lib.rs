@@ -3,8 +3,8 @@
 //! It covers what lumis needs and nothing more: a device whose errors become
 //! Rust errors, a scene built from triangle meshes and spheres whose buffers
 //! are shared with Embree (no second copy), and the two queries, closest hit
-//! and occlusion, for single rays (`intersect1`, `occluded1`) and packets
-//! of eight (`intersect_packets`, `occluded_packets`).
+//! and occlusion, for single rays (`intersect1`, `occluded1`) and for
+//! packets of 4, 8 or 16 (`intersect_packets`, `occluded_packets`).
 //!
 //! All `unsafe` code of lumis lives in this crate; each block says why it is
 //! sound.
@@ -14,13 +14,14 @@
 pub mod bare;
 mod buffer;
 mod device;
+mod packet;
 mod record;
 mod scene;
 mod tape;
 
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 pub use device::{Device, EmbreeError};
-pub use record::PACKET;
+pub use packet::{PacketWidth, Packets, MAX_PACKET};
 pub use scene::{BuildQuality, Hit, Ray, Scene, SceneBuilder, SceneOptions};
 
 /// The geometry id Embree reports when nothing was hit.

@@ -1,5 +1,4 @@
-//! The ray and ray-hit records handed to `rtcIntersect1` / `rtcOccluded1`,
-//! and their packets of eight for `rtcIntersect8` / `rtcOccluded8`.
+//! The ray and ray-hit records handed to `rtcIntersect1` / `rtcOccluded1`.
 //!
 //! `embree4-sys` is generated from the Embree 4.2 headers, but the runtime
 //! lumis links may be newer. Embree 4.3 added instance arrays, and a runtime
@@ -28,7 +27,7 @@ use crate::scene::Ray;
 /// The deepest instance stack (`RTC_MAX_INSTANCE_LEVEL_COUNT`) of a runtime
 /// whose hits fit in a [`RayHit`]. Embree's default is 1; lumis instances
 /// one level deep.
-const MAX_INSTANCE_LEVELS: usize = 8;
+pub(crate) const MAX_INSTANCE_LEVELS: usize = 8;
 
 /// Words Embree may write after the 4.2 `RTCHit`, whose `instID` holds one
 /// word: `instID[1..L]` and `instPrimID[0..L]`, `2 L - 1` words, rounded up
@@ -137,89 +136,6 @@ fn empty_hit() -> sys::RTCHit {
         primID: sys::RTC_INVALID_GEOMETRY_ID,
         geomID: sys::RTC_INVALID_GEOMETRY_ID,
         instID: [sys::RTC_INVALID_GEOMETRY_ID; 1],
-    }
-}
-
-/// Rays per packet: eight, the width of an AVX2 register, which the Embree
-/// runtime's kernels are built for.
-pub const PACKET: usize = 8;
-
-/// An `RTCRayHit8` with room for whatever a newer runtime writes after it:
-/// `instID[1..L]` and `instPrimID[0..L]`, each eight lanes wide.
-#[repr(C, align(32))]
-pub(crate) struct RayHit8 {
-    pub ray: sys::RTCRay8,
-    pub hit: sys::RTCHit8,
-    _tail: MaybeUninit<[u32; (2 * MAX_INSTANCE_LEVELS - 1) * PACKET]>,
-}
-
-const _: () = {
-    assert!(std::mem::offset_of!(RayHit8, ray) == std::mem::offset_of!(sys::RTCRayHit8, ray));
-    assert!(std::mem::offset_of!(RayHit8, hit) == std::mem::offset_of!(sys::RTCRayHit8, hit));
-    assert!(std::mem::align_of::<RayHit8>() >= std::mem::align_of::<sys::RTCRayHit8>());
-};
-
-/// Which lanes of a packet hold a ray: -1 (valid) or 0, 32-byte aligned as
-/// `rtcIntersect8` requires.
-#[repr(C, align(32))]
-pub(crate) struct Valid8(pub [i32; PACKET]);
-
-impl Valid8 {
-    /// The first `n` lanes valid.
-    #[inline]
-    pub fn first(n: usize) -> Self {
-        Self(std::array::from_fn(|i| if i < n { -1 } else { 0 }))
-    }
-}
-
-/// `rays` (at most [`PACKET`]) as a packet; lanes past them hold an empty
-/// ray that the valid mask switches off.
-#[inline]
-pub(crate) fn raw_packet(rays: &[Ray]) -> sys::RTCRay8 {
-    debug_assert!(rays.len() <= PACKET);
-    let lane = |f: &dyn Fn(&Ray) -> f32| std::array::from_fn(|i| rays.get(i).map_or(0.0, f));
-    sys::RTCRay8 {
-        org_x: lane(&|r| r.org[0]),
-        org_y: lane(&|r| r.org[1]),
-        org_z: lane(&|r| r.org[2]),
-        tnear: lane(&|r| r.tnear),
-        dir_x: lane(&|r| r.dir[0]),
-        dir_y: lane(&|r| r.dir[1]),
-        dir_z: lane(&|r| r.dir[2]),
-        time: [0.0; PACKET],
-        tfar: lane(&|r| r.tfar),
-        mask: [u32::MAX; PACKET],
-        id: [0; PACKET],
-        flags: [0; PACKET],
-    }
-}
-
-impl RayHit8 {
-    /// A closest-hit packet for `rays` (at most [`PACKET`]), no hits yet.
-    #[inline]
-    pub fn new(rays: &[Ray]) -> Self {
-        Self {
-            ray: raw_packet(rays),
-            hit: sys::RTCHit8 {
-                Ng_x: [0.0; PACKET],
-                Ng_y: [0.0; PACKET],
-                Ng_z: [0.0; PACKET],
-                u: [0.0; PACKET],
-                v: [0.0; PACKET],
-                primID: [sys::RTC_INVALID_GEOMETRY_ID; PACKET],
-                geomID: [sys::RTC_INVALID_GEOMETRY_ID; PACKET],
-                instID: [[sys::RTC_INVALID_GEOMETRY_ID; PACKET]; 1],
-            },
-            _tail: MaybeUninit::uninit(),
-        }
-    }
-
-    /// The record as Embree's API takes it; Embree may write up to the end
-    /// of `self`.
-    #[inline]
-    pub fn as_raw(&mut self) -> *mut sys::RTCRayHit8 {
-        // As `RayHit::as_raw`: `RTCRayHit8` is a prefix (asserted above).
-        (self as *mut Self).cast()
     }
 }
 

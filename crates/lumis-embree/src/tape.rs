@@ -8,6 +8,11 @@
 //! the order a single-threaded render of the same scene, seed and spp asks
 //! for them. A query past the end of the recording traverses the scene.
 //! Without the feature the tape is empty and every query traverses.
+//!
+//! A packet query records its lanes' answers in lane order, into the same
+//! track as single rays of its kind, and replays them the same way: the
+//! tape holds the answers the recorded render saw, whichever way it traced,
+//! and a batch replays whether it was recorded as packets or ray by ray.
 
 use crate::Hit;
 
@@ -31,10 +36,18 @@ impl Tape {
         traverse()
     }
 
-    /// Whether queries are being recorded or replayed: never.
     #[inline(always)]
-    pub(crate) fn active(&self) -> bool {
-        false
+    pub(crate) fn hits(
+        &self,
+        out: &mut [Option<Hit>],
+        traverse: impl FnOnce(usize, &mut [Option<Hit>]),
+    ) {
+        traverse(0, out)
+    }
+
+    #[inline(always)]
+    pub(crate) fn occlusions(&self, out: &mut [bool], traverse: impl FnOnce(usize, &mut [bool])) {
+        traverse(0, out)
     }
 }
 
@@ -87,6 +100,26 @@ mod recorder {
             let answer = *self.played.get(i)?;
             self.next.store(i + 1, Relaxed);
             Some(answer)
+        }
+
+        /// Plays back into `out` as many answers as are left, at most its
+        /// length; returns how many.
+        #[inline(always)]
+        fn next_batch(&self, out: &mut [T]) -> usize {
+            let i = self.next.load(Relaxed);
+            let left = self.played.get(i..).unwrap_or_default();
+            let n = left.len().min(out.len());
+            out[..n].copy_from_slice(&left[..n]);
+            self.next.store(i + n, Relaxed);
+            n
+        }
+
+        #[cold]
+        fn keep_batch(&self, answers: &[T]) {
+            self.recording
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .extend_from_slice(answers);
         }
 
         #[cold]
@@ -144,11 +177,49 @@ mod recorder {
             self.answer(&self.occluded, traverse)
         }
 
-        /// Whether queries are being recorded or replayed, which the
-        /// tape does one query at a time.
+        /// Answers into `out` for a batch of closest-hit queries;
+        /// `traverse(start, out)` traces the batch's rays from `start` on
+        /// into `out` (the rest of the batch).
         #[inline(always)]
-        pub(crate) fn active(&self) -> bool {
-            self.mode.load(Relaxed) != OFF
+        pub(crate) fn hits(
+            &self,
+            out: &mut [Option<Hit>],
+            traverse: impl FnOnce(usize, &mut [Option<Hit>]),
+        ) {
+            self.answer_batch(&self.hits, out, traverse)
+        }
+
+        /// As [`Tape::hits`], for shadow queries.
+        #[inline(always)]
+        pub(crate) fn occlusions(
+            &self,
+            out: &mut [bool],
+            traverse: impl FnOnce(usize, &mut [bool]),
+        ) {
+            self.answer_batch(&self.occluded, out, traverse)
+        }
+
+        #[inline(always)]
+        fn answer_batch<T: Copy>(
+            &self,
+            track: &Track<T>,
+            out: &mut [T],
+            traverse: impl FnOnce(usize, &mut [T]),
+        ) {
+            match self.mode.load(Relaxed) {
+                REPLAYING => {
+                    // Past the recording's end, the rest traverses.
+                    let n = track.next_batch(out);
+                    if n < out.len() {
+                        traverse(n, &mut out[n..]);
+                    }
+                }
+                RECORDING => {
+                    traverse(0, out);
+                    track.keep_batch(out);
+                }
+                _ => traverse(0, out),
+            }
         }
 
         #[inline(always)]

@@ -83,7 +83,7 @@ const ACCEL_PARAMS: &[ParamSpec] = &[
         "packets",
         ParamType::Bool,
         "false",
-        "trace the batches of the wavefront integrator as Embree packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray; off by default: slower on the bench suite's rays",
+        "the wavefront integrator traces camera rays as coherent Embree packets of 8 always; true: its bounce and shadow rays too, as packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray; off by default: slower on most of the bench suite",
     ),
 ];
 

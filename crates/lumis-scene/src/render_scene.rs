@@ -8,7 +8,7 @@ use lumis_core::ray::SurfacePoint;
 use lumis_core::{
     Bsdf, BsdfFlags, Light, LightIndex, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3,
 };
-use lumis_embree::{Hit, PaddedBuffer, Triangle, Vertex, INVALID_ID, PACKET};
+use lumis_embree::{Hit, PacketWidth, Packets, PaddedBuffer, Triangle, Vertex, INVALID_ID};
 
 pub use crate::report::LoadReport;
 
@@ -182,7 +182,8 @@ pub struct RenderScene {
     pub(crate) light_sampler: Box<dyn LightSampler>,
     pub(crate) counts: SceneCounts,
     pub(crate) report: LoadReport,
-    /// `[accel] packets`: batched queries as Embree packets.
+    /// `[accel] packets`: every ray of a batch in packets, not only camera
+    /// rays ([`Scene::intersect_batch`]).
     pub(crate) packets: bool,
 }
 
@@ -199,6 +200,11 @@ impl RenderScene {
     /// The Embree scene, for benchmarks that trace the same rays bare.
     pub fn embree(&self) -> &lumis_embree::Scene {
         &self.embree
+    }
+
+    /// Sets what `[accel] packets` sets (for benchmarks that compare).
+    pub fn set_packets(&mut self, packets: bool) {
+        self.packets = packets;
     }
 
     /// The Embree scene, to record and replay its answers (feature
@@ -283,7 +289,78 @@ fn to_embree(ray: &Ray) -> lumis_embree::Ray {
     }
 }
 
+/// Camera rays: packets with Embree's coherence hint.
+const CAMERA_PACKETS: Packets = Packets {
+    width: PacketWidth::Eight,
+    coherent: true,
+};
+
+/// Every other ray, with `[accel] packets`: without the hint, which slows
+/// incoherent rays down 1.2 to 3 times.
+const OTHER_PACKETS: Packets = Packets {
+    width: PacketWidth::Eight,
+    coherent: false,
+};
+
+/// Rays per packet, of either kind.
+const LANES: usize = CAMERA_PACKETS.width.lanes();
+const _: () = assert!(OTHER_PACKETS.width.lanes() == LANES);
+
+/// The first [`LANES`] rays of `rays`, if they all leave one point: camera
+/// rays (a pinhole's), which a wavefront batch holds in runs (a wave's new
+/// paths, in pixel order, each pixel's samples together). Only these gained
+/// as packets on every bench scene, so only these go as packets by default.
+///
+/// Measured with the `embree_overhead` bench (the `wavefront` integrator's
+/// batches, 16 spp, one thread), in rays per second of packets over those
+/// of single rays, bare Embree, by kind of ray:
+///
+/// | scene                  | camera, 8 / 16 coherent | bounce, 8 | shadow, 8 |
+/// |------------------------|-------------------------|-----------|-----------|
+/// | Cornell box            | 1.09-1.16 / 1.26-1.58   | 0.83-0.86 | 0.86-0.90 |
+/// | dragon scan (871k tri) | 1.37-1.40 / 1.75-1.77   | 0.91-0.94 | 1.14-1.17 |
+///
+/// Packets of 16 traverse fastest, but slow the rest of a render down (the
+/// 512-bit instructions, presumably through the core's clock): whole
+/// renders took 5% longer with 16-wide camera packets on the Cornell box and
+/// gained nothing on the dragon, where packets of 8 gain 4% (and lose 1% on
+/// the Cornell box, within what code placement alone moves there). Shadow
+/// rays gained on three more bench scenes (1.05-1.34) but lost on the
+/// Cornell box, so they go one by one unless `[accel] packets` asks. A
+/// partial packet costs about what a full one does, so the rays after a
+/// run's last full packet go one by one.
+#[inline]
+fn camera_packet(rays: &[Ray]) -> Option<&[Ray]> {
+    let packet = rays.get(..LANES)?;
+    let origin = packet[0].o;
+    packet[1..].iter().all(|r| r.o == origin).then_some(packet)
+}
+
+/// `rays` (at most [`LANES`]) as Embree takes them.
+#[inline]
+fn to_embree_packet(rays: &[Ray]) -> [lumis_embree::Ray; LANES] {
+    debug_assert!(rays.len() <= LANES);
+    std::array::from_fn(|i| rays.get(i).map_or(NO_RAY, to_embree))
+}
+
 impl RenderScene {
+    /// Traces `rays` (at most [`LANES`]) as one packet into `out`, shading
+    /// the hits as [`Scene::intersect`] does.
+    fn intersect_packet<'s>(
+        &'s self,
+        packets: Packets,
+        rays: &[Ray],
+        out: &mut [Option<SurfaceInteraction<'s>>],
+    ) {
+        let n = rays.len();
+        let mut hits = [None; LANES];
+        self.embree
+            .intersect_packets(packets, &to_embree_packet(rays)[..n], &mut hits[..n]);
+        for ((ray, hit), out) in rays.iter().zip(&hits).zip(out) {
+            *out = hit.as_ref().map(|hit| self.interaction_at(ray, hit));
+        }
+    }
+
     /// A hit inside an instance: shaded in object space, then placed.
     #[inline]
     fn instance_hit(&self, hit: &Hit, wo: Vec3) -> SurfaceInteraction<'_> {
@@ -448,38 +525,44 @@ impl Scene for RenderScene {
         self.embree.occluded1(&to_embree(ray))
     }
 
-    /// Ray by ray, or with `[accel] packets` as Embree packets of eight.
+    /// Camera rays as coherent packets of 8, every other ray by itself (in
+    /// packets of 8 with `[accel] packets`); see [`camera_packet`] for the
+    /// rule and the measurements behind it.
     fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
-        if !self.packets {
-            for (ray, out) in rays.iter().zip(out) {
-                *out = self.intersect(ray);
-            }
-            return;
-        }
-        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-            let queries: [lumis_embree::Ray; PACKET] =
-                std::array::from_fn(|i| rays.get(i).map_or(NO_RAY, to_embree));
-            let mut hits = [None; PACKET];
-            self.embree
-                .intersect_packets(&queries[..rays.len()], &mut hits[..rays.len()]);
-            for ((ray, hit), out) in rays.iter().zip(&hits).zip(out) {
-                *out = hit.as_ref().map(|hit| self.interaction_at(ray, hit));
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
+        let mut i = 0;
+        while i < rays.len() {
+            if let Some(packet) = camera_packet(&rays[i..]) {
+                self.intersect_packet(CAMERA_PACKETS, packet, &mut out[i..i + LANES]);
+                i += LANES;
+            } else if self.packets {
+                // Up to a packet of the rays before the next camera packet.
+                let mut end = i + 1;
+                while end < rays.len() && end - i < LANES && camera_packet(&rays[end..]).is_none() {
+                    end += 1;
+                }
+                self.intersect_packet(OTHER_PACKETS, &rays[i..end], &mut out[i..end]);
+                i = end;
+            } else {
+                out[i] = self.intersect(&rays[i]);
+                i += 1;
             }
         }
     }
 
-    /// As [`Scene::intersect_batch`].
+    /// Ray by ray (in packets of 8 with `[accel] packets`): shadow rays
+    /// lost as packets on the Cornell box ([`camera_packet`]).
     fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
         if !self.packets {
             for (ray, out) in rays.iter().zip(out) {
                 *out = self.occluded(ray);
             }
             return;
         }
-        for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-            let queries: [lumis_embree::Ray; PACKET] =
-                std::array::from_fn(|i| rays.get(i).map_or(NO_RAY, to_embree));
-            self.embree.occluded_packets(&queries[..rays.len()], out);
+        for (rays, out) in rays.chunks(LANES).zip(out.chunks_mut(LANES)) {
+            self.embree
+                .occluded_packets(OTHER_PACKETS, &to_embree_packet(rays)[..rays.len()], out);
         }
     }
 
@@ -497,5 +580,353 @@ impl Scene for RenderScene {
 
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use lumis_core::{BsdfContext, BsdfSample, LightSampleContext, Rgb, SampledLight};
+    use lumis_embree::{Device, SceneBuilder, SceneOptions, SpherePoint};
+
+    use super::*;
+
+    struct Black;
+
+    impl Bsdf for Black {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::DIFFUSE_REFLECTION
+        }
+        fn f(&self, _: &BsdfContext, _: Vec3, _: Vec3) -> Rgb {
+            Rgb::BLACK
+        }
+        fn sample_f(&self, _: &BsdfContext, _: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
+            None
+        }
+        fn pdf(&self, _: &BsdfContext, _: Vec3, _: Vec3) -> f32 {
+            0.0
+        }
+    }
+
+    struct NoLights;
+
+    impl LightSampler for NoLights {
+        fn sample(&self, _: &LightSampleContext, _: f32) -> Option<SampledLight> {
+            None
+        }
+        fn pmf(&self, _: &LightSampleContext, _: u32) -> f32 {
+            0.0
+        }
+    }
+
+    /// A small deterministic generator (SplitMix64).
+    struct Rng(u64);
+
+    impl Rng {
+        fn next_f32(&mut self) -> f32 {
+            self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut z = self.0;
+            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+        }
+
+        fn range(&mut self, lo: f32, hi: f32) -> f32 {
+            lo + (hi - lo) * self.next_f32()
+        }
+
+        fn direction(&mut self) -> Vec3 {
+            let z = self.range(-1.0, 1.0);
+            let phi = self.range(0.0, std::f32::consts::TAU);
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        }
+    }
+
+    /// A UV sphere mesh with smooth normals and texture coordinates.
+    fn uv_sphere(n: u32, bsdf: u32) -> MeshData {
+        let (mut vertices, mut normals, mut uvs) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..=n {
+            let theta = std::f32::consts::PI * i as f32 / n as f32;
+            for j in 0..n {
+                let phi = std::f32::consts::TAU * j as f32 / n as f32;
+                let p = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
+                vertices.push(p.to_array());
+                normals.push(p);
+                uvs.push(Vec2::new(j as f32 / n as f32, i as f32 / n as f32));
+            }
+        }
+        let at = |i: u32, j: u32| i * n + j % n;
+        let mut indices = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                indices.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                indices.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        MeshData {
+            vertices: Arc::new(vertices.into()),
+            indices: Arc::new(indices.into()),
+            normals: Some(normals),
+            uvs: Some(uvs),
+            bsdf,
+            lights: Vec::new(),
+            orientation: 1.0,
+            flat_frames: Vec::new(),
+        }
+    }
+
+    /// A flat-shaded floor whose second triangle emits.
+    fn floor(bsdf: u32) -> MeshData {
+        let vertices = vec![
+            [-5.0, -5.0, -1.5],
+            [5.0, -5.0, -1.5],
+            [5.0, 5.0, -1.5],
+            [-5.0, 5.0, -1.5],
+        ];
+        let mut mesh = MeshData {
+            vertices: Arc::new(vertices.into()),
+            indices: Arc::new(vec![[0, 1, 2], [0, 2, 3]].into()),
+            normals: None,
+            uvs: None,
+            bsdf,
+            lights: vec![NO_LIGHT, 0],
+            orientation: 1.0,
+            flat_frames: Vec::new(),
+        };
+        mesh.store_flat_frames();
+        mesh
+    }
+
+    fn add(builder: &mut SceneBuilder, mesh: &MeshData) {
+        builder
+            .add_triangle_mesh(mesh.vertices.clone(), mesh.indices.clone())
+            .unwrap();
+    }
+
+    /// A mesh with shading normals and uvs, a flat floor, two placed
+    /// instances of a prototype and spheres: every kind of hit shading
+    /// knows. Geometry ids follow the order of `geometries`.
+    fn scene(packets: bool) -> RenderScene {
+        let device = Device::new().unwrap();
+        let mut proto_builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        let proto_mesh = uv_sphere(12, 1);
+        add(&mut proto_builder, &proto_mesh);
+        let prototype = Arc::new(proto_builder.commit().unwrap());
+
+        let mut builder = SceneBuilder::new(&device, SceneOptions::default()).unwrap();
+        let mut geometries = Vec::new();
+        let mesh = uv_sphere(24, 0);
+        add(&mut builder, &mesh);
+        geometries.push(Geometry::Mesh(mesh));
+        let floor = floor(1);
+        add(&mut builder, &floor);
+        geometries.push(Geometry::Mesh(floor));
+        for (angle, translation) in [
+            (0.3f32, Vec3::new(2.2, 0.5, 0.0)),
+            (1.1, Vec3::new(-2.0, 1.5, 0.5)),
+        ] {
+            let linear =
+                Mat3::from_rotation_z(angle) * Mat3::from_diagonal(Vec3::new(0.6, 0.8, 0.7));
+            let mut transform = [0.0; 12];
+            transform[..9].copy_from_slice(&linear.to_cols_array());
+            transform[9..].copy_from_slice(&translation.to_array());
+            builder.add_instance(prototype.clone(), &transform).unwrap();
+            geometries.push(Geometry::Instance {
+                prototype: 0,
+                placement: Placement {
+                    linear,
+                    translation,
+                    normal: linear.inverse().transpose(),
+                },
+                lights: Vec::new(),
+            });
+        }
+        let spheres: Vec<SpherePoint> = vec![[0.5, -2.0, 0.0, 0.7]];
+        builder.add_spheres(Arc::new(spheres.into())).unwrap();
+        geometries.push(Geometry::Sphere {
+            center: Vec3::new(0.5, -2.0, 0.0),
+            radius: 0.7,
+            bsdf: 1,
+            light: Some(1),
+            orientation: 1.0,
+        });
+        RenderScene {
+            embree: builder.commit().unwrap(),
+            geometries,
+            prototypes: vec![Prototype {
+                meshes: vec![proto_mesh],
+            }],
+            bsdfs: vec![
+                SceneBsdf::new(Arc::new(Black)),
+                SceneBsdf::new(Arc::new(Black)),
+            ],
+            lights: Vec::new(),
+            infinite_lights: Vec::new(),
+            light_sampler: Box::new(NoLights),
+            counts: SceneCounts::default(),
+            report: LoadReport::default(),
+            packets,
+        }
+    }
+
+    /// A batch as a wavefront integrator makes one: incoherent rays from
+    /// anywhere, then runs of camera rays (one origin, nearby directions)
+    /// of lengths around the packet width; a third of all rays have a
+    /// finite `t_max`, often short of what they would hit.
+    fn batch(seed: u64) -> Vec<Ray> {
+        let mut rng = Rng(seed);
+        let mut rays = Vec::new();
+        let limit = |rng: &mut Rng, o: Vec3, d: Vec3| {
+            let t_max = if rng.next_f32() < 1.0 / 3.0 {
+                rng.range(0.05, 5.0)
+            } else {
+                f32::INFINITY
+            };
+            Ray { o, d, t_max }
+        };
+        for run in [0, 3, 16, 17, 5, 40, 15, 32] {
+            for _ in 0..60 {
+                let o = Vec3::new(
+                    rng.range(-3.0, 3.0),
+                    rng.range(-3.0, 3.0),
+                    rng.range(-1.0, 3.0),
+                );
+                let d = rng.direction();
+                rays.push(limit(&mut rng, o, d));
+            }
+            let eye = Vec3::new(0.3, -0.2, 6.0);
+            let aim = Vec3::new(rng.range(-0.4, 0.4), rng.range(-0.4, 0.4), -1.0);
+            for _ in 0..run {
+                let jitter = Vec3::new(rng.range(-0.02, 0.02), rng.range(-0.02, 0.02), 0.0);
+                rays.push(limit(&mut rng, eye, (aim + jitter).normalize()));
+            }
+        }
+        rays
+    }
+
+    /// Whether two interactions agree up to the rounding of the traversal.
+    fn same(a: &SurfaceInteraction, b: &SurfaceInteraction) -> bool {
+        let close =
+            |x: Vec3, y: Vec3| (x - y).abs().max_element() <= 1e-4 * x.abs().max_element().max(1.0);
+        close(a.point.p, b.point.p)
+            && close(a.point.n, b.point.n)
+            && close(a.shading.z.into(), b.shading.z.into())
+            && close(a.shading.x.into(), b.shading.x.into())
+            && (a.uv - b.uv).abs().max_element() <= 1e-4
+            && a.wo == b.wo
+            && std::ptr::addr_eq(a.bsdf, b.bsdf)
+            && a.bsdf_flags == b.bsdf_flags
+            && a.light == b.light
+    }
+
+    /// Both batch queries answer as the single-ray ones, with and without
+    /// `[accel] packets`, on whole batches and on lengths that are not
+    /// multiples of a packet, from offsets that cut camera runs apart.
+    #[test]
+    fn batches_answer_as_single_rays() {
+        let rays = batch(11);
+        for packets in [false, true] {
+            let scene = scene(packets);
+            let single: Vec<_> = rays.iter().map(|r| scene.intersect(r)).collect();
+            let blocked: Vec<bool> = rays.iter().map(|r| scene.occluded(r)).collect();
+            for n in [0, 1, 7, 9, 33, rays.len()] {
+                for start in [0, 61, 70, 100, 171] {
+                    let end = (start + n).min(rays.len());
+                    let mut found = vec![None; end - start];
+                    scene.intersect_batch(&rays[start..end], &mut found);
+                    let mut occluded = vec![false; end - start];
+                    scene.occluded_batch(&rays[start..end], &mut occluded);
+                    for (k, (found, occluded)) in (start..end).zip(found.iter().zip(&occluded)) {
+                        match (&single[k], found) {
+                            (None, None) => {}
+                            (Some(a), Some(b)) if same(a, b) => {}
+                            (a, b) => panic!(
+                                "packets {packets}, batch {start}..{end}, ray {k} {:?}: single {:?}, batch {:?}",
+                                rays[k],
+                                a.as_ref().map(|h| (h.point, h.uv, h.light)),
+                                b.as_ref().map(|h| (h.point, h.uv, h.light)),
+                            ),
+                        }
+                        assert_eq!(*occluded, blocked[k], "packets {packets}, ray {k}");
+                    }
+                }
+            }
+            // The rays reach every geometry (and the emitting triangle),
+            // and finite segments stop short of some hits.
+            let hits: Vec<&SurfaceInteraction> = single.iter().flatten().collect();
+            assert!(
+                hits.len() > 200 && hits.len() < rays.len(),
+                "{}",
+                hits.len()
+            );
+            assert!(hits.iter().any(|h| h.light == LightIndex::new(0)));
+            assert!(
+                hits.iter().any(|h| h.light == LightIndex::new(1)),
+                "a sphere hit"
+            );
+            assert!(
+                hits.iter().any(|h| h.point.p.x > 1.5 && h.point.p.z > -1.0),
+                "an instance hit"
+            );
+            let cut = rays
+                .iter()
+                .zip(&single)
+                .filter(|(r, hit)| {
+                    hit.is_none()
+                        && scene
+                            .intersect(&Ray {
+                                t_max: f32::INFINITY,
+                                ..**r
+                            })
+                            .is_some()
+                })
+                .count();
+            assert!(cut > 20, "{cut}");
+        }
+    }
+
+    /// The comparison tells a wrong answer from rounding.
+    #[test]
+    fn interaction_comparison_rejects_wrong_answers() {
+        let scene = scene(false);
+        let ray = Ray {
+            o: Vec3::new(0.1, 0.2, 5.0),
+            d: Vec3::NEG_Z,
+            t_max: f32::INFINITY,
+        };
+        let hit = scene.intersect(&ray).unwrap();
+        assert!(same(&hit, &hit));
+        let mut moved = hit;
+        moved.point.p.z += 1e-3;
+        assert!(!same(&hit, &moved));
+        let mut other = hit;
+        other.bsdf = scene.bsdfs[1].bsdf.as_ref();
+        assert!(!same(&hit, &other));
+        let mut lit = hit;
+        lit.light = LightIndex::new(3);
+        assert!(!same(&hit, &lit));
+    }
+
+    /// Packets go to runs of a full packet of rays from one origin, and
+    /// only to those.
+    #[test]
+    fn camera_packets_are_full_runs_from_one_origin() {
+        let ray = |x: f32| Ray {
+            o: Vec3::new(x, 0.0, 1.0),
+            d: Vec3::NEG_Z,
+            t_max: f32::INFINITY,
+        };
+        let run = vec![ray(0.0); LANES + 3];
+        assert_eq!(camera_packet(&run).map(<[Ray]>::len), Some(LANES));
+        assert_eq!(camera_packet(&run[3..]).map(<[Ray]>::len), Some(LANES));
+        assert!(camera_packet(&run[4..]).is_none());
+        let mut broken = run.clone();
+        broken[LANES - 1] = ray(1e-6);
+        assert!(camera_packet(&broken).is_none());
+        assert!(camera_packet(&broken[LANES..]).is_none());
     }
 }
