@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lumis_core::{Error, Integrator, RenderStats, Result, Rgb, Sampler, Scene, UVec2};
+use lumis_core::{Error, Integrator, Ray, RenderStats, Result, Rgb, Sampler, Scene, UVec2, Vec3};
 use lumis_image::Image;
 use rayon::prelude::*;
 
@@ -52,6 +52,53 @@ fn tiles(resolution: UVec2) -> Vec<Tile> {
     out
 }
 
+/// The camera rays of a tile waiting for the integrator, one per lane.
+struct Batch {
+    rays: Vec<Ray>,
+    pixel_of_lane: Vec<usize>,
+    radiance: Vec<Rgb>,
+    /// Lanes holding a ray.
+    filled: usize,
+}
+
+impl Batch {
+    /// Traces the filled lanes and adds their radiance to their pixels'
+    /// sums, in lane order.
+    fn trace(
+        &mut self,
+        scene: &dyn Scene,
+        integrator: &dyn Integrator,
+        lanes: &mut [Box<dyn Sampler>],
+        stats: &mut RenderStats,
+        sums: &mut [[f64; 3]],
+    ) {
+        let n = std::mem::take(&mut self.filled);
+        if n == 0 {
+            return;
+        }
+        profile::in_stage(Stage::Integrator, || {
+            integrator.li_batch(
+                &self.rays[..n],
+                scene,
+                &mut lanes[..n],
+                stats,
+                &mut self.radiance[..n],
+            )
+        });
+        for (&i, l) in self.pixel_of_lane[..n].iter().zip(&self.radiance) {
+            stats.samples += 1;
+            if !l.is_finite() {
+                stats.nonfinite += 1;
+                continue;
+            }
+            let sum = &mut sums[i];
+            sum[0] += l.r as f64;
+            sum[1] += l.g as f64;
+            sum[2] += l.b as f64;
+        }
+    }
+}
+
 /// Renders one tile. The tile's samples go to the integrator in batches of
 /// its [`Integrator::batch_size`], in order (pixel by pixel, each pixel's
 /// samples by index), one sampler per batch lane; each pixel's samples are
@@ -70,47 +117,29 @@ fn render_tile(
     let width = tile.max.x - tile.min.x;
     let count = width * (tile.max.y - tile.min.y);
     let mut sums = vec![[0.0f64; 3]; count as usize];
-    let mut rays = Vec::with_capacity(lanes.len());
-    let mut pixel_of_lane = Vec::with_capacity(lanes.len());
-    let mut radiance = vec![Rgb::BLACK; lanes.len()];
-    let mut samples = (0..count).flat_map(|i| (0..settings.spp).map(move |index| (i, index)));
-    loop {
-        rays.clear();
-        pixel_of_lane.clear();
-        for (lane, (i, index)) in lanes.iter_mut().zip(samples.by_ref()) {
-            let pixel = UVec2::new(tile.min.x + i % width, tile.min.y + i / width);
+    let mut batch = Batch {
+        rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
+        pixel_of_lane: vec![0; lanes.len()],
+        radiance: vec![Rgb::BLACK; lanes.len()],
+        filled: 0,
+    };
+    for i in 0..count {
+        let pixel = UVec2::new(tile.min.x + i % width, tile.min.y + i / width);
+        for index in 0..settings.spp {
+            let lane = &mut lanes[batch.filled];
             lane.start_pixel_sample(pixel, index, settings.seed);
             // Box filter of radius 1/2: uniform over the pixel, weight 1.
-            rays.push(profile::in_stage(Stage::CameraAndFilm, || {
+            batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
                 camera.generate_ray(pixel, lane.get_pixel_2d())
-            }));
-            pixel_of_lane.push(i as usize);
-        }
-        let n = rays.len();
-        if n == 0 {
-            break;
-        }
-        profile::in_stage(Stage::Integrator, || {
-            integrator.li_batch(
-                &rays,
-                scene,
-                &mut lanes[..n],
-                &mut stats,
-                &mut radiance[..n],
-            )
-        });
-        for (&i, l) in pixel_of_lane.iter().zip(&radiance) {
-            stats.samples += 1;
-            if !l.is_finite() {
-                stats.nonfinite += 1;
-                continue;
+            });
+            batch.pixel_of_lane[batch.filled] = i as usize;
+            batch.filled += 1;
+            if batch.filled == lanes.len() {
+                batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
             }
-            let sum = &mut sums[i];
-            sum[0] += l.r as f64;
-            sum[1] += l.g as f64;
-            sum[2] += l.b as f64;
         }
     }
+    batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
     let inv = 1.0 / settings.spp as f64;
     let pixels = sums
         .into_iter()

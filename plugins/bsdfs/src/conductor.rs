@@ -440,9 +440,7 @@ mod tests {
                     c.eval_batch(&ctx[..len], &wo[..len], &wi[..len], &mut out);
                     for k in 0..len {
                         let (f, pdf) = c.eval(&ctx[k], wo[k], wi[k]);
-                        let bits = |(f, pdf): (Rgb, f32)| {
-                            [f.r, f.g, f.b, pdf].map(f32::to_bits)
-                        };
+                        let bits = |(f, pdf): (Rgb, f32)| [f.r, f.g, f.b, pdf].map(f32::to_bits);
                         assert_eq!(
                             bits(out[k]),
                             bits((f, pdf)),

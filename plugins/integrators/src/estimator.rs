@@ -495,14 +495,14 @@ impl Estimator {
             return Rgb::BLACK;
         }
         stats.light_samples += 1;
-        unshadowed
+        unshadowed()
     }
 
     /// The weighted contribution of light sample `ls` (of light chosen with
     /// probability `pmf`) if nothing blocks it, given the BSDF's value `f`
     /// and density `p_bsdf` for its direction, whose cosine with the
-    /// shading normal is `cos_theta`; `None` where the BSDF gives it no
-    /// weight, so that no shadow ray is traced for it.
+    /// shading normal is `cos_theta`, as a closure; `None` where the BSDF
+    /// gives it no weight, so that no shadow ray is traced for it.
     #[inline]
     pub fn light_contribution(
         &self,
@@ -512,13 +512,17 @@ impl Estimator {
         f: Rgb,
         p_bsdf: f32,
         cos_theta: f32,
-    ) -> Option<Rgb> {
+    ) -> Option<impl FnOnce() -> Rgb + '_> {
         let f = f * cos_theta.abs();
         if f.is_black() {
             return None;
         }
-        let p_light = pmf * ls.pdf;
-        Some(f * ls.l * (self.light_weight(p_light, p_bsdf, delta) / p_light))
+        // Worked out when asked, after the shadow ray in `path`.
+        let (l, pdf) = (ls.l, ls.pdf);
+        Some(move || {
+            let p_light = pmf * pdf;
+            f * l * (self.light_weight(p_light, p_bsdf, delta) / p_light)
+        })
     }
 
     /// The numbers a path vertex draws before its hit is known: the BSDF

@@ -387,7 +387,7 @@ impl WavefrontIntegrator {
                 {
                     stage.pending.push(PendingShadow {
                         vertex: k,
-                        unshadowed,
+                        unshadowed: unshadowed(),
                     });
                     stage
                         .shadow_rays
