@@ -526,7 +526,7 @@ impl Scene for RenderScene {
     }
 
     /// Camera rays as coherent packets of 8, every other ray by itself (in
-    /// packets of 8 with `[accel] packets`); see [`camera_packet`] for the
+    /// packets of 8 with `[accel] packets`); see `camera_packet` for the
     /// rule and the measurements behind it.
     fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
         assert_eq!(rays.len(), out.len(), "one answer per ray");
@@ -551,7 +551,7 @@ impl Scene for RenderScene {
     }
 
     /// Ray by ray (in packets of 8 with `[accel] packets`): shadow rays
-    /// lost as packets on the Cornell box ([`camera_packet`]).
+    /// lost as packets on the Cornell box (`camera_packet`).
     fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
         assert_eq!(rays.len(), out.len(), "one answer per ray");
         if !self.packets {
