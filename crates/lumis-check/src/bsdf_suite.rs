@@ -331,48 +331,84 @@ impl BatchLanes {
 
 /// `sample_f_batch` and `eval_batch` against `sample_f` and `eval`, lane
 /// by lane: the same samples and values up to rounding (a relative 1e-4,
-/// and `None` exactly where the scalar method gives none).
+/// and `None` or zero exactly where the scalar method gives them).
+///
+/// The lanes differ as a wave's do, so that an override that reads one
+/// lane's arguments for another fails: `wo` cycles through the case's
+/// direction, the same turned a quarter about the normal, and its mirror
+/// image through the surface (the back side); the transport mode
+/// alternates; a BSDF that takes an albedo scale gets one on some lanes.
+/// Each method runs on the whole batch (a partial last SIMD chunk for
+/// every width up to 16) and on prefixes of 1 and 3 lanes.
 fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
     let n = lanes.wi.len();
-    let ctx = vec![BsdfContext::default(); n];
-    let wos = vec![wo; n];
+    let wos: Vec<Vec3> = (0..n)
+        .map(|i| match i % 3 {
+            0 => wo,
+            1 => Vec3::new(-wo.y, wo.x, wo.z),
+            _ => Vec3::new(wo.x, wo.y, -wo.z),
+        })
+        .collect();
+    let ctx: Vec<BsdfContext> = (0..n)
+        .map(|i| BsdfContext {
+            mode: if i % 2 == 0 {
+                TransportMode::Radiance
+            } else {
+                TransportMode::Importance
+            },
+            albedo_scale: (bsdf.takes_albedo_scale() && i % 7 == 3)
+                .then_some(Rgb::new(0.5, 0.25, 1.0)),
+            ..Default::default()
+        })
+        .collect();
     let u1: Vec<f32> = lanes.u.iter().map(|u| u.0).collect();
     let u2: Vec<Vec2> = lanes.u.iter().map(|u| u.1).collect();
-    let mut samples = vec![None; n];
-    bsdf.sample_f_batch(&ctx, &wos, &u1, &u2, &mut samples);
-    let mut evals = vec![(Rgb::BLACK, 0.0); n];
-    bsdf.eval_batch(&ctx, &wos, &lanes.wi, &mut evals);
-    let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs()) || a == b;
+    let close =
+        |a: f32, b: f32| a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
     let close_rgb = |a: Rgb, b: Rgb| close(a.r, b.r) && close(a.g, b.g) && close(a.b, b.b);
     let mut problems = Vec::new();
-    for i in 0..n {
-        let scalar = bsdf.sample_f(&ctx[i], wo, u1[i], u2[i]);
-        let agree = match (&scalar, &samples[i]) {
-            (None, None) => true,
-            (Some(a), Some(b)) => {
-                close_rgb(a.f, b.f)
-                    && close(a.pdf, b.pdf)
-                    && (a.wi - b.wi).abs().max_element() <= 1e-4
-                    && a.flags == b.flags
+    for len in [n, 1, 3] {
+        let len = len.min(n);
+        let mut samples = vec![None; len];
+        bsdf.sample_f_batch(
+            &ctx[..len],
+            &wos[..len],
+            &u1[..len],
+            &u2[..len],
+            &mut samples,
+        );
+        let mut evals = vec![(Rgb::splat(f32::NAN), f32::NAN); len];
+        bsdf.eval_batch(&ctx[..len], &wos[..len], &lanes.wi[..len], &mut evals);
+        for i in 0..len {
+            let scalar = bsdf.sample_f(&ctx[i], wos[i], u1[i], u2[i]);
+            let agree = match (&scalar, &samples[i]) {
+                (None, None) => true,
+                (Some(a), Some(b)) => {
+                    close_rgb(a.f, b.f)
+                        && close(a.pdf, b.pdf)
+                        && (a.wi - b.wi).abs().max_element() <= 1e-4
+                        && a.flags == b.flags
+                        && close(a.eta, b.eta)
+                }
+                _ => false,
+            };
+            if !agree {
+                problems.push(format!(
+                    "sample_f_batch lane {i} of {len} gave {:?} but sample_f gave {scalar:?} (wo = {:?}, u1 = {}, u2 = {:?}, {:?})",
+                    samples[i], wos[i], u1[i], u2[i], ctx[i].mode
+                ));
             }
-            _ => false,
-        };
-        if !agree {
-            problems.push(format!(
-                "sample_f_batch lane {i} of {n} gave {:?} but sample_f gave {scalar:?} (wo = {wo:?})",
-                samples[i]
-            ));
-        }
-        let (f, pdf) = bsdf.eval(&ctx[i], wo, lanes.wi[i]);
-        let (bf, bpdf) = evals[i];
-        if !(close_rgb(f, bf) && close(pdf, bpdf)) {
-            problems.push(format!(
-                "eval_batch lane {i} of {n} gave ({bf:?}, {bpdf}) but eval gave ({f:?}, {pdf}) at wi = {:?}",
-                lanes.wi[i]
-            ));
-        }
-        if problems.len() >= 2 {
-            break;
+            let (f, pdf) = bsdf.eval(&ctx[i], wos[i], lanes.wi[i]);
+            let (bf, bpdf) = evals[i];
+            if !(close_rgb(f, bf) && close(pdf, bpdf)) {
+                problems.push(format!(
+                    "eval_batch lane {i} of {len} gave ({bf:?}, {bpdf}) but eval gave ({f:?}, {pdf}) (wo = {:?}, wi = {:?}, {:?})",
+                    wos[i], lanes.wi[i], ctx[i].mode
+                ));
+            }
+            if problems.len() >= 2 {
+                return problems;
+            }
         }
     }
     problems
@@ -638,9 +674,12 @@ mod tests {
     }
 
     /// A Lambertian BSDF whose batched methods can be made wrong.
+    #[derive(Default)]
     struct Lambert {
         wrong_eval_batch: bool,
         wrong_sample_batch: bool,
+        /// `eval_batch` reads the first lane's `wo` for every lane.
+        first_wo: bool,
     }
 
     impl Bsdf for Lambert {
@@ -695,10 +734,11 @@ mod tests {
             out: &mut [(Rgb, f32)],
         ) {
             for (i, out) in out.iter_mut().enumerate() {
-                let (f, pdf) = self.eval(&ctx[i], wo[i], wi[i]);
+                let wo = if self.first_wo { wo[0] } else { wo[i] };
+                let (f, pdf) = self.eval(&ctx[i], wo, wi[i]);
                 // The wrong override forgets the cosine in the pdf.
-                *out = if self.wrong_eval_batch {
-                    (f, pdf.min(std::f32::consts::FRAC_1_PI * 0.999))
+                *out = if self.wrong_eval_batch && pdf > 0.0 {
+                    (f, std::f32::consts::FRAC_1_PI)
                 } else {
                     (f, pdf)
                 };
@@ -709,25 +749,35 @@ mod tests {
     #[test]
     fn wrong_batched_overrides_are_reported() {
         let wo = direction(0.6, 0.3);
-        let check = |wrong_eval_batch, wrong_sample_batch| {
-            let bsdf = Lambert {
-                wrong_eval_batch,
-                wrong_sample_batch,
-            };
-            check_values(&bsdf, wo, 4000, 7).2
-        };
-        assert!(check(false, false).is_empty(), "{:?}", check(false, false));
-        let eval = check(true, false);
+        let check = |bsdf: Lambert| check_values(&bsdf, wo, 4000, 7).2;
+        let right = check(Lambert::default());
+        assert!(right.is_empty(), "{right:?}");
+        let eval = check(Lambert {
+            wrong_eval_batch: true,
+            ..Default::default()
+        });
         assert!(
             eval.iter().any(|p| p.starts_with("eval_batch lane")),
             "{eval:?}"
         );
-        let sample = check(false, true);
+        let sample = check(Lambert {
+            wrong_sample_batch: true,
+            ..Default::default()
+        });
         assert!(
             sample
                 .iter()
                 .any(|p| p.starts_with("sample_f_batch lane 7")),
             "{sample:?}"
+        );
+        // The lanes' own `wo` matters: lane 2 looks from behind.
+        let first = check(Lambert {
+            first_wo: true,
+            ..Default::default()
+        });
+        assert!(
+            first.iter().any(|p| p.starts_with("eval_batch lane 2 ")),
+            "{first:?}"
         );
     }
 }

@@ -5,7 +5,9 @@
 //! Each is a polynomial or rational approximation evaluated in f32 with
 //! plain multiplies and adds (no `fma`, which baseline x86-64 would call
 //! out of line), inlinable and branch-light, so that it costs a few
-//! nanoseconds where glibc's double-precision calls cost tens. Each states
+//! nanoseconds where glibc's double-precision calls cost tens. Each is
+//! generic over [`Real`]: on `f32`, and on SIMD lanes with each lane's
+//! result bit for bit the scalar one (see [`crate::real`]). Each states
 //! its maximum error over its whole domain; the tests below measure it
 //! against the double-precision functions of the standard library (and
 //! `libm`'s `erf`/`erfc`) on a dense sweep of every binade, and fail if it
@@ -56,12 +58,16 @@ pub fn exp<F: Real>(x: F) -> F {
         let y = F::select(x.lt(s(UNDERFLOW)), s(0.0), y);
         F::select(x.is_nan(), x, y)
     };
-    if F::all(x.is_nan() | x.gt(s(OVERFLOW)) | x.lt(s(UNDERFLOW))) {
+    let out_of_range = x.is_nan() | x.gt(s(OVERFLOW)) | x.lt(s(UNDERFLOW));
+    if F::all(out_of_range) {
         return special(x);
     }
-    // Worked on `x` clamped to the finite range; overflow, underflow and
-    // NaN lanes are selected at the end.
-    let xc = x.max(s(UNDERFLOW)).min(s(OVERFLOW));
+    // Overflow, underflow and NaN lanes are worked on as 0 and selected at
+    // the end: clamped to the range ends instead, an underflowing lane
+    // would scale to a subnormal, and each SIMD operation on one costs a
+    // microcode assist of ~150 cycles (they made `eval_batch` slower than
+    // the scalar loop on narrow lobes).
+    let xc = F::select(out_of_range, s(0.0), x);
     let k = (xc * s(LOG2_E) + s(ROUND_MAGIC)) - s(ROUND_MAGIC);
     let r = (xc - k * s(LN2_HI)) - k * s(LN2_LO);
     let mut p = s(C[6]);
@@ -82,35 +88,33 @@ pub fn exp<F: Real>(x: F) -> F {
 /// `ln(1 + f) = f - (f^2/2 - s (f^2/2 + R))`, `R = 2 s^2/3 + ... + 2
 /// s^8/9`.
 #[inline]
-pub fn ln(x: f32) -> f32 {
-    if !(x > 0.0 && x < f32::INFINITY) {
-        return if x == 0.0 {
-            f32::NEG_INFINITY
-        } else if x == f32::INFINITY {
-            x
-        } else {
-            f32::NAN
-        };
-    }
-    let (x, bias) = if x < f32::MIN_POSITIVE {
-        (x * 8_388_608.0, 23 + 127)
-    } else {
-        (x, 127)
+pub fn ln<F: Real>(x: F) -> F {
+    let c = F::splat;
+    let in_domain = x.gt(c(0.0)) & x.lt(c(f32::INFINITY));
+    let special = || {
+        let y = F::select(x.eq(c(f32::INFINITY)), x, c(f32::NAN));
+        F::select(x.eq(c(0.0)), c(f32::NEG_INFINITY), y)
     };
-    let bits = x.to_bits();
-    let mut e = ((bits >> 23) as i32) - bias;
-    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    if m > std::f32::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
+    if F::all(!in_domain) {
+        return special();
     }
-    let f = m - 1.0;
-    let s = f / (2.0 + f);
+    // Lanes outside the domain are worked on as 1 and selected at the end.
+    let x = F::select(in_domain, x, c(1.0));
+    // Subnormals scaled by 2^23 into the normal range first.
+    let subnormal = x.lt(c(f32::MIN_POSITIVE));
+    let x = F::select(subnormal, x * c(8_388_608.0), x);
+    let (e, m) = x.exponent_significand();
+    let e = F::select(subnormal, e - c(23.0), e);
+    let above = m.gt(c(std::f32::consts::SQRT_2));
+    let m = F::select(above, m * c(0.5), m);
+    let e = F::select(above, e + c(1.0), e);
+    let f = m - c(1.0);
+    let s = f / (c(2.0) + f);
     let s2 = s * s;
-    let r = s2 * (2.0 / 3.0 + s2 * (2.0 / 5.0 + s2 * (2.0 / 7.0 + s2 * (2.0 / 9.0))));
-    let half_f2 = 0.5 * f * f;
-    let e = e as f32;
-    e * LN2_HI + ((f - (half_f2 - s * (half_f2 + r))) + e * LN2_LO)
+    let r = s2 * (c(2.0 / 3.0) + s2 * (c(2.0 / 5.0) + s2 * (c(2.0 / 7.0) + s2 * c(2.0 / 9.0))));
+    let half_f2 = c(0.5) * f * f;
+    let y = e * c(LN2_HI) + ((f - (half_f2 - s * (half_f2 + r))) + e * c(LN2_LO));
+    F::select(in_domain, y, special())
 }
 
 /// The complementary error function `erfc(x) = 1 - erf(x)`. Maximum
@@ -189,7 +193,7 @@ fn two_sum<F: Real>(a: F, b: F) -> (F, F) {
 /// relative precision at tiny `x`; from 1 on, `1 - erfc(|x|)`, whose error
 /// is then below an ulp of `erf`.
 #[inline]
-pub fn erf(x: f32) -> f32 {
+pub fn erf<F: Real>(x: F) -> F {
     /// `2/sqrt(pi) - 1`, so that `x` is added exactly.
     const FRAC_2_SQRT_PI_MINUS_1: f32 = 0.128_379_17;
     /// `2/sqrt(pi) (-1)^n / (n! (2n + 1))`.
@@ -206,17 +210,25 @@ pub fn erf(x: f32) -> f32 {
         -1.636_584_5e-7,
         1.480_719_3e-8,
     ];
+    let s = F::splat;
     let z = x.abs();
-    if z < 1.0 {
+    let series = || {
         // x + x (T[0] - 1 + x^2 (...)): the leading term exact.
         let x2 = x * x;
-        let mut p = T[10];
+        let mut p = s(T[10]);
         for &c in T[1..10].iter().rev() {
-            p = c + x2 * p;
+            p = s(c) + x2 * p;
         }
-        x + x * (FRAC_2_SQRT_PI_MINUS_1 + x2 * p)
+        x + x * (s(FRAC_2_SQRT_PI_MINUS_1) + x2 * p)
+    };
+    let complement = || (s(1.0) - erfc(z)).copysign(x);
+    let small = z.lt(s(1.0));
+    if F::all(small) {
+        series()
+    } else if F::all(!small) {
+        complement()
     } else {
-        (1.0 - erfc(z)).copysign(x)
+        F::select(small, series(), complement())
     }
 }
 
@@ -229,7 +241,7 @@ pub fn erf(x: f32) -> f32 {
 /// polynomial in `w - 5/2` for `w < 5` and in `sqrt(w) - 3` beyond, times
 /// `y`. `1 - y^2` is formed as `(1 - y)(1 + y)`, exact enough near `+-1`.
 #[inline]
-pub fn erf_inv(y: f32) -> f32 {
+pub fn erf_inv<F: Real>(y: F) -> F {
     const CENTRAL: [f32; 9] = [
         2.810_226_4e-8,
         3.432_739_4e-7,
@@ -252,24 +264,39 @@ pub fn erf_inv(y: f32) -> f32 {
         1.001_674,
         2.832_976_8,
     ];
-    if y.abs() >= 1.0 {
-        return if y.abs() == 1.0 {
-            f32::INFINITY.copysign(y)
-        } else {
-            f32::NAN
-        };
-    }
-    let w = -ln((1.0 - y) * (1.0 + y));
-    let (coefficients, t) = if w < 5.0 {
-        (&CENTRAL, w - 2.5)
-    } else {
-        (&TAIL, w.sqrt() - 3.0)
+    let s = F::splat;
+    let inside = y.abs().lt(s(1.0));
+    let special = || {
+        F::select(
+            y.abs().eq(s(1.0)),
+            s(f32::INFINITY).copysign(y),
+            s(f32::NAN),
+        )
     };
-    let mut p = coefficients[0];
-    for &c in &coefficients[1..] {
-        p = c + p * t;
+    if F::all(!inside) {
+        return special();
     }
-    p * y
+    // Lanes at or beyond +-1 are worked on as 0 and selected at the end.
+    let y = F::select(inside, y, s(0.0));
+    let w = -ln((s(1.0) - y) * (s(1.0) + y));
+    let polynomial = |coefficient: &dyn Fn(usize) -> F, t: F| {
+        let mut p = coefficient(0);
+        for i in 1..9 {
+            p = coefficient(i) + p * t;
+        }
+        p
+    };
+    let central = w.lt(s(5.0));
+    let p = if F::all(central) {
+        polynomial(&|i| s(CENTRAL[i]), w - s(2.5))
+    } else if F::all(!central) {
+        polynomial(&|i| s(TAIL[i]), w.sqrt() - s(3.0))
+    } else {
+        // Each lane with its own branch's coefficients and variable.
+        let t = F::select(central, w - s(2.5), w.sqrt() - s(3.0));
+        polynomial(&|i| F::select(central, s(CENTRAL[i]), s(TAIL[i])), t)
+    };
+    F::select(inside, p * y, special())
 }
 
 /// `(sin x, cos x)` for `|x| <= pi/4`: the Taylor polynomials of degree 9
@@ -277,7 +304,7 @@ pub fn erf_inv(y: f32) -> f32 {
 /// 2e-9` and `x^12/12! < 2e-10`, far below f32's half ulp, so the result is
 /// within 2 ulp of the exact one (tested).
 #[inline]
-pub fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
+pub fn sin_cos_quarter_turn<F: Real>(x: F) -> (F, F) {
     const S: [f32; 4] = [-1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362_880.0];
     const C: [f32; 5] = [
         -1.0 / 2.0,
@@ -286,9 +313,11 @@ pub fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
         1.0 / 40_320.0,
         -1.0 / 3_628_800.0,
     ];
+    let s = F::splat;
     let x2 = x * x;
-    let sin = x + x * x2 * (S[0] + x2 * (S[1] + x2 * (S[2] + x2 * S[3])));
-    let cos = 1.0 + x2 * (C[0] + x2 * (C[1] + x2 * (C[2] + x2 * (C[3] + x2 * C[4]))));
+    let sin = x + x * x2 * (s(S[0]) + x2 * (s(S[1]) + x2 * (s(S[2]) + x2 * s(S[3]))));
+    let cos =
+        s(1.0) + x2 * (s(C[0]) + x2 * (s(C[1]) + x2 * (s(C[2]) + x2 * (s(C[3]) + x2 * s(C[4])))));
     (sin, cos)
 }
 
@@ -300,25 +329,28 @@ pub fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
 /// `t - q/4` is computed without rounding (Sterbenz), leaving `|x| <=
 /// pi/4` for [`sin_cos_quarter_turn`], then a rotation by `q` quarters.
 #[inline]
-pub fn sin_cos_turns(t: f32) -> (f32, f32) {
-    let quarters = (4.0 * t + ROUND_MAGIC) - ROUND_MAGIC;
-    let x = (t - 0.25 * quarters) * (4.0 * FRAC_PI_2);
+pub fn sin_cos_turns<F: Real>(t: F) -> (F, F) {
+    let k = F::splat;
+    let quarters = (k(4.0) * t + k(ROUND_MAGIC)) - k(ROUND_MAGIC);
+    let x = (t - k(0.25) * quarters) * k(4.0 * FRAC_PI_2);
     let (s, c) = sin_cos_quarter_turn(x);
-    match (quarters as i32) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    // Quarter q mod 4 = 0, 1, 2, 3: (s, c), (c, -s), (-s, -c), (-c, s):
+    // an odd q swaps, bit 1 of q negates.
+    let odd = quarters.int_bit(0);
+    let (s, c) = (F::select(odd, c, s), F::select(odd, -s, c));
+    let half_turn = quarters.int_bit(1);
+    (F::select(half_turn, -s, s), F::select(half_turn, -c, c))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::real::F32x4;
+    use crate::real::{F32x4, F32x8};
 
-    /// The generic functions on four SIMD lanes give the scalar results bit
-    /// for bit, over every binade of both signs and the special values.
+    /// The generic functions on SIMD lanes (four and eight) give the
+    /// scalar results bit for bit, over every binade of both signs and the
+    /// special values, each chunk mixing lanes that take different
+    /// branches.
     #[test]
     fn lanes_match_the_scalar_functions_bit_for_bit() {
         let mut xs: Vec<f32> = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0]
@@ -332,22 +364,64 @@ mod tests {
                 10.07,
                 f32::MAX,
                 f32::MIN_POSITIVE,
+                f32::from_bits(1),
+                1.0,
+                -1.0,
+                0.999_999_94,
+                -0.999_999_94,
+                0.25,
+                0.5,
+                0.75,
             ])
             .collect();
         xs.extend(sweep(1e-30, 200.0, 9_973));
         xs.extend(sweep(-1e-30, -200.0, 9_973));
+        xs.extend(sweep(1e-40, 1.0, 99_991));
+        xs.extend(sweep(-1e-40, -1.0, 99_991));
+        check_lanes::<F32x4>(&xs);
+        check_lanes::<F32x8>(&xs);
+    }
+
+    /// A scalar function, its value on the lanes, its name.
+    type Case<'a, F> = (fn(f32) -> f32, F, &'a str);
+
+    fn check_lanes<F: Real>(xs: &[f32]) {
         let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
-        for chunk in xs.chunks(4) {
-            let lanes = F32x4::new(std::array::from_fn(|i| chunk[i % chunk.len()]));
-            for (f, simd, name) in [
-                (exp::<f32> as fn(f32) -> f32, exp::<F32x4>(lanes), "exp"),
-                (erfc::<f32>, erfc::<F32x4>(lanes), "erfc"),
-            ] {
+        for chunk in xs.chunks(F::LANES) {
+            let lanes = F::from_fn(|i| chunk[i % chunk.len()]);
+            let turns = |x: F| sin_cos_turns(x);
+            let quarter = |x: F| sin_cos_quarter_turn(x * F::splat(1e-2));
+            let results: [Case<F>; 9] = [
+                (exp::<f32>, exp(lanes), "exp"),
+                (erfc::<f32>, erfc(lanes), "erfc"),
+                (erf::<f32>, erf(lanes), "erf"),
+                (erf_inv::<f32>, erf_inv(lanes), "erf_inv"),
+                (ln::<f32>, ln(lanes), "ln"),
+                (|x| sin_cos_turns(x).0, turns(lanes).0, "sin turns"),
+                (|x| sin_cos_turns(x).1, turns(lanes).1, "cos turns"),
+                (
+                    |x| sin_cos_quarter_turn(x * 1e-2).0,
+                    quarter(lanes).0,
+                    "sin",
+                ),
+                (
+                    |x| sin_cos_quarter_turn(x * 1e-2).1,
+                    quarter(lanes).1,
+                    "cos",
+                ),
+            ];
+            for (f, simd, name) in results {
                 for (i, &x) in chunk.iter().enumerate() {
-                    let lane = simd.to_array()[i];
+                    // Outside the documented domain |t| < 2^20 (or NaN).
+                    let in_domain = x.abs() < 1_048_576.0;
+                    if name.ends_with("turns") && !in_domain {
+                        continue;
+                    }
+                    let lane = simd.lane(i);
                     assert!(
                         same(lane, f(x)),
-                        "{name}({x}): lane {lane}, scalar {}",
+                        "{name}({x}) on {} lanes: lane {lane}, scalar {}",
+                        F::LANES,
                         f(x)
                     );
                 }

@@ -7,6 +7,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_4, PI};
 
 use glam::{Vec2, Vec3};
 
+use crate::real::{Real, V3};
 use crate::special::{sin_cos_quarter_turn, sin_cos_turns};
 
 /// Concentric map of the square to the unit disk (Shirley and Chiu 1997,
@@ -182,9 +183,10 @@ mod tests {
 /// `1 - cos theta = sin^2 theta / (1 + cos theta)`. Exact to a few ulps even
 /// for `s = 1e-16` (a sphere of radius 1e-4 at distance 1e4), where
 /// `1 - sqrt(1 - s)` is 0 in `f32`.
-#[inline]
-pub fn one_minus_cos_from_sin2(sin2: f32) -> f32 {
-    sin2 / (1.0 + (1.0 - sin2).max(0.0).sqrt())
+/// Generic over [`Real`], so that a batched light runs it on SIMD lanes.
+#[inline(always)]
+pub fn one_minus_cos_from_sin2<F: Real>(sin2: F) -> F {
+    sin2 / (F::splat(1.0) + (F::splat(1.0) - sin2).max(F::splat(0.0)).sqrt())
 }
 
 /// A direction uniform in the cone of half-angle `theta_max` around `+z`,
@@ -193,16 +195,22 @@ pub fn one_minus_cos_from_sin2(sin2: f32) -> f32 {
 /// `sin theta = sqrt(h (2 - h))`). Density [`uniform_cone_pdf`].
 #[inline]
 pub fn square_to_uniform_cone(u: Vec2, h_max: f32) -> Vec3 {
-    let h = u.x * h_max;
-    let sin_theta = (h * (2.0 - h)).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = sin_cos_turns(u.y);
-    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, 1.0 - h)
+    square_to_uniform_cone_lanes([u.x, u.y], h_max).into()
+}
+
+/// [`square_to_uniform_cone`] of a sample per lane, each lane its bits.
+#[inline(always)]
+pub fn square_to_uniform_cone_lanes<F: Real>([u0, u1]: [F; 2], h_max: F) -> V3<F> {
+    let h = u0 * h_max;
+    let sin_theta = (h * (F::splat(2.0) - h)).max(F::splat(0.0)).sqrt();
+    let (sin_phi, cos_phi) = sin_cos_turns(u1);
+    V3::new(sin_theta * cos_phi, sin_theta * sin_phi, F::splat(1.0) - h)
 }
 
 /// `1 / (2 pi (1 - cos theta_max))`, the solid angle of the cone inverted.
-#[inline]
-pub fn uniform_cone_pdf(h_max: f32) -> f32 {
-    1.0 / (2.0 * PI * h_max)
+#[inline(always)]
+pub fn uniform_cone_pdf<F: Real>(h_max: F) -> F {
+    F::splat(1.0) / (F::splat(2.0 * PI) * h_max)
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! hemispherical average a diffuse layer under a coat sees.
 
 use lumis_core::{Rgb, Vec3};
+use lumis_sampling::real::Real;
 
 /// Unpolarised Fresnel reflectance of a dielectric interface (Born and
 /// Wolf, section 1.5.2; pbrt-v4 `FrDielectric`). `cos_theta_i` is measured
@@ -24,35 +25,47 @@ pub fn dielectric(cos_theta_i: f32, eta: f32) -> f32 {
     0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
 }
 
-/// A complex number, only as much as the conductor Fresnel term needs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Complex {
-    re: f32,
-    im: f32,
+/// A complex number, only as much as the conductor Fresnel term needs;
+/// of one value or of SIMD lanes.
+#[derive(Debug, Clone, Copy)]
+struct Complex<F> {
+    re: F,
+    im: F,
 }
 
-impl Complex {
-    const fn new(re: f32, im: f32) -> Self {
+impl<F: Real> Complex<F> {
+    #[inline(always)]
+    fn new(re: F, im: F) -> Self {
         Self { re, im }
     }
+    #[inline(always)]
+    fn real(re: F) -> Self {
+        Self::new(re, F::splat(0.0))
+    }
+    #[inline(always)]
     fn add(self, o: Self) -> Self {
         Self::new(self.re + o.re, self.im + o.im)
     }
+    #[inline(always)]
     fn sub(self, o: Self) -> Self {
         Self::new(self.re - o.re, self.im - o.im)
     }
+    #[inline(always)]
     fn mul(self, o: Self) -> Self {
         Self::new(
             self.re * o.re - self.im * o.im,
             self.re * o.im + self.im * o.re,
         )
     }
-    fn scale(self, s: f32) -> Self {
+    #[inline(always)]
+    fn scale(self, s: F) -> Self {
         Self::new(self.re * s, self.im * s)
     }
-    fn norm(self) -> f32 {
+    #[inline(always)]
+    fn norm(self) -> F {
         self.re * self.re + self.im * self.im
     }
+    #[inline(always)]
     fn div(self, o: Self) -> Self {
         let d = o.norm();
         Self::new(
@@ -61,18 +74,22 @@ impl Complex {
         )
     }
     /// Principal square root, stable for both signs of the real part.
+    #[inline(always)]
     fn sqrt(self) -> Self {
+        let zero = F::splat(0.0);
         let n = self.norm().sqrt();
-        if n == 0.0 {
-            return Self::new(0.0, 0.0);
-        }
-        let t1 = (0.5 * (n + self.re.abs())).sqrt();
-        let t2 = 0.5 * self.im / t1;
-        if self.re >= 0.0 {
-            Self::new(t1, t2)
-        } else {
-            Self::new(t2.abs(), t1.copysign(self.im))
-        }
+        let t1 = (F::splat(0.5) * (n + self.re.abs())).sqrt();
+        let t2 = F::splat(0.5) * self.im / t1;
+        let right = self.re.ge(zero);
+        let root = Self::new(
+            F::select(right, t1, t2.abs()),
+            F::select(right, t2, t1.copysign(self.im)),
+        );
+        let origin = n.eq(zero);
+        Self::new(
+            F::select(origin, zero, root.re),
+            F::select(origin, zero, root.im),
+        )
     }
 }
 
@@ -80,15 +97,23 @@ impl Complex {
 /// relative to the outside (pbrt-v4 `FrComplex`, the same two amplitude
 /// ratios as the dielectric with a complex eta). `cos_theta_i` in [0, 1].
 pub fn conductor_channel(cos_theta_i: f32, eta: f32, k: f32) -> f32 {
-    let cos_i = cos_theta_i.clamp(0.0, 1.0);
-    let eta = Complex::new(eta, k);
-    let sin2_i = 1.0 - cos_i * cos_i;
-    let sin2_t = Complex::new(sin2_i, 0.0).div(eta.mul(eta));
-    let cos_t = Complex::new(1.0, 0.0).sub(sin2_t).sqrt();
-    let ci = Complex::new(cos_i, 0.0);
+    conductor_channel_lanes(cos_theta_i, eta, k)
+}
+
+/// [`conductor_channel`] lane by lane: the same operations, so the same
+/// bits in each lane.
+#[inline]
+pub fn conductor_channel_lanes<F: Real>(cos_theta_i: F, eta: f32, k: f32) -> F {
+    let s = F::splat;
+    let cos_i = cos_theta_i.max(s(0.0)).min(s(1.0));
+    let eta = Complex::new(s(eta), s(k));
+    let sin2_i = s(1.0) - cos_i * cos_i;
+    let sin2_t = Complex::real(sin2_i).div(eta.mul(eta));
+    let cos_t = Complex::real(s(1.0)).sub(sin2_t).sqrt();
+    let ci = Complex::real(cos_i);
     let r_parallel = eta.scale(cos_i).sub(cos_t).div(eta.scale(cos_i).add(cos_t));
     let r_perpendicular = ci.sub(eta.mul(cos_t)).div(ci.add(eta.mul(cos_t)));
-    0.5 * (r_parallel.norm() + r_perpendicular.norm())
+    s(0.5) * (r_parallel.norm() + r_perpendicular.norm())
 }
 
 /// Per-channel conductor reflectance.
@@ -238,6 +263,37 @@ mod tests {
         let gold = metal("Au").unwrap();
         let f = conductor(1.0, gold.eta.into(), gold.k.into());
         assert!(f.r > f.g && f.g > f.b, "gold is yellow: {f:?}");
+    }
+
+    /// On SIMD lanes the conductor term is the scalar one bit for bit,
+    /// for every metal, at cosines from beyond both ends of [0, 1] to
+    /// grazing and normal incidence, and with no absorption (where the
+    /// square root's argument changes sign).
+    #[test]
+    fn conductor_lanes_are_the_scalar_bit_for_bit() {
+        use lumis_sampling::real::F32x8;
+        let cosines: Vec<f32> = [-0.5, 0.0, 1e-6, 1e-4, 1.0, 1.5]
+            .into_iter()
+            .chain((0..1000).map(|i| i as f32 / 999.0))
+            .collect();
+        let mut indices: Vec<(f32, f32)> = METALS
+            .iter()
+            .flat_map(|m| (0..3).map(|c| (m.eta[c], m.k[c])))
+            .collect();
+        indices.extend([(1.5, 0.0), (0.5, 0.0), (1.0, 0.0)]);
+        for (eta, k) in indices {
+            for chunk in cosines.chunks(8) {
+                let lanes = F32x8::from_fn(|i| chunk[i % chunk.len()]);
+                let lanes = conductor_channel_lanes(lanes, eta, k);
+                for (i, &c) in chunk.iter().enumerate() {
+                    assert_eq!(
+                        lanes.lane(i).to_bits(),
+                        conductor_channel(c, eta, k).to_bits(),
+                        "eta {eta} k {k} cos {c}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
