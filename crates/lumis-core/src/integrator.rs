@@ -1,7 +1,7 @@
 //! The integrator plugin interface.
 
 use crate::ray::Ray;
-use crate::sampler::Sampler;
+use crate::sampler::{Sampler, SamplerLanes};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use crate::stats::RenderStats;
@@ -26,19 +26,19 @@ pub trait Integrator: Send + Sync {
     }
 
     /// The estimates for a batch of camera rays: `out[i]` for `rays[i]`,
-    /// whose pixel sample `samplers[i]` has started (its camera dimensions
-    /// drawn). A wavefront integrator advances the paths together; the
-    /// default traces them one by one with `li`.
+    /// whose pixel sample lane `i` of `samplers` has started (its camera
+    /// dimensions drawn). A wavefront integrator advances the paths
+    /// together; the default traces them one by one with `li`.
     fn li_batch(
         &self,
         rays: &[Ray],
         scene: &dyn Scene,
-        samplers: &mut [Box<dyn Sampler>],
+        samplers: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
         out: &mut [Rgb],
     ) {
-        for ((ray, sampler), out) in rays.iter().zip(samplers).zip(out) {
-            *out = self.li(ray, scene, sampler.as_mut(), stats);
+        for (i, (ray, out)) in rays.iter().zip(out).enumerate() {
+            *out = self.li(ray, scene, samplers.lane(i), stats);
         }
     }
 }

@@ -33,7 +33,7 @@ pub use math::Frame;
 pub use params::{ParamSpec, ParamType, Params};
 pub use ray::Ray;
 pub use registry::{PluginKind, PluginSpec, Registry};
-pub use sampler::Sampler;
+pub use sampler::{ConcreteLanes, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;

@@ -32,4 +32,74 @@ pub trait Sampler: Send + Sync {
 
     /// An independent copy for another thread.
     fn clone_sampler(&self) -> Box<dyn Sampler>;
+
+    /// `n` independent copies, one per lane of a batch of paths. The
+    /// default boxes `n` clones and asks them one virtual call at a time;
+    /// a `Clone` sampler returns [`ConcreteLanes`] instead, whose batched requests
+    /// call it directly.
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        Box::new(BoxedLanes((0..n).map(|_| self.clone_sampler()).collect()))
+    }
+}
+
+/// The samplers of a batch of paths, one per lane, each drawing its own
+/// pixel sample's numbers in its own order; a wavefront integrator asks
+/// them together.
+pub trait SamplerLanes: Send {
+    /// How many lanes.
+    fn len(&self) -> usize;
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Lane `i`'s sampler, for a request of one lane.
+    fn lane(&mut self, i: usize) -> &mut dyn Sampler;
+
+    /// `out[k]` = [`Sampler::get_1d_2d`] of lane `lanes[k]`, in order: the
+    /// request each vertex of a wave makes for its BSDF sample and for its
+    /// light sample. Each lane gets exactly the numbers it would get asked
+    /// alone.
+    fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
+        for (&i, out) in lanes.iter().zip(out) {
+            *out = self.lane(i).get_1d_2d();
+        }
+    }
+}
+
+/// The default [`Sampler::lanes`]: boxed clones.
+struct BoxedLanes(Vec<Box<dyn Sampler>>);
+
+impl SamplerLanes for BoxedLanes {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn lane(&mut self, i: usize) -> &mut dyn Sampler {
+        self.0[i].as_mut()
+    }
+}
+
+/// Lanes of a concrete sampler type: the batched requests call `S`'s
+/// methods without a virtual call per lane, so they inline into one loop.
+pub struct ConcreteLanes<S>(pub Vec<S>);
+
+impl<S: Sampler + Clone + 'static> ConcreteLanes<S> {
+    /// `n` copies of `sampler`, boxed for [`Sampler::lanes`].
+    pub fn boxed(sampler: &S, n: usize) -> Box<dyn SamplerLanes> {
+        Box::new(Self(vec![sampler.clone(); n]))
+    }
+}
+
+impl<S: Sampler + 'static> SamplerLanes for ConcreteLanes<S> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn lane(&mut self, i: usize) -> &mut dyn Sampler {
+        &mut self.0[i]
+    }
+    fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
+        for (&i, out) in lanes.iter().zip(out) {
+            *out = self.0[i].get_1d_2d();
+        }
+    }
 }

@@ -4,7 +4,9 @@
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use lumis_core::{Error, Integrator, Ray, RenderStats, Result, Rgb, Sampler, Scene, UVec2, Vec3};
+use lumis_core::{
+    Error, Integrator, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene, UVec2, Vec3,
+};
 use lumis_image::Image;
 use rayon::prelude::*;
 
@@ -68,7 +70,7 @@ impl Batch {
         &mut self,
         scene: &dyn Scene,
         integrator: &dyn Integrator,
-        lanes: &mut [Box<dyn Sampler>],
+        lanes: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
         sums: &mut [[f64; 3]],
     ) {
@@ -80,7 +82,7 @@ impl Batch {
             integrator.li_batch(
                 &self.rays[..n],
                 scene,
-                &mut lanes[..n],
+                lanes,
                 stats,
                 &mut self.radiance[..n],
             )
@@ -109,7 +111,7 @@ fn render_tile(
     camera: &PerspectiveCamera,
     scene: &dyn Scene,
     integrator: &dyn Integrator,
-    lanes: &mut [Box<dyn Sampler>],
+    lanes: &mut dyn SamplerLanes,
     settings: &RenderSettings,
 ) -> (Vec<[f32; 3]>, RenderStats) {
     profile::enter_worker();
@@ -126,7 +128,7 @@ fn render_tile(
     for i in 0..count {
         let pixel = UVec2::new(tile.min.x + i % width, tile.min.y + i / width);
         for index in 0..settings.spp {
-            let lane = &mut lanes[batch.filled];
+            let lane = lanes.lane(batch.filled);
             lane.start_pixel_sample(pixel, index, settings.seed);
             // Box filter of radius 1/2: uniform over the pixel, weight 1.
             batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
@@ -199,13 +201,10 @@ pub fn render(
         tiles
             .par_iter()
             .map_init(
-                || {
-                    (0..integrator.batch_size().max(1))
-                        .map(|_| sampler.clone_sampler())
-                        .collect::<Vec<_>>()
-                },
+                || sampler.lanes(integrator.batch_size().max(1)),
                 |lanes, tile| {
-                    let out = render_tile(tile, camera, scene, integrator, lanes, settings);
+                    let out =
+                        render_tile(tile, camera, scene, integrator, lanes.as_mut(), settings);
                     progress.inc(1);
                     out
                 },

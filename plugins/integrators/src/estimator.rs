@@ -27,8 +27,8 @@ use lumis_core::bsdf::{BsdfContext, BsdfSample};
 use lumis_core::ray::RayOrigins;
 use lumis_core::{
     Light, LightIndex, LightKind, LightSample, LightSampleContext, LightSampler, ParamSpec,
-    ParamType, Params, Ray, RenderStats, Result, Rgb, Sampler, Scene, SurfaceInteraction, Vec2,
-    Vec3,
+    ParamType, Params, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene,
+    SurfaceInteraction, Vec2, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
@@ -539,6 +539,26 @@ impl Estimator {
             (0.0, Vec2::ZERO)
         };
         VertexNumbers { bsdf, light }
+    }
+
+    /// [`Self::vertex_numbers`] of each lane of `lanes`, as batched
+    /// requests: `bsdf[k]` and `light[k]` for lane `lanes[k]`, each lane
+    /// drawing them in `vertex_numbers`'s order.
+    pub fn vertex_numbers_batch(
+        &self,
+        samplers: &mut dyn SamplerLanes,
+        lanes: &[usize],
+        bsdf: &mut Vec<(f32, Vec2)>,
+        light: &mut Vec<(f32, Vec2)>,
+    ) {
+        for numbers in [&mut *bsdf, &mut *light] {
+            numbers.clear();
+            numbers.resize(lanes.len(), (0.0, Vec2::ZERO));
+        }
+        samplers.get_1d_2d_batch(lanes, bsdf);
+        if self.samples_lights() {
+            samplers.get_1d_2d_batch(lanes, light);
+        }
     }
 
     /// Emission found by `plan.extra_bsdf_samples` BSDF samples at `vertex`

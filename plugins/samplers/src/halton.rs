@@ -1,7 +1,8 @@
 //! `halton`: the Halton sequence over the whole image, scrambled.
 
 use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
+    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
@@ -147,6 +148,10 @@ impl Sampler for HaltonSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

@@ -1,7 +1,9 @@
 //! `hammersley`: the finite Hammersley point set of the pixel's samples,
 //! Owen-scrambled per pixel.
 
-use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
+use lumis_core::{
+    ConcreteLanes, Params, PluginKind, PluginSpec, Result, Sampler, SamplerLanes, UVec2, Vec2,
+};
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
     hash_with, laine_karras_permutation, pixel_key, reversed_to_unit_f32,
@@ -101,6 +103,10 @@ impl Sampler for HammersleySampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

@@ -1,6 +1,8 @@
 //! `independent`: uniform random numbers, no stratification.
 
-use lumis_core::{Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2};
+use lumis_core::{
+    ConcreteLanes, Params, PluginKind, PluginSpec, Result, Sampler, SamplerLanes, UVec2, Vec2,
+};
 use lumis_sampling::{hash_u64, pixel_key, Pcg32};
 
 use crate::spp::{read_spp, SPP_PARAM};
@@ -65,6 +67,10 @@ impl Sampler for IndependentSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

@@ -1,7 +1,8 @@
 //! `poisson-disk`: Poisson disk patterns for the film plane.
 
 use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
+    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::poisson_disk::{max_packing_distance, poisson_disk_pattern};
 use lumis_sampling::{hash_u64, pixel_key, Pcg32};
@@ -124,6 +125,10 @@ impl Sampler for PoissonDiskSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

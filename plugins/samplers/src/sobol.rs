@@ -4,7 +4,8 @@ use std::fmt;
 use std::marker::PhantomData;
 
 use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
+    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_to_unit_f32,
@@ -419,6 +420,10 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

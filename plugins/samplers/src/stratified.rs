@@ -2,7 +2,8 @@
 //! across dimensions by per-pixel random permutations (padding).
 
 use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
+    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, permutation_element, pixel_key, Pcg32, ONE_MINUS_EPSILON,
@@ -134,6 +135,10 @@ impl Sampler for StratifiedSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

@@ -2,7 +2,8 @@
 //! pixels, for blue-noise error between neighbouring pixels.
 
 use lumis_core::{
-    ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler, UVec2, Vec2,
+    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, laine_karras_permutation, reversed_to_unit_f32, sobol_reversed_u32,
@@ -221,6 +222,10 @@ impl Sampler for ZSobolSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
+        ConcreteLanes::boxed(self, n)
     }
 }
 

@@ -1,6 +1,7 @@
 //! `get_1d_2d` is `get_1d` then `get_2d`, bit for bit, for every sampler
 //! and every randomisation: the integrators take light and BSDF samples
-//! through it, so an override that drifted would change every render.
+//! through it, so an override that drifted would change every render. The
+//! same holds for its batched form over a sampler's lanes.
 
 use lumis_core::doc;
 use lumis_core::registry::TableRef;
@@ -89,6 +90,49 @@ fn fused_1d_2d_requests_match_separate_ones() {
                     "{name}"
                 );
             }
+        }
+    }
+}
+
+/// Each lane of `Sampler::lanes`, asked through `get_1d_2d_batch` over
+/// changing subsets of lanes and through single requests in between, draws
+/// exactly what a lone clone started on the same pixel sample draws.
+#[test]
+fn batched_requests_match_lone_samplers() {
+    let mut registry = Registry::new();
+    lumis_samplers::register(&mut registry).unwrap();
+    const N: usize = 6;
+    for (name, sampler) in variants(&registry) {
+        let mut lanes = sampler.lanes(N);
+        assert_eq!(lanes.len(), N, "{name}");
+        let mut lone: Vec<Box<dyn Sampler>> = (0..N).map(|_| sampler.clone_sampler()).collect();
+        for (i, lone) in lone.iter_mut().enumerate() {
+            let (pixel, index) = (UVec2::new(i as u32 % 3, 40 + i as u32), 7 * i as u32);
+            lanes.lane(i).start_pixel_sample(pixel, index, 42);
+            lone.start_pixel_sample(pixel, index, 42);
+            assert_eq!(lanes.lane(i).get_pixel_2d(), lone.get_pixel_2d(), "{name}");
+        }
+        let subsets: [&[usize]; 3] = [&[0, 1, 2, 3, 4, 5], &[1, 4], &[5, 0, 3]];
+        for request in 0..30 {
+            let subset = subsets[request % subsets.len()];
+            let mut batched = vec![(f32::NAN, lumis_core::Vec2::NAN); subset.len()];
+            lanes.get_1d_2d_batch(subset, &mut batched);
+            for (&i, &(u, v)) in subset.iter().zip(&batched) {
+                let (a, b) = lone[i].get_1d_2d();
+                assert_eq!(
+                    (u.to_bits(), v.x.to_bits(), v.y.to_bits()),
+                    (a.to_bits(), b.x.to_bits(), b.y.to_bits()),
+                    "{name}: lane {i}, request {request}"
+                );
+            }
+            // A single request of one lane between batches, as `plan` and
+            // Russian roulette make.
+            let i = request % N;
+            assert_eq!(
+                lanes.lane(i).get_1d().to_bits(),
+                lone[i].get_1d().to_bits(),
+                "{name}: lane {i}"
+            );
         }
     }
 }

@@ -22,13 +22,11 @@ mod batched;
 
 use lumis_core::{
     BsdfSample, Integrator, LightKind, LightSample, LightSampleContext, ParamSpec, ParamType,
-    Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler, Scene,
-    SurfaceInteraction, Vec2, Vec3,
+    Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler,
+    SamplerLanes, Scene, SurfaceInteraction, Vec2, Vec3,
 };
 
-use crate::estimator::{
-    bsdf_context, extra_sample_ray, SceneView, Vertex, VertexNumbers, VertexPlan,
-};
+use crate::estimator::{bsdf_context, extra_sample_ray, SceneView, Vertex, VertexPlan};
 use crate::path::{self, PathIntegrator};
 use crate::path_state::PathState;
 use batched::{Batcher, BsdfLane};
@@ -118,13 +116,15 @@ struct PendingShadow {
 /// wave: the paths, and the buffers each stage fills for the next.
 struct Wave<'s> {
     paths: Vec<PathState>,
-    numbers: Vec<VertexNumbers>,
     live: Vec<usize>,
     rays: Vec<Ray>,
     found: Vec<Option<SurfaceInteraction<'s>>>,
     vertices: Vec<WaveVertex<'s>>,
     bsdf_lanes: Vec<BsdfLane<'s>>,
-    u: Vec<(f32, Vec2)>,
+    /// The vertices' numbers (`Estimator::vertex_numbers_batch`): the
+    /// BSDF sample's and the first light sample's.
+    bsdf_u: Vec<(f32, Vec2)>,
+    light_u: Vec<(f32, Vec2)>,
     continuations: Vec<Option<BsdfSample>>,
     light_sums: Vec<Rgb>,
     extra_sums: Vec<Rgb>,
@@ -135,6 +135,9 @@ struct Wave<'s> {
 /// The buffers of one round of light samples.
 #[derive(Default)]
 struct LightStage {
+    /// The lanes drawing a later round's numbers, and the numbers.
+    lanes: Vec<usize>,
+    numbers: Vec<(f32, Vec2)>,
     takers: Vec<usize>,
     chosen: Vec<SampledLight>,
     ctx: Vec<LightSampleContext>,
@@ -156,13 +159,13 @@ impl Wave<'_> {
     fn new(camera_rays: &[Ray], n: usize) -> Self {
         Self {
             paths: camera_rays.iter().map(PathState::new).collect(),
-            numbers: Vec::with_capacity(n),
             live: Vec::with_capacity(n),
             rays: Vec::with_capacity(n),
             found: Vec::with_capacity(n),
             vertices: Vec::with_capacity(n),
             bsdf_lanes: Vec::with_capacity(n),
-            u: Vec::with_capacity(n),
+            bsdf_u: Vec::with_capacity(n),
+            light_u: Vec::with_capacity(n),
             continuations: Vec::with_capacity(n),
             light_sums: Vec::with_capacity(n),
             extra_sums: Vec::with_capacity(n),
@@ -195,7 +198,7 @@ impl Integrator for WavefrontIntegrator {
         &self,
         rays: &[Ray],
         scene: &dyn Scene,
-        samplers: &mut [Box<dyn Sampler>],
+        samplers: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
         out: &mut [Rgb],
     ) {
@@ -222,24 +225,21 @@ impl WavefrontIntegrator {
         &self,
         scene: &SceneView<'s, dyn Scene + 's>,
         wave: &mut Wave<'s>,
-        samplers: &mut [Box<dyn Sampler>],
+        samplers: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
     ) {
         let estimator = &self.path.estimator;
-        wave.numbers.clear();
+        estimator.vertex_numbers_batch(samplers, &wave.live, &mut wave.bsdf_u, &mut wave.light_u);
         wave.rays.clear();
-        for &lane in &wave.live {
-            wave.numbers
-                .push(estimator.vertex_numbers(samplers[lane].as_mut()));
-            wave.rays.push(wave.paths[lane].ray);
-        }
+        wave.rays
+            .extend(wave.live.iter().map(|&lane| wave.paths[lane].ray));
         wave.found.clear();
         wave.found.resize(wave.rays.len(), None);
         stats.rays += wave.rays.len() as u64;
         scene.scene.intersect_batch(&wave.rays, &mut wave.found);
 
-        // Emission, then the vertices where the paths go on; `numbers`
-        // follows the vertices.
+        // Emission, then the vertices where the paths go on; their numbers
+        // follow them.
         wave.vertices.clear();
         let mut kept = 0;
         for (k, found) in wave.found.drain(..).enumerate() {
@@ -256,7 +256,7 @@ impl WavefrontIntegrator {
                 continue;
             }
             let plan = if hit.bsdf_flags.is_non_specular() {
-                estimator.plan(samplers[lane].as_mut())
+                estimator.plan(samplers.lane(lane))
             } else {
                 VertexPlan::UNWEIGHTED
             };
@@ -266,17 +266,17 @@ impl WavefrontIntegrator {
                 hit,
                 plan,
             });
-            wave.numbers[kept] = wave.numbers[k];
+            wave.bsdf_u[kept] = wave.bsdf_u[k];
+            wave.light_u[kept] = wave.light_u[k];
             kept += 1;
         }
-        wave.numbers.truncate(kept);
+        wave.bsdf_u.truncate(kept);
+        wave.light_u.truncate(kept);
         wave.bsdf_lanes.clear();
         wave.bsdf_lanes
             .extend(wave.vertices.iter().map(WaveVertex::bsdf_lane));
-        wave.u.clear();
-        wave.u.extend(wave.numbers.iter().map(|n| n.bsdf));
         wave.batcher
-            .sample_f(&wave.bsdf_lanes, &wave.u, &mut wave.continuations);
+            .sample_f(&wave.bsdf_lanes, &wave.bsdf_u, &mut wave.continuations);
 
         self.sample_lights(scene, wave, samplers, stats);
         self.extra_bsdf_samples(scene, wave, samplers, stats);
@@ -296,7 +296,7 @@ impl WavefrontIntegrator {
                 continue;
             };
             let path = &mut wave.paths[v.lane];
-            let sampler = samplers[v.lane].as_mut();
+            let sampler = samplers.lane(v.lane);
             if path.continue_path(&v.vertex(), bs, &v.plan, self.path.rr_depth, sampler) {
                 wave.live.push(v.lane);
             }
@@ -311,7 +311,7 @@ impl WavefrontIntegrator {
         &self,
         scene: &SceneView<'s, dyn Scene + 's>,
         wave: &mut Wave<'s>,
-        samplers: &mut [Box<dyn Sampler>],
+        samplers: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
     ) {
         let estimator = &self.path.estimator;
@@ -326,14 +326,27 @@ impl WavefrontIntegrator {
             stage.chosen.clear();
             stage.ctx.clear();
             stage.u.clear();
+            // The first round's numbers came with the vertex's; the later
+            // rounds' are drawn here, one batched request per round.
+            if round > 0 {
+                stage.lanes.clear();
+                stage.lanes.extend(
+                    vertices
+                        .iter()
+                        .filter(|v| v.plan.light_samples > round)
+                        .map(|v| v.lane),
+                );
+                stage.numbers.resize(stage.lanes.len(), (0.0, Vec2::ZERO));
+                samplers.get_1d_2d_batch(&stage.lanes, &mut stage.numbers);
+            }
+            let mut later_numbers = stage.numbers.iter();
             for (k, v) in vertices.iter().enumerate() {
                 if v.plan.light_samples <= round {
                     continue;
                 }
-                let (u_light, u_point) = if round == 0 {
-                    wave.numbers[k].light
-                } else {
-                    samplers[v.lane].get_1d_2d()
+                let (u_light, u_point) = match round {
+                    0 => wave.light_u[k],
+                    _ => *later_numbers.next().expect("one per taker"),
                 };
                 let here = v.hit.light_context();
                 if let Some(light) = scene.light_sampler.sample(&here, u_light) {
@@ -417,7 +430,7 @@ impl WavefrontIntegrator {
         &self,
         scene: &SceneView<'s, dyn Scene + 's>,
         wave: &mut Wave<'s>,
-        samplers: &mut [Box<dyn Sampler>],
+        samplers: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
     ) {
         let estimator = &self.path.estimator;
@@ -429,10 +442,9 @@ impl WavefrontIntegrator {
             let takers: Vec<usize> = (0..vertices.len())
                 .filter(|&k| vertices[k].plan.extra_bsdf_samples > round)
                 .collect();
-            let u: Vec<(f32, Vec2)> = takers
-                .iter()
-                .map(|&k| samplers[vertices[k].lane].get_1d_2d())
-                .collect();
+            let taker_lanes: Vec<usize> = takers.iter().map(|&k| vertices[k].lane).collect();
+            let mut u = vec![(0.0, Vec2::ZERO); takers.len()];
+            samplers.get_1d_2d_batch(&taker_lanes, &mut u);
             let lanes: Vec<BsdfLane> = takers.iter().map(|&k| wave.bsdf_lanes[k].clone()).collect();
             let mut bsdf_samples = Vec::new();
             wave.batcher.sample_f(&lanes, &u, &mut bsdf_samples);
