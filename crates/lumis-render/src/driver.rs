@@ -102,10 +102,13 @@ impl Batch {
 }
 
 /// Renders one tile. The tile's samples go to the integrator in batches of
-/// its [`Integrator::batch_size`], in order (pixel by pixel, each pixel's
-/// samples by index), one sampler per batch lane; each pixel's samples are
-/// summed in that order, so the result does not depend on the thread count
-/// or the batch size.
+/// at most its [`Integrator::batch_size`], one sampler per batch lane: a
+/// run of the tile's pixels, several samples of each. Lane `l` holds pixel
+/// `l % run` of the run throughout, so that a lane keeps one pixel for all
+/// its samples and its sampler reuses per-pixel work (the Sobol' sampler's
+/// scramble seeds), as `path`'s single sampler does. Each pixel's samples
+/// are summed in index order, so the result does not depend on the thread
+/// count or the batch size.
 fn render_tile(
     tile: &Tile,
     camera: &PerspectiveCamera,
@@ -117,31 +120,36 @@ fn render_tile(
     profile::enter_worker();
     let mut stats = RenderStats::default();
     let width = tile.max.x - tile.min.x;
-    let count = width * (tile.max.y - tile.min.y);
-    let mut sums = vec![[0.0f64; 3]; count as usize];
+    let count = (width * (tile.max.y - tile.min.y)) as usize;
+    let mut sums = vec![[0.0f64; 3]; count];
     let mut batch = Batch {
         rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
         pixel_of_lane: vec![0; lanes.len()],
         radiance: vec![Rgb::BLACK; lanes.len()],
         filled: 0,
     };
-    for i in 0..count {
-        let pixel = UVec2::new(tile.min.x + i % width, tile.min.y + i / width);
-        for index in 0..settings.spp {
-            let lane = lanes.lane(batch.filled);
-            lane.start_pixel_sample(pixel, index, settings.seed);
-            // Box filter of radius 1/2: uniform over the pixel, weight 1.
-            batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
-                camera.generate_ray(pixel, lane.get_pixel_2d())
-            });
-            batch.pixel_of_lane[batch.filled] = i as usize;
-            batch.filled += 1;
-            if batch.filled == lanes.len() {
-                batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
+    let run = lanes.len().min(count);
+    let samples_per_batch = (lanes.len() / run) as u32;
+    for first in (0..count).step_by(run) {
+        let pixels = first..(first + run).min(count);
+        for base in (0..settings.spp).step_by(samples_per_batch as usize) {
+            for index in base..(base + samples_per_batch).min(settings.spp) {
+                for i in pixels.clone() {
+                    let pixel =
+                        UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
+                    let lane = lanes.lane(batch.filled);
+                    lane.start_pixel_sample(pixel, index, settings.seed);
+                    // Box filter of radius 1/2: uniform over the pixel, weight 1.
+                    batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
+                        camera.generate_ray(pixel, lane.get_pixel_2d())
+                    });
+                    batch.pixel_of_lane[batch.filled] = i;
+                    batch.filled += 1;
+                }
             }
+            batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
         }
     }
-    batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
     let inv = 1.0 / settings.spp as f64;
     let pixels = sums
         .into_iter()
