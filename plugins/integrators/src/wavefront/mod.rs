@@ -79,30 +79,40 @@ impl WavefrontIntegrator {
     }
 }
 
-/// A path vertex of the wave: its lane and what `path` knows there.
-struct WaveVertex<'s> {
+/// A path vertex of the wave: its lane and what `path` knows there, the
+/// hit left where the scene query wrote it (`Wave::found[found]`): moved,
+/// it would cost a `memcpy` per vertex.
+struct WaveVertex {
     lane: usize,
-    hit: SurfaceInteraction<'s>,
+    found: usize,
     wo: Vec3,
     plan: VertexPlan,
 }
 
-impl<'s> WaveVertex<'s> {
-    fn vertex(&self) -> Vertex<'_> {
+impl WaveVertex {
+    fn vertex<'a>(&self, hit: &'a SurfaceInteraction) -> Vertex<'a> {
         Vertex {
-            hit: &self.hit,
-            origins: self.hit.point.ray_origins(),
+            hit,
+            origins: hit.point.ray_origins(),
             wo: self.wo,
         }
     }
 
-    fn bsdf_lane(&self) -> BsdfLane<'s> {
+    fn bsdf_lane<'s>(&self, hit: &SurfaceInteraction<'s>) -> BsdfLane<'s> {
         BsdfLane {
-            bsdf: self.hit.bsdf,
-            ctx: bsdf_context(&self.hit),
+            bsdf: hit.bsdf,
+            ctx: bsdf_context(hit),
             wo: self.wo,
         }
     }
+}
+
+/// The hit of `v`, which every vertex has.
+fn hit_of<'a, 's>(
+    found: &'a [Option<SurfaceInteraction<'s>>],
+    v: &WaveVertex,
+) -> &'a SurfaceInteraction<'s> {
+    found[v.found].as_ref().expect("a wave vertex is a hit")
 }
 
 /// A light sample of a wave vertex waiting for its shadow ray.
@@ -119,7 +129,7 @@ struct Wave<'s> {
     live: Vec<usize>,
     rays: Vec<Ray>,
     found: Vec<Option<SurfaceInteraction<'s>>>,
-    vertices: Vec<WaveVertex<'s>>,
+    vertices: Vec<WaveVertex>,
     bsdf_lanes: Vec<BsdfLane<'s>>,
     /// The vertices' numbers (`Estimator::vertex_numbers_batch`): the
     /// BSDF sample's and the first light sample's.
@@ -242,7 +252,7 @@ impl WavefrontIntegrator {
         // follow them.
         wave.vertices.clear();
         let mut kept = 0;
-        for (k, found) in wave.found.drain(..).enumerate() {
+        for (k, found) in wave.found.iter().enumerate() {
             let lane = wave.live[k];
             let path = &mut wave.paths[lane];
             path.add_emission(
@@ -262,8 +272,8 @@ impl WavefrontIntegrator {
             };
             wave.vertices.push(WaveVertex {
                 lane,
+                found: k,
                 wo: hit.shading.to_local(-path.ray.d),
-                hit,
                 plan,
             });
             wave.bsdf_u[kept] = wave.bsdf_u[k];
@@ -273,8 +283,9 @@ impl WavefrontIntegrator {
         wave.bsdf_u.truncate(kept);
         wave.light_u.truncate(kept);
         wave.bsdf_lanes.clear();
+        let found = &wave.found;
         wave.bsdf_lanes
-            .extend(wave.vertices.iter().map(WaveVertex::bsdf_lane));
+            .extend(wave.vertices.iter().map(|v| v.bsdf_lane(hit_of(found, v))));
         wave.batcher
             .sample_f(&wave.bsdf_lanes, &wave.bsdf_u, &mut wave.continuations);
 
@@ -292,12 +303,13 @@ impl WavefrontIntegrator {
 
         wave.live.clear();
         for (v, sampled) in wave.vertices.iter().zip(&wave.continuations) {
+            let hit = hit_of(&wave.found, v);
             let Some(bs) = sampled else {
                 continue;
             };
             let path = &mut wave.paths[v.lane];
             let sampler = samplers.lane(v.lane);
-            if path.continue_path(&v.vertex(), bs, &v.plan, self.path.rr_depth, sampler) {
+            if path.continue_path(&v.vertex(hit), bs, &v.plan, self.path.rr_depth, sampler) {
                 wave.live.push(v.lane);
             }
         }
@@ -348,7 +360,7 @@ impl WavefrontIntegrator {
                     0 => wave.light_u[k],
                     _ => *later_numbers.next().expect("one per taker"),
                 };
-                let here = v.hit.light_context();
+                let here = hit_of(&wave.found, v).light_context();
                 if let Some(light) = scene.light_sampler.sample(&here, u_light) {
                     stage.takers.push(k);
                     stage.chosen.push(light);
@@ -375,7 +387,9 @@ impl WavefrontIntegrator {
                     let k = stage.takers[j];
                     stage.sampled.push(j);
                     stage.vertex_of.push(k);
-                    stage.wi.push(vertices[k].hit.shading.to_local(ls.wi));
+                    stage
+                        .wi
+                        .push(hit_of(&wave.found, &vertices[k]).shading.to_local(ls.wi));
                 }
             }
             wave.batcher.eval(
@@ -402,9 +416,12 @@ impl WavefrontIntegrator {
                         vertex: k,
                         unshadowed: unshadowed(),
                     });
-                    stage
-                        .shadow_rays
-                        .push(vertices[k].vertex().origins.spawn_ray_to(&ls.p));
+                    stage.shadow_rays.push(
+                        hit_of(&wave.found, &vertices[k])
+                            .point
+                            .ray_origins()
+                            .spawn_ray_to(&ls.p),
+                    );
                 }
             }
             stage.blocked.clear();
@@ -453,7 +470,7 @@ impl WavefrontIntegrator {
                 let v = &vertices[k];
                 if let Some(ray) = bs
                     .as_ref()
-                    .and_then(|bs| extra_sample_ray(&v.plan, &v.vertex(), bs))
+                    .and_then(|bs| extra_sample_ray(&v.plan, &v.vertex(hit_of(&wave.found, v)), bs))
                 {
                     traced.push((k, ray));
                 }
