@@ -416,7 +416,7 @@ impl Bsdf for Conductor {
     }
 
     /// [`Bsdf::eval`] a SIMD chunk of lanes at a time
-    /// ([`Conductor::eval_lanes`]), each lane bit for bit `eval`'s answer.
+    /// (`Conductor::eval_lanes`), each lane bit for bit `eval`'s answer.
     fn eval_batch(&self, _ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
         let Some(mf) = &self.microfacet else {
             out.fill((Rgb::BLACK, 0.0));
@@ -440,7 +440,7 @@ impl Bsdf for Conductor {
     /// visible-normal sampling of the rough lobe: the normals drawn on SIMD
     /// lanes (`Microfacet::sample_visible`, the scalar's own formulas),
     /// reflected per lane, and the value and density of each lane's
-    /// direction from [`Conductor::eval_lanes`]; bit for bit `sample_f`'s
+    /// direction from `Conductor::eval_lanes`; bit for bit `sample_f`'s
     /// answer. The mirror and the other strategies loop over `sample_f`.
     fn sample_f_batch(
         &self,

@@ -248,7 +248,7 @@ impl Light for SphereLight {
     }
 
     /// [`Light::sample_li`] eight lanes at a time for the cone sampling
-    /// from outside ([`SphereLight::sample_cone_lanes`] on SIMD lanes, the
+    /// from outside (`SphereLight::sample_cone_lanes` on SIMD lanes, the
     /// scalar's own formulas), bit for bit its answer; lanes inside or on
     /// the sphere, and area sampling, call `sample_li`.
     fn sample_li_batch(
