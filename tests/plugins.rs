@@ -186,3 +186,64 @@ fn library_from_another_lumis_core_is_refused_before_registering() {
         .find(lumis_core::PluginKind::Bsdf, "phong")
         .is_none());
 }
+
+#[test]
+fn library_with_another_plugin_interface_is_refused_before_registering() {
+    let library = build_plugin("altered-interface-plugin", "altered_interface_plugin");
+    let mut registry = lumis_cli::builtin_registry().unwrap();
+    // Its register function panics: reaching it would fail differently.
+    let err = lumis_loader::load_library(&library, &mut registry)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("plugin interface differs")
+            && err.contains("0123456789abcdef")
+            && err.contains(lumis_core::plugin::INTERFACE_FINGERPRINT)
+            && err.contains("rebuild"),
+        "{err}"
+    );
+}
+
+/// A copy of the example plugin in a fresh directory.
+fn plugin_copy(tag: &str) -> (PathBuf, PathBuf) {
+    let library = build_example_plugin();
+    let dir = std::env::temp_dir().join(format!("lumis-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let copy = dir.join(library.file_name().unwrap());
+    std::fs::copy(&library, &copy).unwrap();
+    (dir, copy)
+}
+
+/// The same file named twice (once by another path) is loaded once.
+#[test]
+fn a_library_named_twice_loads_once() {
+    let (dir, copy) = plugin_copy("plugin-twice");
+    let mut registry = lumis_cli::builtin_registry().unwrap();
+    lumis_loader::load_library(&copy, &mut registry).unwrap();
+    let again = dir.join(".").join(copy.file_name().unwrap());
+    lumis_loader::load_library(&again, &mut registry).unwrap();
+    let phongs = registry
+        .plugins()
+        .into_iter()
+        .filter(|p| p.spec.name == "phong")
+        .count();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(phongs, 1);
+}
+
+/// A library cut short is an error naming the file, not a SIGBUS.
+#[test]
+fn a_truncated_library_is_an_error() {
+    let (dir, copy) = plugin_copy("plugin-cut");
+    let bytes = std::fs::read(&copy).unwrap();
+    std::fs::write(&copy, &bytes[..bytes.len() / 3]).unwrap();
+    let err = lumis_loader::load_library(&copy, &mut lumis_core::Registry::new())
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(
+        err.contains("cut short") && err.contains("not a loadable shared library"),
+        "{err}"
+    );
+}

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use lumis_check::bsdf_suite::{
     check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
 };
@@ -103,8 +103,24 @@ enum SamplersCommand {
     Analyze(AnalyzeArgs),
 }
 
+/// What `lumis --version` prints after the name: the versions a plugin
+/// library must match to load.
+fn version_text() -> String {
+    use lumis_core::plugin::{
+        CORE_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
+    };
+    format!(
+        "{}\nlumis-core {CORE_VERSION}, plugin ABI {PLUGIN_ABI_VERSION}, plugin interface \
+         {INTERFACE_FINGERPRINT}\nbuilt by {RUSTC_VERSION}",
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // Built once per process; clap keeps a `&'static str`.
+    let version: &'static str = Box::leak(version_text().into_boxed_str());
+    let matches = Cli::command().version(version).get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
         Command::Render(args) => registry_with_search_path().and_then(|registry| {
             render_scene_file(&args, &registry).map(|report| {

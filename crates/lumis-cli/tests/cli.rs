@@ -428,3 +428,51 @@ fn diff_prints_known_numbers_per_region_and_refuses_other_sizes() {
     assert!(!run.status.success());
     assert!(stderr.contains("differ in size: 2x1 vs 1x2"), "{stderr}");
 }
+
+/// A bare plugin library name is the file in the current directory, never
+/// one on the system's library search path, and the loader's reason is
+/// kept.
+#[test]
+fn plugin_library_names_resolve_in_the_current_directory() {
+    let dir = scratch("bare-plugin");
+    let in_dir = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lumis"))
+            .args(args)
+            .current_dir(dir.path())
+            .env_remove("LUMIS_PLUGIN_PATH")
+            .output()
+            .expect("lumis runs")
+    };
+    // libm is on the system's search path, not in this directory.
+    let out = in_dir(&["plugins", "--load", "libm.so.6"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("'libm.so.6' does not exist"),
+        "{stderr}"
+    );
+    std::fs::write(dir.path().join("fake.so"), "not a library").unwrap();
+    let out = in_dir(&["plugins", "--load", "fake.so"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let local = std::fs::canonicalize(dir.path().join("fake.so")).unwrap();
+    assert!(
+        !out.status.success()
+            && stderr.contains(&local.display().to_string())
+            && stderr.contains("no ELF header"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn version_names_the_plugin_interface_and_the_compiler() {
+    let out = lumis(&["--version"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    for part in [
+        lumis_core::plugin::CORE_VERSION,
+        &format!("plugin ABI {}", lumis_core::plugin::PLUGIN_ABI_VERSION),
+        lumis_core::plugin::INTERFACE_FINGERPRINT,
+        lumis_core::plugin::RUSTC_VERSION,
+    ] {
+        assert!(stdout.contains(part), "{part} missing from:\n{stdout}");
+    }
+}

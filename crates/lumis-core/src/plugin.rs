@@ -2,18 +2,25 @@
 //!
 //! Rust has no stable ABI, so a plugin library is only sound to use when it
 //! was built by the same rustc from the same lumis-core as the host. The
-//! declaration carries both, plus an ABI version that comes first so it can
-//! always be read; the host checks all three before calling anything else.
+//! declaration carries both, the fingerprint of the plugin interface (a
+//! hash of lumis-core's code and of the versions of the crates whose types
+//! cross the boundary, computed by its build script), and an ABI version
+//! that comes first so it can always be read; the host checks all four
+//! before calling anything else.
 
 use crate::error::Result;
 use crate::registry::Registry;
 
 /// Bumped whenever [`PluginDeclaration`] or the plugin traits change shape.
-pub const PLUGIN_ABI_VERSION: u32 = 6;
+pub const PLUGIN_ABI_VERSION: u32 = 7;
 /// The compiler that built this copy of lumis-core.
 pub const RUSTC_VERSION: &str = env!("LUMIS_RUSTC_VERSION");
 /// The version of this copy of lumis-core.
 pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// The fingerprint of this copy's plugin interface, 16 hex digits: two
+/// lumis-cores with the same version whose traits differ have different
+/// fingerprints (`build/fingerprint.rs`).
+pub const INTERFACE_FINGERPRINT: &str = env!("LUMIS_INTERFACE_FINGERPRINT");
 /// The symbol [`lumis_plugin!`](crate::lumis_plugin) exports.
 pub const ENTRY_POINT: &str = "lumis_plugin_declaration";
 
@@ -27,6 +34,7 @@ pub struct PluginDeclaration {
     pub abi_version: u32,
     rustc_version: [u8; TEXT],
     core_version: [u8; TEXT],
+    interface_fingerprint: [u8; TEXT],
     /// Called by the host with its registry once the versions match.
     pub register: fn(&mut Registry) -> Result<()>,
 }
@@ -54,6 +62,7 @@ impl PluginDeclaration {
             abi_version: PLUGIN_ABI_VERSION,
             rustc_version: text(RUSTC_VERSION),
             core_version: text(CORE_VERSION),
+            interface_fingerprint: text(INTERFACE_FINGERPRINT),
             register,
         }
     }
@@ -65,12 +74,14 @@ impl PluginDeclaration {
         abi_version: u32,
         rustc_version: &str,
         core_version: &str,
+        interface_fingerprint: &str,
         register: fn(&mut Registry) -> Result<()>,
     ) -> Self {
         Self {
             abi_version,
             rustc_version: text(rustc_version),
             core_version: text(core_version),
+            interface_fingerprint: text(interface_fingerprint),
             register,
         }
     }
@@ -81,6 +92,10 @@ impl PluginDeclaration {
 
     pub fn core_version(&self) -> String {
         read_text(&self.core_version)
+    }
+
+    pub fn interface_fingerprint(&self) -> String {
+        read_text(&self.interface_fingerprint)
     }
 }
 
@@ -123,7 +138,35 @@ mod tests {
             d.rustc_version()
         );
         assert_eq!(d.core_version(), CORE_VERSION);
+        assert_eq!(d.interface_fingerprint(), INTERFACE_FINGERPRINT);
+        assert_eq!(INTERFACE_FINGERPRINT.len(), 16);
         let mut r = Registry::new();
         (d.register)(&mut r).unwrap();
+    }
+
+    mod fingerprint {
+        include!(concat!(env!("CARGO_MANIFEST_DIR"), "/build/fingerprint.rs"));
+    }
+
+    /// A trait that gains a method changes the fingerprint, and so do a
+    /// boundary crate's version and a file's path; comments, documentation
+    /// and formatting do not.
+    #[test]
+    fn fingerprint_sees_the_interface_not_its_comments() {
+        let trait_v1 = "/// A BSDF.\npub trait Bsdf {\n    fn f(&self) -> f32;\n}\n";
+        let sources = |text: &str| vec![("src/bsdf.rs".to_string(), text.to_string())];
+        let glam = vec!["glam = \"=0.34.3\"".to_string()];
+        let base = fingerprint::fingerprint(&sources(trait_v1), &glam);
+        let documented = "//! Scattering.\n/// A BSDF, documented.\npub trait   Bsdf {\n  fn f(&self) -> f32; // value\n}";
+        assert_eq!(fingerprint::fingerprint(&sources(documented), &glam), base);
+        let grown = "pub trait Bsdf {\n    fn f(&self) -> f32;\n    fn g(&self) -> f32;\n}";
+        assert_ne!(fingerprint::fingerprint(&sources(grown), &glam), base);
+        let other_glam = vec!["glam = \"=0.35.0\"".to_string()];
+        assert_ne!(
+            fingerprint::fingerprint(&sources(trait_v1), &other_glam),
+            base
+        );
+        let moved = vec![("src/other.rs".to_string(), trait_v1.to_string())];
+        assert_ne!(fingerprint::fingerprint(&moved, &glam), base);
     }
 }

@@ -1,22 +1,30 @@
 //! Loading plugin libraries at run time.
 //!
-//! The rules that keep this sound (DESIGN.md, "Plugins"):
-//! - the library's declaration is checked first: ABI version, rustc version
-//!   and lumis-core version must equal the host's, or nothing else in the
-//!   library is touched;
+//! The rules that keep this sound:
+//! - the file is checked before it is mapped (`elf.rs`), and found by its
+//!   absolute path, never through the system's library search path;
+//! - the library's declaration is checked first: ABI version, rustc
+//!   version, lumis-core version and plugin interface fingerprint must
+//!   equal the host's, or nothing else in the library is touched;
+//! - a library already loaded is not loaded again;
 //! - the registry is passed in, never shared through globals;
-//! - calls into the library run inside `catch_unwind`;
+//! - the entry point and `register` run inside `catch_unwind`, which
+//!   catches a panic only where the library shares the host's panic
+//!   runtime (a `cdylib` carries its own, and its panics abort);
 //! - a library is never unloaded (thread-local destructors and vtables of
 //!   objects it created must outlive every use), so it is leaked on purpose.
 
 #![allow(unsafe_code)]
+
+mod elf;
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use libloading::{Library, Symbol};
 use lumis_core::plugin::{
-    PluginDeclaration, CORE_VERSION, ENTRY_POINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
+    PluginDeclaration, CORE_VERSION, ENTRY_POINT, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION,
+    RUSTC_VERSION,
 };
 use lumis_core::{Error, Registry, Result};
 
@@ -34,20 +42,58 @@ fn describe_panic(payload: Box<dyn std::any::Any + Send>) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Loads the plugin library at `path` and registers its plugins, labelled
-/// with the path so clashes name both sources.
+/// `e` and the errors under it, which hold the system loader's own words.
+fn describe_error(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text += &format!(": {s}");
+        source = s.source();
+    }
+    text
+}
+
+/// Loads the plugin library at `path` (relative to the current directory)
+/// and registers its plugins, labelled with its absolute path so clashes
+/// name both sources. A library already loaded into `registry` is not
+/// loaded again.
 pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
-    let shown = path.display();
     if !path.exists() {
         return Err(Error::msg(format!(
-            "plugin library '{shown}' does not exist"
+            "plugin library '{}' does not exist",
+            path.display()
         )));
+    }
+    // Absolute, so that `dlopen` opens this file and does not search the
+    // system's library path for a bare name.
+    let path = std::fs::canonicalize(path).map_err(|e| {
+        Error::msg(format!(
+            "plugin library '{}' cannot be opened: {e}",
+            path.display()
+        ))
+    })?;
+    let shown = path.display();
+    if registry
+        .plugins()
+        .iter()
+        .any(|p| *p.source == *shown.to_string())
+    {
+        return Ok(());
+    }
+    if cfg!(target_os = "linux") {
+        elf::check(&path).map_err(|why| {
+            Error::msg(format!("'{shown}' is not a loadable shared library: {why}"))
+        })?;
     }
     // SAFETY: loading runs the library's initialisers. This is the point
     // of a plugin system: the user asked for this library. Everything after
     // is guarded by the declaration check.
-    let library = unsafe { Library::new(path) }
-        .map_err(|e| Error::msg(format!("'{shown}' is not a loadable shared library: {e}")))?;
+    let library = unsafe { Library::new(&path) }.map_err(|e| {
+        Error::msg(format!(
+            "'{shown}' is not a loadable shared library: {}",
+            describe_error(&e)
+        ))
+    })?;
     // SAFETY: the symbol, if present, was exported by `lumis_plugin!` with
     // exactly this signature; a library that exports the name with another
     // signature is not a lumis plugin and breaks the contract it claims.
@@ -92,6 +138,14 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
         return Err(Error::msg(format!(
             "'{shown}' was built against lumis-core {core}, lumis has {CORE_VERSION}: point the \
              plugin's lumis-core dependency at this lumis and rebuild"
+        )));
+    }
+    let interface = declaration.interface_fingerprint();
+    if interface != INTERFACE_FINGERPRINT {
+        return Err(Error::msg(format!(
+            "'{shown}' was built against a lumis-core {core} whose plugin interface differs from \
+             this lumis's (interface fingerprint {interface}, this lumis {INTERFACE_FINGERPRINT}): \
+             point the plugin's lumis-core dependency at this lumis and rebuild"
         )));
     }
     let previous = registry.source().to_string();
