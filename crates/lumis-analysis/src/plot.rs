@@ -108,6 +108,27 @@ pub struct Grid<'a> {
 /// A row-major array as a log10 heat map with a colour bar (viridis).
 /// Values are clamped to `[min, max]` of the positive entries, or to
 /// `range` when given.
+/// The colour scale of [`heat_map`], as log10 of the values: `range`, or
+/// the finite positive values' extent, at least a thousandth of a decade
+/// wide. Values that are all zero or not finite (the error of an image
+/// against itself) get the decade above 1e-12, so the scale and its ticks
+/// stay finite.
+fn log_range(values: &[f64], range: Option<(f64, f64)>) -> (f64, f64) {
+    const FLOOR: f64 = 1e-12;
+    let (lo, hi) = range.unwrap_or_else(|| {
+        values
+            .iter()
+            .copied()
+            .filter(|v| *v > 0.0 && v.is_finite())
+            .fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)))
+    });
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (FLOOR.log10(), FLOOR.log10() + 1.0);
+    }
+    let lo = lo.max(FLOOR).log10();
+    (lo, hi.max(FLOOR).log10().max(lo + 1e-3))
+}
+
 pub fn heat_map(
     path: &Path,
     title: &str,
@@ -115,14 +136,7 @@ pub fn heat_map(
     grid: &Grid,
     range: Option<(f64, f64)>,
 ) -> Result<()> {
-    let positive = values.iter().copied().filter(|v| *v > 0.0);
-    let (lo, hi) = range.unwrap_or_else(|| {
-        positive.fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)))
-    });
-    let (lo, hi) = (
-        lo.max(1e-12).log10(),
-        hi.max(1e-12).log10().max(lo.log10() + 1e-9),
-    );
+    let (lo, hi) = log_range(values, range);
     let (w, h) = (grid.width, grid.height);
     let (x0, y0) = grid.origin;
     // Keep cells square: the plot area follows the grid's aspect ratio.
@@ -371,6 +385,36 @@ mod tests {
             band: None,
         };
         assert!(line_plot(&dir.join("e.png"), &axes, &[empty]).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// All-zero and non-finite values (an image's error against itself, a
+    /// NaN pixel) give a finite scale, so drawing it ends.
+    #[test]
+    fn degenerate_values_get_a_finite_scale() {
+        for values in [
+            vec![0.0; 4],
+            vec![f64::INFINITY, 0.0],
+            vec![f64::NAN, f64::NAN],
+        ] {
+            let (lo, hi) = log_range(&values, None);
+            assert!(lo.is_finite() && hi.is_finite() && hi > lo, "{values:?}");
+        }
+        let (lo, hi) = log_range(&[1e-3, f64::INFINITY, 1e-1], None);
+        assert_eq!((lo, hi), (-3.0, -1.0));
+        let (lo, hi) = log_range(&[0.5, 0.5], None);
+        assert!(hi - lo >= 1e-3 && lo == 0.5f64.log10());
+        let dir = std::env::temp_dir().join(format!("lumis-plot-zero-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let grid = Grid {
+            width: 2,
+            height: 2,
+            origin: (0, 0),
+            x_label: "x",
+            y_label: "y",
+            value_label: "log10 error",
+        };
+        heat_map(&dir.join("z.png"), "zero", &[0.0; 4], &grid, None).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

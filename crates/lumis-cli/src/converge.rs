@@ -207,6 +207,7 @@ pub fn converge(
     registry: &Registry,
     stop: &AtomicBool,
 ) -> Result<ConvergeReport> {
+    crate::warn_if_threads_capped(args.threads);
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
     let provenance = reference_provenance(args);
     let variants_path = args.variants.display().to_string();

@@ -36,6 +36,18 @@ pub fn builtin_registry() -> Result<Registry> {
     Ok(registry)
 }
 
+/// Warns on stderr where `--threads` asks for more workers than a render
+/// runs (`lumis_render::worker_threads`).
+pub fn warn_if_threads_capped(requested: usize) {
+    let used = lumis_render::worker_threads(requested);
+    if requested != 0 && used < requested {
+        eprintln!(
+            "warning: --threads {requested} capped at {used} ({} per core)",
+            lumis_render::MAX_THREADS_PER_CORE
+        );
+    }
+}
+
 /// The built-in plugins plus every library on `LUMIS_PLUGIN_PATH`.
 pub fn registry_with_search_path() -> Result<Registry> {
     let mut registry = builtin_registry()?;

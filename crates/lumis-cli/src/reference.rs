@@ -108,6 +108,7 @@ pub fn render_reference(
     registry: &Registry,
     stop: &AtomicBool,
 ) -> Result<(PathBuf, ReferenceMetadata)> {
+    crate::warn_if_threads_capped(args.threads);
     if args.spp == 0 || args.pass_spp == 0 {
         return Err(Error::msg("--spp and --pass-spp must be at least 1"));
     }
@@ -124,11 +125,12 @@ pub fn render_reference(
         registry,
     )?;
     let base_seed = probe.seed;
+    let name = format!("{}-reference", probe.name);
     let output = args
         .output
         .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{}-reference.exr", probe.name)));
-    let (exr, _) = output_paths(&output);
+        .unwrap_or_else(|| PathBuf::from(format!("{name}.exr")));
+    let (exr, _) = output_paths(&output, &name);
     let meta_path = metadata_path(&exr);
     let resumed = std::fs::read_to_string(&meta_path)
         .ok()

@@ -78,11 +78,20 @@ impl RenderReport {
     }
 }
 
-/// `PATH.exr` and `PATH.png` for an output argument (with or without `.exr`).
-pub fn output_paths(output: &Path) -> (PathBuf, PathBuf) {
-    let stem = if output
+/// `PATH.exr` and `PATH.png` for an output argument given with `.exr`,
+/// `.png` or neither; for a directory (one that exists, or a path ending
+/// in a separator), `NAME.exr` and `NAME.png` in it.
+pub fn output_paths(output: &Path, name: &str) -> (PathBuf, PathBuf) {
+    let names_a_directory = output.is_dir()
+        || output
+            .as_os_str()
+            .to_string_lossy()
+            .ends_with(std::path::MAIN_SEPARATOR);
+    let stem = if names_a_directory {
+        output.join(name)
+    } else if output
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr") || e.eq_ignore_ascii_case("png"))
     {
         output.with_extension("")
     } else {
@@ -154,7 +163,7 @@ pub fn render_scene_file(
         (None, Some(o)) => o.clone(),
         (None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
     };
-    let (exr, png) = output_paths(&output);
+    let (exr, png) = output_paths(&output, &loaded.name);
     // Fail before rendering, not after, when the output cannot be written.
     if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
@@ -165,6 +174,7 @@ pub fn render_scene_file(
             )));
         }
     }
+    crate::warn_if_threads_capped(args.threads);
     let settings = RenderSettings {
         spp: loaded.sampler.samples_per_pixel(),
         seed: loaded.seed,
@@ -213,15 +223,19 @@ mod tests {
 
     #[test]
     fn output_paths_add_both_extensions() {
-        let (e, p) = output_paths(Path::new("out/box.exr"));
+        let paths = |o: &str| {
+            let (e, p) = output_paths(Path::new(o), "scene");
+            (e.display().to_string(), p.display().to_string())
+        };
+        let both = |stem: &str| (format!("{stem}.exr"), format!("{stem}.png"));
+        assert_eq!(paths("out/box.exr"), both("out/box"));
+        assert_eq!(paths("out/box.PNG"), both("out/box"));
+        assert_eq!(paths("box.v2"), both("box.v2"));
+        assert_eq!(paths("renders/"), both("renders/scene"));
+        let dir = std::env::temp_dir();
         assert_eq!(
-            (e.to_str().unwrap(), p.to_str().unwrap()),
-            ("out/box.exr", "out/box.png")
-        );
-        let (e, p) = output_paths(Path::new("box.v2"));
-        assert_eq!(
-            (e.to_str().unwrap(), p.to_str().unwrap()),
-            ("box.v2.exr", "box.v2.png")
+            paths(&dir.display().to_string()),
+            both(&dir.join("scene").display().to_string())
         );
     }
 }

@@ -476,3 +476,65 @@ fn version_names_the_plugin_interface_and_the_compiler() {
         assert!(stdout.contains(part), "{part} missing from:\n{stdout}");
     }
 }
+
+/// An image against itself (zero error everywhere) still gets its error
+/// picture, and the command ends.
+#[test]
+fn diff_of_an_image_with_itself_draws_its_error_picture() {
+    let tmp = scratch("diff-self");
+    let (image, picture) = (tmp.path().join("x.exr"), tmp.path().join("e.png"));
+    write_exr(&image, 4, 2, &[0.5, 1.0, 0.0, 2.0, 0.25, 0.5, 1.0, 3.0]);
+    let x = image.to_str().unwrap();
+    let out = lumis(&["diff", x, x, "--error-image", picture.to_str().unwrap()]);
+    assert!(
+        out.status.success() && picture.exists(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// `-o NAME.png` writes NAME.exr and NAME.png, `-o DIR/` the scene's name
+/// in DIR, and `--threads` past four per core is capped with a warning.
+#[test]
+fn output_names_and_thread_counts_do_what_users_expect() {
+    let tmp = scratch("outputs");
+    let dir = tmp.path();
+    let render = |output: &Path, threads: &str| {
+        lumis(&[
+            "render",
+            &scene("cornell-box.toml"),
+            "--spp",
+            "1",
+            "--threads",
+            threads,
+            "--set",
+            "film.resolution=[8, 8]",
+            "--output",
+            output.to_str().unwrap(),
+            "--quiet",
+        ])
+    };
+    let out = render(&dir.join("box.png"), "100000");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("--threads 100000 capped at"), "{stderr}");
+    assert!(dir.join("box.exr").exists() && dir.join("box.png").exists());
+    assert!(!dir.join("box.png.exr").exists());
+    let sub = dir.join("renders");
+    std::fs::create_dir(&sub).unwrap();
+    let out = render(&sub, "1");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let names: Vec<String> = std::fs::read_dir(&sub)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names.contains(&"cornell-box.exr".to_string())
+            && names.contains(&"cornell-box.png".to_string()),
+        "{names:?}"
+    );
+}

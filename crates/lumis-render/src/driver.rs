@@ -3,7 +3,6 @@
 
 use std::time::Instant;
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lumis_core::{
     Error, Integrator, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene, UVec2, Vec3,
 };
@@ -12,6 +11,7 @@ use rayon::prelude::*;
 
 use crate::camera::PerspectiveCamera;
 use crate::profile::{self, Stage};
+use crate::progress::Progress;
 
 /// Tile edge in pixels: small enough to balance load, large enough that
 /// per-tile overhead (sampler clone, progress update) does not show.
@@ -52,6 +52,20 @@ fn tiles(resolution: UVec2) -> Vec<Tile> {
         }
     }
     out
+}
+
+/// More worker threads than this per core only cost start-up time and
+/// memory: a request beyond it is capped.
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// The worker threads a render runs for `requested` (0: one per core),
+/// capped at [`MAX_THREADS_PER_CORE`] per core.
+pub fn worker_threads(requested: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match requested {
+        0 => cores,
+        n => n.min(MAX_THREADS_PER_CORE * cores),
+    }
 }
 
 /// The camera rays of a tile waiting for the integrator, one per lane.
@@ -180,29 +194,13 @@ pub fn render(
         ))
     })?;
     let tiles = tiles(resolution);
+    let threads = worker_threads(settings.threads);
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(settings.threads)
+        .num_threads(threads)
         .build()
-        .map_err(|e| {
-            Error::msg(format!(
-                "cannot start {} render threads: {e}",
-                settings.threads
-            ))
-        })?;
+        .map_err(|e| Error::msg(format!("cannot start {threads} render threads: {e}")))?;
 
-    let progress = if settings.progress {
-        let bar =
-            ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta}",
-            )
-            .expect("static template is valid"),
-        );
-        bar
-    } else {
-        ProgressBar::hidden()
-    };
+    let progress = Progress::new(settings.progress, tiles.len() as u64);
 
     let start = Instant::now();
     let rendered: Vec<(Vec<[f32; 3]>, RenderStats)> = pool.install(|| {
@@ -213,14 +211,14 @@ pub fn render(
                 |lanes, tile| {
                     let out =
                         render_tile(tile, camera, scene, integrator, lanes.as_mut(), settings);
-                    progress.inc(1);
+                    progress.tile_done();
                     out
                 },
             )
             .collect()
     });
     let seconds = start.elapsed().as_secs_f64();
-    progress.finish_and_clear();
+    progress.finish();
 
     let mut stats = RenderStats::default();
     for (tile, (pixels, tile_stats)) in tiles.iter().zip(rendered) {

@@ -4,6 +4,9 @@
 mod camera;
 mod driver;
 pub mod profile;
+mod progress;
 
 pub use camera::PerspectiveCamera;
-pub use driver::{render, RenderOutput, RenderSettings, TILE_SIZE};
+pub use driver::{
+    render, worker_threads, RenderOutput, RenderSettings, MAX_THREADS_PER_CORE, TILE_SIZE,
+};
