@@ -39,10 +39,25 @@ impl PerspectiveCamera {
                 "resolution must be positive, got {resolution}"
             )));
         }
-        let forward = (target - origin).normalize_or_zero();
-        if forward == Vec3::ZERO {
-            return Err(Error::msg("camera origin and target coincide"));
+        if !(origin.is_finite() && target.is_finite() && up.is_finite()) {
+            return Err(Error::msg(format!(
+                "camera origin {origin}, target {target} and up {up} must be finite"
+            )));
         }
+        let view = target - origin;
+        if view == Vec3::ZERO {
+            return Err(Error::msg(format!(
+                "camera origin and target coincide (both {origin} in f32)"
+            )));
+        }
+        if !view.is_finite() {
+            return Err(Error::msg(format!(
+                "camera origin {origin} and target {target} are too far apart for f32"
+            )));
+        }
+        // Scaled to its largest component first: the squared length of a
+        // distant target (1e30 away) would overflow f32.
+        let forward = (view / view.abs().max_element()).normalize();
         let right = forward.cross(up).normalize_or_zero();
         if right == Vec3::ZERO || !right.is_finite() {
             return Err(Error::msg(
@@ -116,5 +131,23 @@ mod tests {
             PerspectiveCamera::new(Vec3::ZERO, Vec3::ZERO, Vec3::Y, 45.0, UVec2::new(2, 2))
                 .is_err()
         );
+    }
+
+    /// A distant camera is a camera; only a difference that f32 cannot
+    /// hold, or none at all, is an error, and the message says which.
+    #[test]
+    fn camera_checks_account_for_precision() {
+        let at = |origin: Vec3, target: Vec3| {
+            PerspectiveCamera::new(origin, target, Vec3::Y, 45.0, UVec2::new(2, 2))
+        };
+        let far = at(Vec3::new(0.0, 0.0, 1e30), Vec3::ZERO).unwrap();
+        let d = far.generate_ray(UVec2::new(1, 1), Vec2::ZERO).d;
+        assert!((d - Vec3::NEG_Z).length() < 1e-6, "{d}");
+        let huge = at(Vec3::new(0.0, 0.0, 3e38), Vec3::new(0.0, 0.0, -3e38));
+        assert!(huge.err().unwrap().message.contains("too far apart"));
+        let same = at(Vec3::splat(1e8), Vec3::splat(1e8) + Vec3::X);
+        assert!(same.err().unwrap().message.contains("coincide"));
+        let nan = at(Vec3::NAN, Vec3::ZERO);
+        assert!(nan.err().unwrap().message.contains("finite"));
     }
 }
