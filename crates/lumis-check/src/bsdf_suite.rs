@@ -624,18 +624,36 @@ pub fn write_histogram_png(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::{BsdfSample, ParamSpec};
+    use lumis_core::{BsdfSample, ParamChoice, PluginParams};
+
+    #[derive(Clone, Copy, ParamChoice)]
+    enum Mode {
+        A,
+        B,
+    }
+
+    /// The sweeps read the declaration the derive writes.
+    #[derive(PluginParams)]
+    #[allow(dead_code)]
+    struct TestParams {
+        /// albedo
+        albedo: Rgb,
+        /// roughness
+        #[param(default = 0.5, range = (1e-4, 1.0))]
+        roughness: f32,
+        /// mode
+        #[param(default = A)]
+        mode: Mode,
+        /// two-sided
+        #[param(default = false)]
+        two_sided: bool,
+    }
 
     const SPEC: PluginSpec = PluginSpec {
         kind: PluginKind::Bsdf,
         name: "t",
         doc: "",
-        params: &[
-            ParamSpec::required("albedo", ParamType::Rgb, ""),
-            ParamSpec::with_default("roughness", ParamType::Float, "0.5", "").in_range(1e-4, 1.0),
-            ParamSpec::with_default("mode", ParamType::String, "\"a\"", "").one_of(&["a", "b"]),
-            ParamSpec::with_default("two_sided", ParamType::Bool, "false", ""),
-        ],
+        params: TestParams::SPECS,
     };
 
     #[test]

@@ -19,7 +19,7 @@ pub fn plugin_listing(registry: &Registry) -> String {
             for param in p.spec.params {
                 let default = match param.default {
                     ParamDefault::Required => "required".to_string(),
-                    ParamDefault::Value(v) => format!("default {v}"),
+                    ParamDefault::Value(value) => format!("default {value}"),
                     ParamDefault::Absent => "optional".to_string(),
                 };
                 let _ = writeln!(
@@ -105,7 +105,7 @@ fn kind_heading(kind: PluginKind) -> &'static str {
 fn default_cell(param: &ParamSpec) -> String {
     match param.default {
         ParamDefault::Required => "required".to_string(),
-        ParamDefault::Value(v) => format!("`{v}`"),
+        ParamDefault::Value(value) => format!("`{value}`"),
         ParamDefault::Absent => "optional".to_string(),
     }
 }

@@ -6,6 +6,9 @@
 //! [`Integrator`]) with the [`Scene`] they query, and the plugin machinery:
 //! the scene document model, [`Params`] and the [`Registry`].
 
+// The derives name `::lumis_core`, which this lets them do here too.
+extern crate self as lumis_core;
+
 pub mod bsdf;
 pub mod doc;
 pub mod error;
@@ -30,13 +33,17 @@ pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use light::{Light, LightKind, LightSample, LightShape};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;
-pub use params::{ParamSpec, ParamType, Params};
+pub use params::{ParamChoice, ParamSpec, ParamType, ParamValue, Params, PluginParams};
 pub use ray::Ray;
 pub use registry::{PluginKind, PluginSpec, Registry};
 pub use sampler::{ConcreteLanes, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;
+
+/// `#[derive(PluginParams)]` and `#[derive(ParamChoice)]`: a plugin's
+/// parameters declared once, as a struct (see [`PluginParams`](trait@PluginParams)).
+pub use lumis_derive::{ParamChoice, PluginParams};
 
 /// glam, re-exported so plugins use the exact same math types.
 pub use glam;

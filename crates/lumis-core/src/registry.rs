@@ -60,6 +60,8 @@ pub struct PluginSpec {
     pub kind: PluginKind,
     pub name: &'static str,
     pub doc: &'static str,
+    /// `SPECS` of the plugin's struct deriving
+    /// [`PluginParams`](crate::params::PluginParams), which its factory reads.
     pub params: &'static [ParamSpec],
 }
 

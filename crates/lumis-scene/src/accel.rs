@@ -3,7 +3,7 @@
 
 use lumis_core::doc::{Node, Table, Value};
 use lumis_core::params::FromParam;
-use lumis_core::{ParamSpec, ParamType, Params, Result};
+use lumis_core::{ParamSpec, ParamType, ParamValue, Params, Result};
 use lumis_embree::{BuildQuality, SceneOptions};
 
 use crate::as_table;
@@ -63,26 +63,26 @@ const ACCEL_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
         "quality",
         ParamType::String,
-        "\"medium\"",
+        ParamValue::Str("medium"),
         "Embree BVH build quality: \"low\" (fastest build, Morton), \"medium\" (binned SAH), \"high\" (SAH with spatial splits: slower build, faster rays)",
     )
     .one_of(&["low", "medium", "high"]),
     ParamSpec::with_default(
         "robust",
         ParamType::Bool,
-        "false",
+        ParamValue::Bool(false),
         "RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping through shared edges) at some cost in speed",
     ),
     ParamSpec::with_default(
         "compact",
         ParamType::String,
-        "\"auto\"",
+        ParamValue::Str("auto"),
         "true, false or \"auto\". RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed; \"auto\": from 250000 unique triangles on",
     ),
     ParamSpec::with_default(
         "packets",
         ParamType::Bool,
-        "false",
+        ParamValue::Bool(false),
         "the wavefront integrator traces camera rays as coherent Embree packets of 8 always; true: its bounce and shadow rays too, as packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray; off by default: slower on most of the bench suite",
     ),
 ];

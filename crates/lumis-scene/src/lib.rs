@@ -19,7 +19,7 @@ use lumis_core::doc::{self, Node, Table, Value};
 use lumis_core::registry::TableRef;
 use lumis_core::{
     Bsdf, Error, Integrator, Light, LightKind, LightSampler, LightShape, Location, ParamSpec,
-    ParamType, Params, Registry, Result, Sampler, UVec2, Vec3,
+    ParamType, ParamValue, Params, Registry, Result, Sampler, UVec2, Vec3,
 };
 use lumis_embree::{Device, PaddedBuffer, SceneBuilder, SceneOptions};
 use lumis_render::PerspectiveCamera;
@@ -81,7 +81,7 @@ pub(crate) struct Assembly<'r> {
 const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
     "load",
     ParamType::StringArray,
-    "[]",
+    ParamValue::Array(&[]),
     "plugin libraries to load, relative to the scene file",
 )];
 
@@ -89,7 +89,7 @@ const FILM_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
         "resolution",
         ParamType::UIntPair,
-        "[256, 256]",
+        ParamValue::Array(&[ParamValue::Int(256), ParamValue::Int(256)]),
         "image width and height in pixels",
     ),
     ParamSpec::optional(
@@ -107,7 +107,16 @@ const FILM_PARAMS: &[ParamSpec] = &[
 const CAMERA_PARAMS: &[ParamSpec] = &[
     ParamSpec::required("origin", ParamType::Vec3, "eye position"),
     ParamSpec::required("target", ParamType::Vec3, "point looked at"),
-    ParamSpec::with_default("up", ParamType::Vec3, "[0.0, 1.0, 0.0]", "up direction"),
+    ParamSpec::with_default(
+        "up",
+        ParamType::Vec3,
+        ParamValue::Array(&[
+            ParamValue::Float(0.0),
+            ParamValue::Float(1.0),
+            ParamValue::Float(0.0),
+        ]),
+        "up direction",
+    ),
     ParamSpec::required(
         "fov",
         ParamType::Float,

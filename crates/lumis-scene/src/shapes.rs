@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use lumis_core::doc::Table;
-use lumis_core::{Error, Location, ParamSpec, ParamType, Params, Result, Vec3};
+use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, Vec3};
 
 /// Geometry of one shape, before it goes to Embree.
 pub(crate) enum ShapeGeometry {
@@ -42,7 +42,7 @@ macro_rules! shape_params {
                 ParamType::Table,
                 "makes the shape an area light: { radiance = [r, g, b], two_sided = false }",
             ),
-            ParamSpec::with_default("flip_normals", ParamType::Bool, "false", "swap the front and back sides"),
+            ParamSpec::with_default("flip_normals", ParamType::Bool, ParamValue::Bool(false), "swap the front and back sides"),
         ]
     };
 }

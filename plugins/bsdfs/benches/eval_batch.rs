@@ -15,7 +15,9 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use lumis_bsdfs::microfacet::{Distribution, Microfacet};
-use lumis_bsdfs::{fresnel, Conductor, ConductorFresnel, Diffuse, DiffuseSampling, LobeSampling};
+use lumis_bsdfs::{
+    fresnel, Conductor, ConductorFresnel, Diffuse, DiffuseSampling, MicrofacetLobeSampling,
+};
 use lumis_core::{Bsdf, BsdfContext, BsdfSample, Rgb, Vec2, Vec3};
 
 const LANES: usize = 4096;
@@ -146,7 +148,7 @@ fn main() {
                 let bsdf = Conductor::new(
                     Microfacet::new(distribution, alpha, alpha),
                     fresnel,
-                    LobeSampling::parse("visible"),
+                    MicrofacetLobeSampling::Visible.into(),
                 );
                 compare(&format!("conductor {name} {alpha} {metal}"), &bsdf, &l);
             }

@@ -15,31 +15,54 @@
 use std::f32::consts::PI;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
+    PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 
 use crate::fresnel::reflect;
 use crate::lobe_sampling::LobeSampling;
-use crate::microfacet::half_vector;
+use crate::microfacet::{half_vector, NormalSampling};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "blinn",
     doc: "normalised Blinn-Phong microfacet BRDF with V-cavity masking; half-vector sampling; one-sided",
-    params: &[
-        ParamSpec::with_default("reflectance", ParamType::Rgb, "1.0", "scale R of the lobe, each channel in [0, 1]"),
-        ParamSpec::with_default("exponent", ParamType::Float, "100.0", "Blinn exponent n in [0, 1e6]; 0 is a uniform distribution of normals")
-            .in_range(0.0, 1e6),
-        ParamSpec::with_default(
-            "sampling",
-            ParamType::String,
-            "\"blinn\"",
-            "blinn: half vectors from cos^n (the model's own); cosine or uniform hemisphere, for comparison",
-        )
-        .one_of(&["blinn", "cosine", "uniform"]),
-    ],
+    params: BlinnParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct BlinnParams {
+    /// scale R of the lobe, each channel in [0, 1]
+    #[param(default = 1.0)]
+    pub reflectance: Rgb,
+    /// Blinn exponent n in [0, 1e6]; 0 is a uniform distribution of normals
+    #[param(default = 100.0, range = (0.0, 1e6))]
+    pub exponent: f32,
+    /// blinn: half vectors from cos^n (the model's own); cosine or uniform
+    /// hemisphere, for comparison
+    #[param(default = Blinn)]
+    pub sampling: BlinnSampling,
+}
+
+/// How `blinn` draws directions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum BlinnSampling {
+    /// Half vectors from `cos^n`, the model's own.
+    Blinn,
+    Cosine,
+    Uniform,
+}
+
+impl From<BlinnSampling> for LobeSampling {
+    fn from(sampling: BlinnSampling) -> Self {
+        match sampling {
+            // Blinn has one strategy of its own; `Model` carries it.
+            BlinnSampling::Blinn => LobeSampling::Model(NormalSampling::Visible),
+            BlinnSampling::Cosine => LobeSampling::Cosine,
+            BlinnSampling::Uniform => LobeSampling::Uniform,
+        }
+    }
+}
 
 #[derive(Debug, Clone)]
 pub struct Blinn {
@@ -58,18 +81,15 @@ impl Blinn {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let reflectance: Rgb = params.get("reflectance")?;
+        let p = BlinnParams::read(params)?;
+        let reflectance = p.reflectance;
         if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
             return Err(params.error(
-                "reflectance",
+                BlinnParams::KEYS.reflectance,
                 format!("each channel must be in [0, 1], got {reflectance:?}"),
             ));
         }
-        Ok(Self::new(
-            reflectance,
-            params.get_in_range("exponent")?,
-            LobeSampling::parse(&params.get_choice("sampling")?),
-        ))
+        Ok(Self::new(reflectance, p.exponent, p.sampling.into()))
     }
 
     /// `cos^n theta_h` of the unnormalised half vector `h`, as `exp(n/2
@@ -182,7 +202,7 @@ mod tests {
 
     #[test]
     fn huge_exponent_stays_finite_and_peaked() {
-        let b = Blinn::new(Rgb::WHITE, 1e6, LobeSampling::parse("blinn"));
+        let b = Blinn::new(Rgb::WHITE, 1e6, BlinnSampling::Blinn.into());
         let ctx = BsdfContext::default();
         let wo = Vec3::new(0.0, 0.6, 0.8);
         let mirror = Vec3::new(0.0, -0.6, 0.8);

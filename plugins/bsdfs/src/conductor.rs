@@ -10,17 +10,17 @@
 //! One-sided, like Mitsuba's: black from behind.
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
+    Rgb, Vec2, Vec3,
 };
 
 use lumis_sampling::real::{load, F32x8, Real, V3};
 
 use crate::fresnel;
-use crate::lobe_sampling::LobeSampling;
+use crate::lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
+use crate::metal_params::MetalParams;
 use crate::microfacet::{
-    half_vector, half_vector_lanes, Microfacet, NormalSampling, DISTRIBUTION_PARAM,
-    ROUGHNESS_PARAM, ROUGHNESS_V_PARAM,
+    half_vector, half_vector_lanes, Microfacet, MicrofacetParams, NormalSampling,
 };
 
 /// The SIMD lanes of the batched methods: eight, two SSE2 halves without
@@ -36,60 +36,31 @@ type Lanes = F32x8;
 const MAX_LANES: usize = 8;
 const _: () = assert!(Lanes::LANES <= MAX_LANES);
 
-const METAL_CHOICES: &[&str] = &["none", "Ag", "Al", "Au", "Cr", "Cu", "Fe", "Pt"];
-
-const MATERIAL_PARAM: ParamSpec = ParamSpec::with_default(
-    "material",
-    ParamType::String,
-    "\"none\"",
-    "named metal (complex IOR at 650/550/450 nm) or none: a perfect reflector, Fresnel = 1",
-)
-.one_of(METAL_CHOICES);
-const ETA_PARAM: ParamSpec = ParamSpec::optional(
-    "eta",
-    ParamType::Rgb,
-    "real part of the IOR per channel, with k; replaces material",
-);
-const K_PARAM: ParamSpec = ParamSpec::optional(
-    "k",
-    ParamType::Rgb,
-    "imaginary part (absorption) of the IOR per channel, with eta",
-);
-const SCALE_PARAM: ParamSpec = ParamSpec::with_default(
-    "specular_reflectance",
-    ParamType::Rgb,
-    "1.0",
-    "multiplies the Fresnel term (not physical; for artistic tints), each channel in [0, 1]",
-);
-
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "conductor",
     doc: "rough metal: Cook-Torrance with GGX or Beckmann normals, Smith masking, complex Fresnel; one-sided",
-    params: &[
-        DISTRIBUTION_PARAM,
-        ROUGHNESS_PARAM,
-        ROUGHNESS_V_PARAM,
-        MATERIAL_PARAM,
-        ETA_PARAM,
-        K_PARAM,
-        SCALE_PARAM,
-        ParamSpec::with_default(
-            "sampling",
-            ParamType::String,
-            "\"visible\"",
-            "visible normals (Heitz 2018 / Heitz-d'Eon 2014), full D cos, or cosine/uniform hemisphere for comparison",
-        )
-        .one_of(&["visible", "full", "cosine", "uniform"]),
-    ],
+    params: ConductorParams::SPECS,
 };
 
 pub const MIRROR_SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "mirror",
     doc: "smooth metal: delta reflection with the Fresnel term of the metal (conductor with roughness 0)",
-    params: &[MATERIAL_PARAM, ETA_PARAM, K_PARAM, SCALE_PARAM],
+    params: MetalParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct ConductorParams {
+    #[param(flatten)]
+    pub microfacet: MicrofacetParams,
+    #[param(flatten)]
+    pub metal: MetalParams,
+    /// visible normals (Heitz 2018 / Heitz-d'Eon 2014), full D cos, or
+    /// cosine/uniform hemisphere for comparison
+    #[param(default = Visible)]
+    pub sampling: MicrofacetLobeSampling,
+}
 
 /// The metal's reflectance at each angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,38 +91,6 @@ impl ConductorFresnel {
                 .map(|(eta, k)| fresnel::conductor_channel_lanes(cos_theta, eta, k)),
         }
     }
-
-    /// Reads `material`, `eta` and `k`.
-    fn from_params(params: &Params) -> Result<Self> {
-        let material = params.get_choice("material")?;
-        let eta: Option<Rgb> = params.get_opt("eta")?;
-        let k: Option<Rgb> = params.get_opt("k")?;
-        match (eta, k) {
-            (None, None) => Ok(match fresnel::metal(&material) {
-                Some(m) => Self::Complex {
-                    eta: m.eta.into(),
-                    k: m.k.into(),
-                },
-                None => Self::Perfect,
-            }),
-            (Some(eta), Some(k)) => {
-                if params.is_given("material") {
-                    return Err(
-                        params.error("material", "give either material or eta and k, not both")
-                    );
-                }
-                if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
-                    return Err(params.error(
-                        "eta",
-                        format!("eta must be > 0 and k >= 0 per channel, got eta {eta:?}, k {k:?}"),
-                    ));
-                }
-                Ok(Self::Complex { eta, k })
-            }
-            (Some(_), None) => Err(params.error("eta", "needs k too (the absorption)")),
-            (None, Some(_)) => Err(params.error("k", "needs eta too (the real part)")),
-        }
-    }
 }
 
 #[derive(Debug, Clone)]
@@ -161,17 +100,6 @@ pub struct Conductor {
     fresnel: ConductorFresnel,
     scale: Rgb,
     sampling: LobeSampling,
-}
-
-fn scale_from_params(params: &Params) -> Result<Rgb> {
-    let scale: Rgb = params.get("specular_reflectance")?;
-    if !(scale.min_component() >= 0.0 && scale.max_component() <= 1.0) {
-        return Err(params.error(
-            "specular_reflectance",
-            format!("each channel must be in [0, 1], got {scale:?}"),
-        ));
-    }
-    Ok(scale)
 }
 
 impl Conductor {
@@ -198,19 +126,19 @@ impl Conductor {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let microfacet = Microfacet::from_params(params)?;
-        let fresnel = ConductorFresnel::from_params(params)?;
-        let sampling = LobeSampling::parse(&params.get_choice("sampling")?);
+        let p = ConductorParams::read(params)?;
+        let fresnel = p.metal.fresnel(params)?;
         Ok(Self {
-            scale: scale_from_params(params)?,
-            ..Self::new(microfacet, fresnel, sampling)
+            scale: p.metal.scale(params)?,
+            ..Self::new(p.microfacet.microfacet(), fresnel, p.sampling.into())
         })
     }
 
     pub fn mirror_from_params(params: &Params) -> Result<Self> {
+        let metal = MetalParams::read(params)?;
         Ok(Self {
-            scale: scale_from_params(params)?,
-            ..Self::mirror(ConductorFresnel::from_params(params)?)
+            scale: metal.scale(params)?,
+            ..Self::mirror(metal.fresnel(params)?)
         })
     }
 
@@ -510,7 +438,7 @@ mod tests {
         let c = Conductor::new(
             Microfacet::new(Distribution::Ggx, 1e-4, 1e-4),
             ConductorFresnel::Perfect,
-            LobeSampling::parse("visible"),
+            MicrofacetLobeSampling::Visible.into(),
         );
         assert!(c.flags().is_specular());
         let wo = Vec3::new(0.6, 0.0, 0.8);
@@ -567,17 +495,17 @@ mod tests {
                             eta: Rgb::new(0.2, 0.9, 1.1),
                             k: Rgb::new(3.9, 2.4, 2.2),
                         },
-                        "visible",
+                        MicrofacetLobeSampling::Visible,
                     ),
-                    (ConductorFresnel::Perfect, "visible"),
-                    (ConductorFresnel::Perfect, "full"),
-                    (ConductorFresnel::Perfect, "cosine"),
-                    (ConductorFresnel::Perfect, "uniform"),
+                    (ConductorFresnel::Perfect, MicrofacetLobeSampling::Visible),
+                    (ConductorFresnel::Perfect, MicrofacetLobeSampling::Full),
+                    (ConductorFresnel::Perfect, MicrofacetLobeSampling::Cosine),
+                    (ConductorFresnel::Perfect, MicrofacetLobeSampling::Uniform),
                 ] {
                     all.push(Conductor::new(
                         Microfacet::new(distribution, ax, ay),
                         fresnel,
-                        LobeSampling::parse(sampling),
+                        sampling.into(),
                     ));
                 }
             }
@@ -667,11 +595,5 @@ mod tests {
             }
             assert!(some > n / 4, "{c:?}: too few samples to compare ({some})");
         }
-    }
-
-    #[test]
-    fn metal_names_are_the_choices() {
-        let names: Vec<&str> = fresnel::METALS.iter().map(|m| m.name).collect();
-        assert_eq!(&METAL_CHOICES[1..], names.as_slice());
     }
 }

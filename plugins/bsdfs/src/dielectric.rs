@@ -12,14 +12,13 @@
 //! `eta'^2`; importance is not (Veach 1997, section 5.2). `eta'` is the
 //! relative index along the path: `eta` entering, `1/eta` leaving.
 
-use lumis_core::params::ParamDefault;
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, TransportMode, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
+    Rgb, TransportMode, Vec2, Vec3,
 };
 
 use crate::fresnel::{self, reflect, refract};
-use crate::microfacet::{Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_PARAM, ROUGHNESS_V_PARAM};
+use crate::microfacet::{Microfacet, MicrofacetParams, NormalSampling};
 
 /// Relative indices closer to 1 than this are index-matched: reflection
 /// is below 3e-7 and the rough transmission lobe narrower than 1e-3 rad,
@@ -27,51 +26,27 @@ use crate::microfacet::{Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_PARAM, ROUGHNE
 /// by the vanishing generalized half vector).
 pub const INDEX_MATCHED: f32 = 1e-3;
 
-pub const INT_IOR_PARAM: ParamSpec = ParamSpec::with_default(
-    "int_ior",
-    ParamType::Float,
-    "1.5",
-    "index of refraction inside (the side opposite the normal); 1.5 is glass",
-)
-.in_range(1.0, 5.0);
-pub const EXT_IOR_PARAM: ParamSpec = ParamSpec::with_default(
-    "ext_ior",
-    ParamType::Float,
-    "1.0",
-    "index of refraction outside (the side the normal points to)",
-)
-.in_range(1.0, 5.0);
-/// Glass and coats are smooth unless asked otherwise.
-pub const SMOOTH_ROUGHNESS_PARAM: ParamSpec = ParamSpec {
-    default: ParamDefault::Value("0.0"),
-    ..ROUGHNESS_PARAM
-};
-
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "dielectric",
     doc: "glass: Fresnel reflection and refraction, smooth (delta) or rough (Walter et al. 2007)",
-    params: &[
-        INT_IOR_PARAM,
-        EXT_IOR_PARAM,
-        DISTRIBUTION_PARAM,
-        SMOOTH_ROUGHNESS_PARAM,
-        ROUGHNESS_V_PARAM,
-        ParamSpec::with_default(
-            "sampling",
-            ParamType::String,
-            "\"visible\"",
-            "microfacet normals: visible (Heitz 2018 / Heitz-d'Eon 2014) or full D cos",
-        )
-        .one_of(&["visible", "full"]),
-    ],
+    params: DielectricParams::SPECS,
 };
 
-/// `int_ior / ext_ior`, validated.
-pub fn relative_ior(params: &Params) -> Result<f32> {
-    let int_ior = params.get_in_range("int_ior")?;
-    let ext_ior = params.get_in_range("ext_ior")?;
-    Ok(int_ior / ext_ior)
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct DielectricParams {
+    /// index of refraction inside (the side opposite the normal); 1.5 is glass
+    #[param(default = 1.5, range = (1.0, 5.0))]
+    pub int_ior: f32,
+    /// index of refraction outside (the side the normal points to)
+    #[param(default = 1.0, range = (1.0, 5.0))]
+    pub ext_ior: f32,
+    /// Glass is smooth unless asked otherwise.
+    #[param(flatten, default(roughness = 0.0))]
+    pub microfacet: MicrofacetParams,
+    /// microfacet normals: visible (Heitz 2018 / Heitz-d'Eon 2014) or full D cos
+    #[param(default = Visible)]
+    pub sampling: NormalSampling,
 }
 
 /// The generalized half vector of a pair of directions and its cosines.
@@ -103,13 +78,9 @@ impl Dielectric {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let eta = relative_ior(params)?;
-        let sampling = crate::lobe_sampling::LobeSampling::parse(&params.get_choice("sampling")?);
-        let mut microfacet = Microfacet::from_params(params)?;
-        if let crate::lobe_sampling::LobeSampling::Model(s) = sampling {
-            microfacet = microfacet.with_sampling(s);
-        }
-        Ok(Self::new(eta, microfacet))
+        let p = DielectricParams::read(params)?;
+        let microfacet = p.microfacet.microfacet().with_sampling(p.sampling);
+        Ok(Self::new(p.int_ior / p.ext_ior, microfacet))
     }
 
     fn sample_smooth(&self, ctx: &BsdfContext, wo: Vec3, u1: f32) -> Option<BsdfSample> {

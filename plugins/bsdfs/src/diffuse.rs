@@ -3,8 +3,8 @@
 use std::f32::consts::FRAC_1_PI;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
+    PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -12,25 +12,24 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "diffuse",
     doc: "Lambertian reflection f = R/pi, one-sided unless two_sided",
-    params: &[
-        ParamSpec::required("reflectance", ParamType::Rgb, "albedo R in linear RGB, each channel in [0, 1]"),
-        ParamSpec::with_default(
-            "two_sided",
-            ParamType::Bool,
-            "false",
-            "reflect on both sides (one-sided surfaces are black from behind, like Mitsuba's)",
-        ),
-        ParamSpec::with_default(
-            "sampling",
-            ParamType::String,
-            "\"cosine\"",
-            "\"cosine\" (Malley: pdf cos/pi, zero variance for f cos) or \"uniform\" (pdf 1/(2 pi), for comparison)",
-        )
-        .one_of(&["cosine", "uniform"]),
-    ],
+    params: DiffuseParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct DiffuseParams {
+    /// albedo R in linear RGB, each channel in [0, 1]
+    pub reflectance: Rgb,
+    /// reflect on both sides (one-sided surfaces are black from behind,
+    /// like Mitsuba's)
+    #[param(default = false)]
+    pub two_sided: bool,
+    /// "cosine" (Malley: pdf cos/pi, zero variance for f cos) or "uniform"
+    /// (pdf 1/(2 pi), for comparison)
+    #[param(default = Cosine)]
+    pub sampling: DiffuseSampling,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum DiffuseSampling {
     Cosine,
     Uniform,
@@ -53,20 +52,17 @@ impl Diffuse {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let reflectance: Rgb = params.get("reflectance")?;
+        let p = DiffuseParams::read(params)?;
+        let reflectance = p.reflectance;
         if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
             return Err(params.error(
-                "reflectance",
+                DiffuseParams::KEYS.reflectance,
                 format!(
                     "each channel must be in [0, 1] (energy conservation), got {reflectance:?}"
                 ),
             ));
         }
-        let sampling = match params.get_choice("sampling")?.as_str() {
-            "uniform" => DiffuseSampling::Uniform,
-            _ => DiffuseSampling::Cosine,
-        };
-        Ok(Self::new(reflectance, params.get("two_sided")?, sampling))
+        Ok(Self::new(reflectance, p.two_sided, p.sampling))
     }
 
     /// Maps `(wo, wi)` into the upper hemisphere if this side reflects;

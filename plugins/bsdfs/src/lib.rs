@@ -8,15 +8,17 @@ mod dielectric;
 mod diffuse;
 pub mod fresnel;
 mod lobe_sampling;
+mod metal_params;
 pub mod microfacet;
 mod plastic;
 
-pub use blinn::Blinn;
-pub use conductor::{Conductor, ConductorFresnel};
-pub use dielectric::Dielectric;
-pub use diffuse::{Diffuse, DiffuseSampling};
-pub use lobe_sampling::LobeSampling;
-pub use plastic::Plastic;
+pub use blinn::{Blinn, BlinnParams, BlinnSampling};
+pub use conductor::{Conductor, ConductorFresnel, ConductorParams};
+pub use dielectric::{Dielectric, DielectricParams};
+pub use diffuse::{Diffuse, DiffuseParams, DiffuseSampling};
+pub use lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
+pub use metal_params::{MetalName, MetalParams};
+pub use plastic::{Plastic, PlasticParams};
 
 use std::sync::Arc;
 

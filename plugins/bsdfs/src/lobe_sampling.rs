@@ -2,7 +2,7 @@
 //! that a scene can measure what importance sampling buys (`sampling =
 //! "cosine"` or `"uniform"` on the same material).
 
-use lumis_core::{Vec2, Vec3};
+use lumis_core::{ParamChoice, Vec2, Vec3};
 use lumis_sampling::warp;
 
 use crate::microfacet::NormalSampling;
@@ -18,18 +18,27 @@ pub enum LobeSampling {
     Uniform,
 }
 
-impl LobeSampling {
-    /// `"visible"`, `"full"`, `"cosine"` or `"uniform"`; `model` names the
-    /// model's own strategy for BSDFs with only one (e.g. `"blinn"`).
-    pub fn parse(choice: &str) -> Self {
-        match choice {
-            "cosine" => Self::Cosine,
-            "uniform" => Self::Uniform,
-            "full" => Self::Model(NormalSampling::Full),
-            _ => Self::Model(NormalSampling::Visible),
+/// The `sampling` choice of a BSDF whose lobe samples microfacet normals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum MicrofacetLobeSampling {
+    Visible,
+    Full,
+    Cosine,
+    Uniform,
+}
+
+impl From<MicrofacetLobeSampling> for LobeSampling {
+    fn from(sampling: MicrofacetLobeSampling) -> Self {
+        match sampling {
+            MicrofacetLobeSampling::Visible => Self::Model(NormalSampling::Visible),
+            MicrofacetLobeSampling::Full => Self::Model(NormalSampling::Full),
+            MicrofacetLobeSampling::Cosine => Self::Cosine,
+            MicrofacetLobeSampling::Uniform => Self::Uniform,
         }
     }
+}
 
+impl LobeSampling {
     /// For the two baselines: a direction in the upper hemisphere, or
     /// `None` on the horizon (where reflection is zero).
     #[inline]

@@ -11,7 +11,7 @@
 use std::f32::consts::PI;
 use std::ops::{Add, Div, Mul};
 
-use lumis_core::{ParamSpec, ParamType, Params, Result, Vec2, Vec3};
+use lumis_core::{ParamChoice, PluginParams, Vec2, Vec3};
 use lumis_sampling::real::{Real, V3};
 use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
 use wide::f64x4;
@@ -23,16 +23,16 @@ use wide::f64x4;
 pub const SMOOTH_THRESHOLD: f32 = 1e-3;
 
 /// Which normal distribution.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Distribution {
-    /// Beckmann-Spizzichino: Gaussian slopes (Walter et al. 2007, eq. 25).
-    Beckmann,
     /// Trowbridge-Reitz, a.k.a. GGX: longer tails (Walter et al. 2007, eq. 33).
     Ggx,
+    /// Beckmann-Spizzichino: Gaussian slopes (Walter et al. 2007, eq. 25).
+    Beckmann,
 }
 
 /// How microfacet normals are drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum NormalSampling {
     /// The normals visible from `wo`, `G1(wo) D(m) <wo, m> / cos theta_o`
     /// (Heitz and d'Eon 2014): no sample is wasted on back-facing facets.
@@ -42,29 +42,29 @@ pub enum NormalSampling {
     Full,
 }
 
-/// The parameters every microfacet BSDF shares, for its `ParamSpec` list.
-pub const DISTRIBUTION_PARAM: ParamSpec = ParamSpec::with_default(
-    "distribution",
-    ParamType::String,
-    "\"ggx\"",
-    "microfacet normal distribution: ggx (Trowbridge-Reitz) or beckmann",
-)
-.one_of(&["ggx", "beckmann"]);
+/// The parameters every microfacet BSDF shares (flattened into its own).
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct MicrofacetParams {
+    /// microfacet normal distribution: ggx (Trowbridge-Reitz) or beckmann
+    #[param(default = Ggx)]
+    pub distribution: Distribution,
+    /// alpha, the RMS slope of the microfacets (Beckmann) or the GGX width;
+    /// below 1e-3 the lobe is a delta
+    #[param(default = 0.1, range = (0.0, 1.0))]
+    pub roughness: f32,
+    /// alpha along the surface's second tangent (anisotropy); default:
+    /// roughness; each axis is at least 1e-3 once the other is
+    #[param(range = (0.0, 1.0))]
+    pub roughness_v: Option<f32>,
+}
 
-pub const ROUGHNESS_PARAM: ParamSpec = ParamSpec::with_default(
-    "roughness",
-    ParamType::Float,
-    "0.1",
-    "alpha, the RMS slope of the microfacets (Beckmann) or the GGX width; below 1e-3 the lobe is a delta",
-)
-.in_range(0.0, 1.0);
-
-pub const ROUGHNESS_V_PARAM: ParamSpec = ParamSpec::optional(
-    "roughness_v",
-    ParamType::Float,
-    "alpha along the surface's second tangent (anisotropy); default: roughness; each axis is at least 1e-3 once the other is",
-)
-.in_range(0.0, 1.0);
+impl MicrofacetParams {
+    /// The distribution they describe, sampling visible normals.
+    pub fn microfacet(&self) -> Microfacet {
+        let alpha_y = self.roughness_v.unwrap_or(self.roughness);
+        Microfacet::new(self.distribution, self.roughness, alpha_y)
+    }
+}
 
 /// The half vector `h` of unit `wo`, `wi` and `<wo, h> = <wi, h> = |wo +
 /// wi| / 2`; `None` if they are opposite.
@@ -207,20 +207,6 @@ impl Microfacet {
 
     pub fn with_sampling(self, sampling: NormalSampling) -> Self {
         Self { sampling, ..self }
-    }
-
-    /// Reads `distribution`, `roughness` and `roughness_v`.
-    pub fn from_params(params: &Params) -> Result<Self> {
-        let distribution = match params.get_choice("distribution")?.as_str() {
-            "beckmann" => Distribution::Beckmann,
-            _ => Distribution::Ggx,
-        };
-        let alpha_x = params.get_in_range("roughness")?;
-        let alpha_y = match params.get_opt::<f32>("roughness_v")? {
-            Some(_) => params.get_in_range("roughness_v")?,
-            None => alpha_x,
-        };
-        Ok(Self::new(distribution, alpha_x, alpha_y))
     }
 
     /// Whether the lobe is too narrow to be anything but a delta.

@@ -25,57 +25,43 @@
 use std::f32::consts::FRAC_1_PI;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
+    Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
-use crate::dielectric::{relative_ior, SMOOTH_ROUGHNESS_PARAM};
 use crate::fresnel::{self, reflect};
-use crate::microfacet::{half_vector, Microfacet, DISTRIBUTION_PARAM, ROUGHNESS_V_PARAM};
+use crate::microfacet::{half_vector, Microfacet, MicrofacetParams};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "plastic",
     doc: "diffuse base under a smooth or rough dielectric coat; lobe choice by albedo; one-sided",
-    params: &[
-        ParamSpec::with_default(
-            "diffuse_reflectance",
-            ParamType::Rgb,
-            "0.5",
-            "albedo rho of the base, each channel in [0, 1]",
-        ),
-        ParamSpec::with_default(
-            "specular_reflectance",
-            ParamType::Rgb,
-            "1.0",
-            "scale of the coat's reflection (1 is physical), in [0, 1]",
-        ),
-        ParamSpec::with_default(
-            "int_ior",
-            ParamType::Float,
-            "1.49",
-            "index of refraction of the coat (polypropylene 1.49)",
-        )
-        .in_range(1.0, 5.0),
-        ParamSpec::with_default(
-            "ext_ior",
-            ParamType::Float,
-            "1.0",
-            "index of refraction outside",
-        )
-        .in_range(1.0, 5.0),
-        DISTRIBUTION_PARAM,
-        SMOOTH_ROUGHNESS_PARAM,
-        ROUGHNESS_V_PARAM,
-        ParamSpec::with_default(
-            "nonlinear",
-            ParamType::Bool,
-            "false",
-            "account for the colour shift of internal scattering (see the module docs)",
-        ),
-    ],
+    params: PlasticParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PlasticParams {
+    /// albedo rho of the base, each channel in [0, 1]
+    #[param(default = 0.5)]
+    pub diffuse_reflectance: Rgb,
+    /// scale of the coat's reflection (1 is physical), in [0, 1]
+    #[param(default = 1.0)]
+    pub specular_reflectance: Rgb,
+    /// index of refraction of the coat (polypropylene 1.49)
+    #[param(default = 1.49, range = (1.0, 5.0))]
+    pub int_ior: f32,
+    /// index of refraction outside
+    #[param(default = 1.0, range = (1.0, 5.0))]
+    pub ext_ior: f32,
+    /// The coat is smooth unless asked otherwise.
+    #[param(flatten, default(roughness = 0.0))]
+    pub coat: MicrofacetParams,
+    /// account for the colour shift of internal scattering (see the module
+    /// docs)
+    #[param(default = false)]
+    pub nonlinear: bool,
+}
 
 /// The base as one hit sees it: its albedo, constant or textured.
 #[derive(Debug, Clone, Copy)]
@@ -120,26 +106,22 @@ impl Plastic {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let diffuse: Rgb = params.get("diffuse_reflectance")?;
-        let specular: Rgb = params.get("specular_reflectance")?;
-        for (name, v) in [
-            ("diffuse_reflectance", diffuse),
-            ("specular_reflectance", specular),
+        let p = PlasticParams::read(params)?;
+        let keys = PlasticParams::KEYS;
+        for (key, v) in [
+            (keys.diffuse_reflectance, p.diffuse_reflectance),
+            (keys.specular_reflectance, p.specular_reflectance),
         ] {
             if !(v.min_component() >= 0.0 && v.max_component() <= 1.0) {
-                return Err(
-                    params.error(name, format!("each channel must be in [0, 1], got {v:?}"))
-                );
+                return Err(params.error(key, format!("each channel must be in [0, 1], got {v:?}")));
             }
         }
-        let eta = relative_ior(params)?;
-        let coat = Microfacet::from_params(params)?;
         Ok(Self::new(
-            diffuse,
-            specular,
-            eta,
-            coat,
-            params.get("nonlinear")?,
+            p.diffuse_reflectance,
+            p.specular_reflectance,
+            p.int_ior / p.ext_ior,
+            p.coat.microfacet(),
+            p.nonlinear,
         ))
     }
 

@@ -17,7 +17,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use std::sync::Arc;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, ParamSpec, ParamType, Params, PluginKind,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
@@ -26,18 +26,31 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "phong",
     doc: "modified Phong (Lafortune-Willems 1994): diffuse + normalized cos^n lobe, lobe-mixture sampling; one-sided",
-    params: &[
-        ParamSpec::with_default("diffuse", ParamType::Rgb, "0.5", "diffuse albedo rho_d"),
-        ParamSpec::with_default("specular", ParamType::Rgb, "0.2", "glossy albedo rho_s; rho_d + rho_s <= 1 per channel"),
-        ParamSpec::with_default("exponent", ParamType::Float, "30.0", "Phong exponent n in [0, 1e4]; larger = sharper")
-            .in_range(0.0, 1e4),
-        ParamSpec::with_default("sampling", ParamType::String, "\"lobes\"", "lobes: each lobe's own shape (the model's sampling); cosine or uniform hemisphere, for comparison")
-            .one_of(&["lobes", "cosine", "uniform"]),
-    ],
+    params: PhongParams::SPECS,
 };
 
-/// How `sample_f` draws directions; `pdf` always matches it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The parameters, declared once: each field is a scene key, its `///`
+/// comment the description `lumis plugins` shows.
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PhongParams {
+    /// diffuse albedo rho_d
+    #[param(default = 0.5)]
+    pub diffuse: Rgb,
+    /// glossy albedo rho_s; rho_d + rho_s <= 1 per channel
+    #[param(default = 0.2)]
+    pub specular: Rgb,
+    /// Phong exponent n in [0, 1e4]; larger = sharper
+    #[param(default = 30.0, range = (0.0, 1e4))]
+    pub exponent: f32,
+    /// lobes: each lobe's own shape (the model's sampling); cosine or
+    /// uniform hemisphere, for comparison
+    #[param(default = Lobes)]
+    pub sampling: Sampling,
+}
+
+/// How `sample_f` draws directions; `pdf` always matches it. The scene
+/// names the variants in lower case: `sampling = "cosine"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Sampling {
     /// Pick a lobe by albedo, then sample its own shape.
     Lobes,
@@ -83,27 +96,23 @@ impl Phong {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let diffuse: Rgb = params.get("diffuse")?;
-        let specular: Rgb = params.get("specular")?;
-        if diffuse.min_component() < 0.0 || specular.min_component() < 0.0 {
-            return Err(params.error("specular", "albedos must be non-negative"));
+        // Types, ranges and choices are checked by `read`; what only this
+        // model can judge is checked here, the error located at the value.
+        let p = PhongParams::read(params)?;
+        let specular = PhongParams::KEYS.specular;
+        if p.diffuse.min_component() < 0.0 || p.specular.min_component() < 0.0 {
+            return Err(params.error(specular, "albedos must be non-negative"));
         }
-        if (diffuse + specular).max_component() > 1.0 {
+        if (p.diffuse + p.specular).max_component() > 1.0 {
             return Err(params.error(
-                "specular",
+                specular,
                 format!(
                     "diffuse + specular must be <= 1 per channel to conserve energy, got {:?}",
-                    diffuse + specular
+                    p.diffuse + p.specular
                 ),
             ));
         }
-        let exponent = params.get_in_range("exponent")?;
-        let sampling = match params.get_choice("sampling")?.as_str() {
-            "cosine" => Sampling::Cosine,
-            "uniform" => Sampling::Uniform,
-            _ => Sampling::Lobes,
-        };
-        Ok(Self::new(diffuse, specular, exponent).with_sampling(sampling))
+        Ok(Self::new(p.diffuse, p.specular, p.exponent).with_sampling(p.sampling))
     }
 
     #[inline]

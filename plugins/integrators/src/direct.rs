@@ -6,21 +6,19 @@
 //! between the strategies.
 
 use lumis_core::{
-    Integrator, ParamSpec, Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler,
-    Scene,
+    Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
+    Sampler, Scene,
 };
 
-use crate::estimator::{self, BsdfRay, Estimator, SceneView, Vertex, VertexPlan};
+use crate::estimator::{BsdfRay, Estimator, EstimatorParams, SceneView, Vertex, VertexPlan};
 use crate::specialize::Trace;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "direct",
     doc: "direct lighting at the first hit: n_f BSDF and n_g light samples combined by MIS (or one strategy alone); specular surfaces pass one BSDF sample on to the emitter it hits",
-    params: &PARAMS,
+    params: EstimatorParams::SPECS,
 };
-
-const PARAMS: [ParamSpec; 6] = estimator::PARAMS;
 
 #[derive(Debug, Clone)]
 pub struct DirectIntegrator {

@@ -26,51 +26,45 @@
 use lumis_core::bsdf::{BsdfContext, BsdfSample};
 use lumis_core::ray::RayOrigins;
 use lumis_core::{
-    Light, LightIndex, LightKind, LightSample, LightSampleContext, LightSampler, ParamSpec,
-    ParamType, Params, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene,
+    Light, LightIndex, LightKind, LightSample, LightSampleContext, LightSampler, ParamChoice,
+    Params, PluginParams, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene,
     SurfaceInteraction, Vec2, Vec3,
 };
 use lumis_sampling::{balance_heuristic, power_heuristic};
 
 /// The parameters every integrator built on [`Estimator`] accepts.
-pub const PARAMS: [ParamSpec; 6] = [
-    ParamSpec::with_default(
-        "strategy",
-        ParamType::String,
-        "\"mis\"",
-        "\"bsdf\" (emission found by BSDF sampling only), \"light\" (next-event estimation only) or \"mis\" (both, weighted)",
-    )
-    .one_of(&["bsdf", "light", "mis"]),
-    ParamSpec::with_default(
-        "heuristic",
-        ParamType::String,
-        "\"power\"",
-        "MIS weights with strategy = \"mis\": \"balance\" or \"power\"",
-    )
-    .one_of(&["balance", "power"]),
-    ParamSpec::with_default("beta", ParamType::Float, "2.0", "exponent of the power heuristic"),
-    ParamSpec::with_default(
-        "n_f",
-        ParamType::Int,
-        "1",
-        "BSDF samples per vertex for direct lighting (the first also continues the path)",
-    )
-    .in_range(1.0, 64.0),
-    ParamSpec::with_default(
-        "n_g",
-        ParamType::Int,
-        "1",
-        "light samples per vertex (next-event estimation)",
-    )
-    .in_range(1.0, 64.0),
-    ParamSpec::with_default(
-        "estimator",
-        ParamType::String,
-        "\"multi-sample\"",
-        "with strategy = \"mis\": \"multi-sample\" takes n_f BSDF and n_g light samples per vertex (Veach eq. 9.3); \"one-sample\" takes one, from the BSDF or the lights with probability n_f : n_g (Veach section 9.2.4)",
-    )
-    .one_of(&["multi-sample", "one-sample"]),
-];
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct EstimatorParams {
+    /// "bsdf" (emission found by BSDF sampling only), "light" (next-event
+    /// estimation only) or "mis" (both, weighted)
+    #[param(default = Mis)]
+    pub strategy: Strategy,
+    /// MIS weights with strategy = "mis": "balance" or "power"
+    #[param(default = Power)]
+    pub heuristic: HeuristicName,
+    /// exponent of the power heuristic
+    #[param(default = 2.0)]
+    pub beta: f32,
+    /// BSDF samples per vertex for direct lighting (the first also continues
+    /// the path)
+    #[param(default = 1, range = (1, 64))]
+    pub n_f: u32,
+    /// light samples per vertex (next-event estimation)
+    #[param(default = 1, range = (1, 64))]
+    pub n_g: u32,
+    /// with strategy = "mis": "multi-sample" takes n_f BSDF and n_g light
+    /// samples per vertex (Veach eq. 9.3); "one-sample" takes one, from the
+    /// BSDF or the lights with probability n_f : n_g (Veach section 9.2.4)
+    #[param(default = MultiSample)]
+    pub estimator: MisEstimator,
+}
+
+/// The `heuristic` choice; [`Heuristic`] adds the power's exponent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum HeuristicName {
+    Balance,
+    Power,
+}
 
 /// The scene as the estimators use it: traversal plus its lights. The
 /// light list, the light sampler and the infinite lights are read from the
@@ -114,7 +108,7 @@ impl<'a, S: Scene + ?Sized> SceneView<'a, S> {
 }
 
 /// Which estimator finds emission.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Strategy {
     Bsdf,
     Light,
@@ -141,7 +135,7 @@ impl Heuristic {
 }
 
 /// Veach's two ways of combining the strategies.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum MisEstimator {
     MultiSample,
     OneSample,
@@ -351,31 +345,38 @@ impl Estimator {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let strategy = match params.get_choice("strategy")?.as_str() {
-            "bsdf" => Strategy::Bsdf,
-            "light" => Strategy::Light,
-            _ => Strategy::Mis,
-        };
+        Self::from_read(&EstimatorParams::read(params)?, params)
+    }
+
+    /// The estimator `p` describes; `params` locates errors.
+    pub fn from_read(p: &EstimatorParams, params: &Params) -> Result<Self> {
+        let keys = EstimatorParams::KEYS;
         // Heuristic and beta are validated whatever the strategy, so that
         // `--set integrator.strategy=bsdf` works on a scene that sets them;
         // they only change the estimate when strategy = "mis".
-        let heuristic = match params.get_choice("heuristic")?.as_str() {
-            "balance" => Heuristic::Balance,
-            _ => Heuristic::Power {
-                beta: params.get_positive("beta")?,
-            },
-        };
-        if params.is_given("beta") && heuristic == Heuristic::Balance {
-            return Err(params.error("beta", "only applies to heuristic = \"power\""));
-        }
-        let n_f = params.get_in_range("n_f")?;
-        let n_g = params.get_in_range("n_g")?;
-        let mode = match params.get_choice("estimator")?.as_str() {
-            "one-sample" => MisEstimator::OneSample,
-            _ => MisEstimator::MultiSample,
+        let heuristic = match p.heuristic {
+            HeuristicName::Balance => {
+                if params.is_given(keys.beta) {
+                    return Err(params.error(keys.beta, "only applies to heuristic = \"power\""));
+                }
+                Heuristic::Balance
+            }
+            HeuristicName::Power => {
+                if !(p.beta > 0.0 && p.beta.is_finite()) {
+                    return Err(params.error(
+                        keys.beta,
+                        format!("must be a positive finite number, got {}", p.beta),
+                    ));
+                }
+                Heuristic::Power { beta: p.beta }
+            }
         };
         Ok(Self::with_counts(
-            strategy, heuristic, n_f as u32, n_g as u32, mode,
+            p.strategy,
+            heuristic,
+            p.n_f,
+            p.n_g,
+            p.estimator,
         ))
     }
 

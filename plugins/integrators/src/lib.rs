@@ -9,10 +9,13 @@ mod specialize;
 mod wavefront;
 
 pub use direct::DirectIntegrator;
-pub use estimator::{Estimator, Heuristic, MisEstimator, SceneView, Strategy, VertexPlan};
-pub use path::PathIntegrator;
+pub use estimator::{
+    Estimator, EstimatorParams, Heuristic, HeuristicName, MisEstimator, SceneView, Strategy,
+    VertexPlan,
+};
+pub use path::{PathIntegrator, PathParams};
 pub use specialize::{Specialized, Trace};
-pub use wavefront::WavefrontIntegrator;
+pub use wavefront::{WavefrontIntegrator, WavefrontParams};
 
 use lumis_core::{Registry, Result, Scene};
 

@@ -14,12 +14,12 @@
 //! worked out once per vertex.
 
 use lumis_core::{
-    Integrator, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Ray, RenderStats, Result,
-    Rgb, Sampler, Scene,
+    Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
+    Sampler, Scene,
 };
 
 use crate::estimator::{
-    self, bsdf_context, Estimator, Heuristic, SceneView, Strategy, Vertex, VertexPlan,
+    bsdf_context, Estimator, EstimatorParams, Heuristic, SceneView, Strategy, Vertex, VertexPlan,
 };
 use crate::path_state::PathState;
 use crate::specialize::Trace;
@@ -28,30 +28,23 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "path",
     doc: "unidirectional path tracer: BSDF sampling, light sampling, or both combined with MIS",
-    params: &PARAMS,
+    params: PathParams::SPECS,
 };
 
 /// The parameters of a path tracer, which the wavefront one shares.
-pub(crate) const PARAMS: [ParamSpec; 8] = [
-    ParamSpec::with_default(
-        "max_depth",
-        ParamType::Int,
-        "8",
-        "maximum path segments from the camera: 1 = emitters seen directly, 2 = direct lighting",
-    ),
-    ParamSpec::with_default(
-        "rr_depth",
-        ParamType::Int,
-        "5",
-        "Russian roulette may end paths longer than this many segments (unbiased); large = off",
-    ),
-    estimator::PARAMS[0],
-    estimator::PARAMS[1],
-    estimator::PARAMS[2],
-    estimator::PARAMS[3],
-    estimator::PARAMS[4],
-    estimator::PARAMS[5],
-];
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PathParams {
+    /// maximum path segments from the camera: 1 = emitters seen directly, 2
+    /// = direct lighting
+    #[param(default = 8)]
+    pub max_depth: u32,
+    /// Russian roulette may end paths longer than this many segments
+    /// (unbiased); large = off
+    #[param(default = 5)]
+    pub rr_depth: u32,
+    #[param(flatten)]
+    pub estimator: EstimatorParams,
+}
 
 #[derive(Debug, Clone)]
 pub struct PathIntegrator {
@@ -74,18 +67,21 @@ impl PathIntegrator {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let max_depth: u32 = params.get("max_depth")?;
-        if max_depth == 0 {
+        Self::from_read(&PathParams::read(params)?, params)
+    }
+
+    /// The path tracer `p` describes; `params` locates errors.
+    pub fn from_read(p: &PathParams, params: &Params) -> Result<Self> {
+        if p.max_depth == 0 {
             return Err(params.error(
-                "max_depth",
+                PathParams::KEYS.max_depth,
                 "must be at least 1 (1 = emitters seen directly)",
             ));
         }
-        let rr_depth: u32 = params.get("rr_depth")?;
         Ok(Self::with_estimator(
-            max_depth,
-            rr_depth,
-            Estimator::from_params(params)?,
+            p.max_depth,
+            p.rr_depth,
+            Estimator::from_read(&p.estimator, params)?,
         ))
     }
 }

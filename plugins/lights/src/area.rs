@@ -4,56 +4,36 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Light, LightKind, LightSample, ParamSpec, ParamType, Params, Result, Rgb, Vec2, Vec3,
+    Light, LightKind, LightSample, ParamChoice, Params, PluginParams, Result, Rgb, Vec2, Vec3,
 };
 
-/// `radiance`, a key of every `emission = { ... }` table.
-pub const RADIANCE: ParamSpec =
-    ParamSpec::required("radiance", ParamType::Rgb, "emitted radiance in linear RGB");
-
-/// `two_sided`, a key of every `emission = { ... }` table.
-pub const TWO_SIDED: ParamSpec = ParamSpec::with_default(
-    "two_sided",
-    ParamType::Bool,
-    "false",
-    "emit from the back side too",
-);
-
-/// `sampling`: how `sample_li` picks points on a quad, triangle or sphere.
-/// Quads and triangles default to `"area"` so that scenes written before the
-/// switch existed render bit-identically; spheres default to
-/// `"solid-angle"`.
-pub const fn sampling_param(default: &'static str) -> ParamSpec {
-    ParamSpec::with_default(
-        "sampling",
-        ParamType::String,
-        default,
-        "\"solid-angle\": uniform over the solid angle the shape subtends (area sampling where that is unstable), \"area\": uniform over the surface, converted to solid angle",
-    )
-    .one_of(&["solid-angle", "area"])
+/// The keys of every `emission = { ... }` table.
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct EmissionParams {
+    /// emitted radiance in linear RGB
+    pub radiance: Rgb,
+    /// emit from the back side too
+    #[param(default = false)]
+    pub two_sided: bool,
+    /// "solid-angle": uniform over the solid angle the shape subtends (area
+    /// sampling where that is unstable), "area": uniform over the surface,
+    /// converted to solid angle
+    // Quads and triangles default to "area" so that scenes written before
+    // the switch existed render bit-identically; spheres default to
+    // "solid-angle".
+    #[param(default = Area)]
+    pub sampling: Sampling,
 }
 
-/// The keys of a quad's or mesh's `emission = { ... }` table.
-pub const EMISSION_PARAMS: &[ParamSpec] = &[RADIANCE, TWO_SIDED, sampling_param("\"area\"")];
-
 /// How an area light chooses points for next-event estimation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Sampling {
-    /// Uniform by area; the density in solid angle is `d^2 / (|cos| A)`,
-    /// which peaks at grazing angles and near the light.
-    Area,
     /// Uniform over the solid angle subtended from the shading point:
     /// density `1 / Omega`, no `1/d^2` or `1/cos` spikes.
     SolidAngle,
-}
-
-impl Sampling {
-    pub fn from_params(params: &Params) -> Result<Self> {
-        Ok(match params.get_choice("sampling")?.as_str() {
-            "area" => Sampling::Area,
-            _ => Sampling::SolidAngle,
-        })
-    }
+    /// Uniform by area; the density in solid angle is `d^2 / (|cos| A)`,
+    /// which peaks at grazing angles and near the light.
+    Area,
 }
 
 /// Constant radiance leaving a surface.
@@ -64,17 +44,18 @@ pub struct Emission {
 }
 
 impl Emission {
-    pub fn from_params(params: &Params) -> Result<Self> {
-        let radiance: Rgb = params.get("radiance")?;
+    /// The emission `p` describes, its radiance checked.
+    pub fn from_params(p: &EmissionParams, params: &Params) -> Result<Self> {
+        let radiance = p.radiance;
         if !(radiance.min_component() >= 0.0 && radiance.is_finite()) {
             return Err(params.error(
-                "radiance",
+                EmissionParams::KEYS.radiance,
                 format!("must be finite and non-negative, got {radiance:?}"),
             ));
         }
         Ok(Self {
             radiance,
-            two_sided: params.get("two_sided")?,
+            two_sided: p.two_sided,
         })
     }
 

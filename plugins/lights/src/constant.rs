@@ -4,8 +4,8 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind,
-    PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -13,12 +13,14 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "constant",
     doc: "constant environment radiance from all directions, sampled uniformly over the sphere",
-    params: &[ParamSpec::required(
-        "radiance",
-        ParamType::Rgb,
-        "radiance arriving from every direction",
-    )],
+    params: ConstantLightParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct ConstantLightParams {
+    /// radiance arriving from every direction
+    pub radiance: Rgb,
+}
 
 #[derive(Debug, Clone)]
 pub struct ConstantLight {
@@ -43,9 +45,12 @@ impl ConstantLight {
                 params.owner()
             )));
         }
-        let radiance: Rgb = params.get("radiance")?;
+        let radiance = ConstantLightParams::read(params)?.radiance;
         if !(radiance.min_component() >= 0.0 && radiance.is_finite()) {
-            return Err(params.error("radiance", "must be finite and non-negative"));
+            return Err(params.error(
+                ConstantLightParams::KEYS.radiance,
+                "must be finite and non-negative",
+            ));
         }
         Ok(Self::new(radiance))
     }

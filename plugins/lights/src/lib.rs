@@ -10,7 +10,7 @@ mod sphere;
 mod spot;
 mod triangle;
 
-pub use area::{AreaLight, Emission, PlanarShape, Sampling};
+pub use area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling};
 pub use constant::ConstantLight;
 pub use point::PointLight;
 pub use quad::{Quad, QuadLight};

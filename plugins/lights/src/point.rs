@@ -3,23 +3,24 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind,
-    PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "point",
     doc: "isotropic point light: never hit by rays, sampled with probability 1 (MIS weight 1)",
-    params: &[
-        ParamSpec::required("position", ParamType::Vec3, "world-space position"),
-        ParamSpec::required(
-            "intensity",
-            ParamType::Rgb,
-            "radiant intensity I (W/sr); irradiance is I cos / d^2",
-        ),
-    ],
+    params: PointLightParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PointLightParams {
+    /// world-space position
+    pub position: Vec3,
+    /// radiant intensity I (W/sr); irradiance is I cos / d^2
+    pub intensity: Rgb,
+}
 
 #[derive(Debug, Clone)]
 pub struct PointLight {
@@ -42,11 +43,14 @@ impl PointLight {
                 params.owner()
             )));
         }
-        let intensity: Rgb = params.get("intensity")?;
-        if !(intensity.min_component() >= 0.0 && intensity.is_finite()) {
-            return Err(params.error("intensity", "must be finite and non-negative"));
+        let p = PointLightParams::read(params)?;
+        if !(p.intensity.min_component() >= 0.0 && p.intensity.is_finite()) {
+            return Err(params.error(
+                PointLightParams::KEYS.intensity,
+                "must be finite and non-negative",
+            ));
         }
-        Ok(Self::new(params.get("position")?, intensity))
+        Ok(Self::new(p.position, p.intensity))
     }
 }
 

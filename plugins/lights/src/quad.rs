@@ -4,17 +4,19 @@
 
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
+use lumis_core::{
+    Error, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+};
 
 use lumis_sampling::{SphericalRectangle, MIN_SPHERICAL_SAMPLE_AREA};
 
-use crate::area::{AreaLight, Emission, PlanarShape, Sampling, SolidAngleSample, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling, SolidAngleSample};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "quad",
     doc: "emission of a quad shape: uniform area sampling converted to solid angle, or spherical-rectangle sampling (Urena et al. 2013) for rectangles subtending at least 3e-4 sr",
-    params: EMISSION_PARAMS,
+    params: EmissionParams::SPECS,
 };
 
 /// A parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`.
@@ -68,10 +70,11 @@ impl QuadLight {
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
-        let emission = Emission::from_params(params)?;
+        let p = EmissionParams::read(params)?;
+        let emission = Emission::from_params(&p, params)?;
         match *shape {
             LightShape::Quad { corner, edge_u, edge_v } => Ok(Self::new(corner, edge_u, edge_v, emission)?
-                .with_sampling(Sampling::from_params(params)?)),
+                .with_sampling(p.sampling)),
             _ => Err(Error::msg(format!(
                 "{}: the quad light is the emission of a quad shape; use [[shape]] type = \"quad\" with emission = {{ ... }}",
                 params.owner()

@@ -9,22 +9,27 @@ use std::f32::consts::PI;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, ParamSpec, Params,
-    PluginKind, PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, Params, PluginKind,
+    PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::real::{load, F32x8, Real, V3};
 use lumis_sampling::warp;
 
-use crate::area::{sampling_param, Emission, Sampling, RADIANCE, TWO_SIDED};
+use crate::area::{Emission, EmissionParams, Sampling};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "sphere",
     doc: "emission of a sphere shape: uniform cone sampling from outside, uniform area sampling from inside or on it",
-    params: &[RADIANCE, TWO_SIDED, SAMPLING],
+    params: SphereLightParams::SPECS,
 };
 
-const SAMPLING: ParamSpec = sampling_param("\"solid-angle\"");
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct SphereLightParams {
+    /// A sphere is sampled by solid angle unless asked otherwise.
+    #[param(flatten, default(sampling = Sampling::SolidAngle))]
+    pub emission: EmissionParams,
+}
 
 /// A shading point closer to the centre than `r (1 + ON_SURFACE / 2)` counts
 /// as on the sphere and samples by area: the cone there is a hemisphere and
@@ -65,8 +70,9 @@ impl SphereLight {
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
-        let emission = Emission::from_params(params)?;
-        let sampling = Sampling::from_params(params)?;
+        let p = SphereLightParams::read(params)?.emission;
+        let emission = Emission::from_params(&p, params)?;
+        let sampling = p.sampling;
         match *shape {
             LightShape::Sphere {
                 center,

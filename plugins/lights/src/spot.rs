@@ -4,38 +4,32 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, ParamSpec, ParamType, Params, PluginKind,
-    PluginSpec, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
+    Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "spot",
     doc: "point light emitting into a cone, full intensity inside falloff_start, smoothstep to zero at cutoff; never hit by rays (MIS weight 1)",
-    params: &[
-        ParamSpec::required("position", ParamType::Vec3, "world-space position"),
-        ParamSpec::required("target", ParamType::Vec3, "a point on the cone's axis"),
-        ParamSpec::required(
-            "intensity",
-            ParamType::Rgb,
-            "radiant intensity I (W/sr) on the axis",
-        ),
-        ParamSpec::with_default(
-            "cutoff",
-            ParamType::Float,
-            "30.0",
-            "half-angle of the cone in degrees, beyond which nothing is emitted",
-        )
-        .in_range(0.0, 90.0),
-        ParamSpec::with_default(
-            "falloff_start",
-            ParamType::Float,
-            "25.0",
-            "half-angle in degrees up to which the intensity is full; <= cutoff",
-        )
-        .in_range(0.0, 90.0),
-    ],
+    params: SpotLightParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct SpotLightParams {
+    /// world-space position
+    pub position: Vec3,
+    /// a point on the cone's axis
+    pub target: Vec3,
+    /// radiant intensity I (W/sr) on the axis
+    pub intensity: Rgb,
+    /// half-angle of the cone in degrees, beyond which nothing is emitted
+    #[param(default = 30.0, range = (0.0, 90.0))]
+    pub cutoff: f32,
+    /// half-angle in degrees up to which the intensity is full; <= cutoff
+    #[param(default = 25.0, range = (0.0, 90.0))]
+    pub falloff_start: f32,
+}
 
 #[derive(Debug, Clone)]
 pub struct SpotLight {
@@ -79,25 +73,18 @@ impl SpotLight {
                 params.owner()
             )));
         }
-        let intensity: Rgb = params.get("intensity")?;
-        if !(intensity.min_component() >= 0.0 && intensity.is_finite()) {
-            return Err(params.error("intensity", "must be finite and non-negative"));
+        let p = SpotLightParams::read(params)?;
+        let keys = SpotLightParams::KEYS;
+        if !(p.intensity.min_component() >= 0.0 && p.intensity.is_finite()) {
+            return Err(params.error(keys.intensity, "must be finite and non-negative"));
         }
-        let cutoff = params.get_in_range("cutoff")?;
-        let falloff_start = params.get_in_range("falloff_start")?;
-        if falloff_start > cutoff {
+        if p.falloff_start > p.cutoff {
             return Err(params.error(
-                "falloff_start",
-                format!("must not exceed cutoff ({cutoff})"),
+                keys.falloff_start,
+                format!("must not exceed cutoff ({})", p.cutoff),
             ));
         }
-        Self::new(
-            params.get("position")?,
-            params.get("target")?,
-            intensity,
-            cutoff,
-            falloff_start,
-        )
+        Self::new(p.position, p.target, p.intensity, p.cutoff, p.falloff_start)
     }
 
     /// The falloff at `cos_theta` from the axis: 1 inside the inner cone, 0

@@ -3,18 +3,20 @@
 
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
-use lumis_core::{Error, LightShape, Params, PluginKind, PluginSpec, Result, Vec2, Vec3};
+use lumis_core::{
+    Error, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+};
 use lumis_sampling::{
     warp, SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
 };
 
-use crate::area::{AreaLight, Emission, PlanarShape, Sampling, SolidAngleSample, EMISSION_PARAMS};
+use crate::area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling, SolidAngleSample};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "triangle",
     doc: "emission of one mesh triangle: uniform area sampling converted to solid angle, or spherical-triangle sampling (Arvo 1995) where it subtends 3e-4 to 6.22 sr",
-    params: EMISSION_PARAMS,
+    params: EmissionParams::SPECS,
 };
 
 /// A triangle; its front faces `(p1 - p0) x (p2 - p0)`.
@@ -50,11 +52,10 @@ impl TriangleLight {
     }
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
-        let emission = Emission::from_params(params)?;
+        let read = EmissionParams::read(params)?;
+        let emission = Emission::from_params(&read, params)?;
         match *shape {
-            LightShape::Triangle { p } => {
-                Ok(Self::new(p, emission)?.with_sampling(Sampling::from_params(params)?))
-            }
+            LightShape::Triangle { p } => Ok(Self::new(p, emission)?.with_sampling(read.sampling)),
             _ => Err(Error::msg(format!(
                 "{}: the triangle light is the emission of a mesh shape; give the mesh an emission = {{ ... }}",
                 params.owner()

@@ -14,7 +14,7 @@ pub mod precompute;
 pub mod tabulate;
 pub mod tabulated;
 
-pub use measured::{Measured, SPEC};
+pub use measured::{Measured, MeasuredParams, MeasuredSampling, SPEC};
 pub use merl::MerlTable;
 
 use std::sync::Arc;

@@ -1,11 +1,12 @@
 //! `measured`: an isotropic BRDF tabulated in the MERL format, with a
 //! choice of importance sampling.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamSpec, ParamType, Params, PluginKind, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
+    PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -17,44 +18,47 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
     doc: "isotropic BRDF tabulated in the MERL format (trilinear f); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
-    params: &[
-        ParamSpec::required(
-            "file",
-            ParamType::String,
-            "MERL .binary table, relative to the scene file (make one with `lumis brdf tabulate`)",
-        ),
-        ParamSpec::with_default(
-            "sampling",
-            ParamType::String,
-            "\"factored\"",
-            "cosine (the baseline), factored (L separable terms in half-vector coordinates), tabulated (a 2D table per outgoing elevation, the memory-hungry reference)",
-        )
-        .one_of(&["cosine", "factored", "tabulated"]),
-        ParamSpec::with_default("terms", ParamType::Int, "2", "L, the terms of the factorization (factored only)")
-            .in_range(1.0, 16.0),
-        ParamSpec::with_default(
-            "grid",
-            ParamType::IntArray,
-            "[32, 64, 64]",
-            "[outgoing elevations, half-angle bins, azimuth bins] of the precomputation (factored, tabulated)",
-        ),
-        ParamSpec::with_default(
-            "cache",
-            ParamType::Bool,
-            "true",
-            "keep the precomputation next to the table (TABLE.STRATEGY-....lumis-cache), reused while the table is unchanged",
-        ),
-    ],
+    params: MeasuredParams::SPECS,
 };
+
+#[derive(Debug, Clone, PluginParams)]
+pub struct MeasuredParams {
+    /// MERL .binary table, relative to the scene file (make one with `lumis
+    /// brdf tabulate`)
+    pub file: PathBuf,
+    /// cosine (the baseline), factored (L separable terms in half-vector
+    /// coordinates), tabulated (a 2D table per outgoing elevation, the
+    /// memory-hungry reference)
+    #[param(default = Factored)]
+    pub sampling: MeasuredSampling,
+    /// L, the terms of the factorization (factored only)
+    #[param(default = 2, range = (1, 16))]
+    pub terms: i64,
+    /// [outgoing elevations, half-angle bins, azimuth bins] of the
+    /// precomputation (factored, tabulated)
+    #[param(default = [32, 64, 64])]
+    pub grid: Vec<i64>,
+    /// keep the precomputation next to the table
+    /// (TABLE.STRATEGY-....lumis-cache), reused while the table is unchanged
+    #[param(default = true)]
+    pub cache: bool,
+}
+
+/// The `sampling` choice of `measured`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum MeasuredSampling {
+    Cosine,
+    Factored,
+    Tabulated,
+}
 
 /// Midpoints per cell and axis of the precomputation grid.
 const SUPERSAMPLES: usize = 4;
 /// The largest grid accepted: 64 MB of f32 for the tabulated strategy.
 const MAX_GRID_CELLS: i64 = 1 << 24;
 
-fn grid_from_params(params: &Params) -> Result<Grid> {
-    let grid: Vec<i64> = params.get("grid")?;
-    match grid.as_slice() {
+fn checked_grid(grid: &[i64], params: &Params) -> Result<Grid> {
+    match grid {
         &[n_o, n_w, n_phi]
             if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n))
                 && n_o * n_w * n_phi <= MAX_GRID_CELLS =>
@@ -67,7 +71,7 @@ fn grid_from_params(params: &Params) -> Result<Grid> {
             })
         }
         _ => Err(params.error(
-            "grid",
+            MeasuredParams::KEYS.grid,
             format!("expected three integers in [2, 1024] with a product of at most {MAX_GRID_CELLS}, got {grid:?}"),
         )),
     }
@@ -104,34 +108,33 @@ impl Measured {
     /// went (also printed to stderr by [`Self::from_params`]).
     pub fn from_params_with_report(params: &Params) -> Result<(Self, Option<PrecomputeReport>)> {
         // Settings first: a typo is reported before a 35 MB read.
-        let plan = match params.get_choice("sampling")?.as_str() {
-            "cosine" => None,
-            "tabulated" => Some(Plan::Tabulated),
-            _ => {
-                // An integer (get_in_range would accept and truncate 2.5).
-                let terms: i64 = params.get("terms")?;
-                if !(1..=16).contains(&terms) {
-                    return Err(params.error("terms", format!("must be in [1, 16], got {terms}")));
+        let p = MeasuredParams::read(params)?;
+        let keys = MeasuredParams::KEYS;
+        // A setting the strategy does not use is refused if given.
+        let plan = match p.sampling {
+            MeasuredSampling::Cosine => {
+                for unused in [keys.terms, keys.grid, keys.cache] {
+                    params.unread(unused);
                 }
-                Some(Plan::Factored {
-                    terms: terms as usize,
-                })
+                None
+            }
+            MeasuredSampling::Factored => Some(Plan::Factored {
+                terms: p.terms as usize,
+            }),
+            MeasuredSampling::Tabulated => {
+                params.unread(keys.terms);
+                Some(Plan::Tabulated)
             }
         };
         let setup = match plan {
-            Some(plan) => Some((
-                plan,
-                grid_from_params(params)?,
-                params.get::<bool>("cache")?,
-            )),
+            Some(plan) => Some((plan, checked_grid(&p.grid, params)?, p.cache)),
             None => None,
         };
-        let path = params.get_path("file")?;
-        let table = Arc::new(MerlTable::read(&path).map_err(|e| params.error("file", e))?);
+        let table = Arc::new(MerlTable::read(&p.file).map_err(|e| params.error(keys.file, e))?);
         let Some((plan, grid, use_cache)) = setup else {
             return Ok((Self::cosine(table), None));
         };
-        let (prepared, report) = prepare(&table, &path, plan, grid, use_cache)?;
+        let (prepared, report) = prepare(&table, &p.file, plan, grid, use_cache)?;
         Ok((Self::with_sampler(table, prepared), Some(report)))
     }
 

@@ -1,7 +1,7 @@
 //! `halton`: the Halton sequence over the whole image, scrambled.
 
 use lumis_core::{
-    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
@@ -9,23 +9,42 @@ use lumis_sampling::{
     hash_u64, hash_with, inverse_radical_inverse, scrambled_radical_inverse, DigitScramble,
 };
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "halton",
     doc: "one Halton sequence over the image (dimension d in base prime(d)); each pixel gets its own sub-sequence; digits scrambled",
-    params: &[
-        SPP_PARAM,
-        ParamSpec::with_default(
-            "randomize",
-            ParamType::String,
-            "\"owen\"",
-            "digit scrambling: owen (nested), digits (one permutation per digit), none",
-        )
-        .one_of(&["owen", "digits", "none"]),
-    ],
+    params: HaltonParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct HaltonParams {
+    #[param(flatten)]
+    pub spp: SppParams,
+    /// digit scrambling: owen (nested), digits (one permutation per digit),
+    /// none
+    #[param(default = Owen)]
+    pub randomize: HaltonRandomize,
+}
+
+/// The `randomize` parameter of `halton`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum HaltonRandomize {
+    Owen,
+    Digits,
+    None,
+}
+
+impl From<HaltonRandomize> for DigitScramble {
+    fn from(randomize: HaltonRandomize) -> Self {
+        match randomize {
+            HaltonRandomize::Owen => DigitScramble::Owen,
+            HaltonRandomize::Digits => DigitScramble::RandomDigits,
+            HaltonRandomize::None => DigitScramble::None,
+        }
+    }
+}
 
 /// Pixels are mapped to sub-sequences modulo this many pixels per axis.
 const TILE: u32 = 128;
@@ -85,12 +104,8 @@ impl HaltonSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let scramble = match params.get_choice("randomize")?.as_str() {
-            "owen" => DigitScramble::Owen,
-            "digits" => DigitScramble::RandomDigits,
-            _ => DigitScramble::None,
-        };
-        Ok(Self::new(read_spp(params)?, scramble))
+        let p = HaltonParams::read(params)?;
+        Ok(Self::new(p.spp.checked(params)?, p.randomize.into()))
     }
 
     fn sample_dimension(&self, dimension: u32) -> f32 {

@@ -2,7 +2,8 @@
 //! Owen-scrambled per pixel.
 
 use lumis_core::{
-    ConcreteLanes, Params, PluginKind, PluginSpec, Result, Sampler, SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
+    UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
@@ -10,13 +11,13 @@ use lumis_sampling::{
     scrambled_radical_inverse, DigitScramble,
 };
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "hammersley",
     doc: "the Hammersley set (i/spp, radical inverses in 2, 3, 5, ...) of each pixel, Owen-scrambled per pixel; a (0,m,2)-net in the pixel when spp = 2^m",
-    params: &[SPP_PARAM],
+    params: SppParams::SPECS,
 };
 
 /// Sample `i` of `N = spp` is `(i/N, phi_2(i), phi_3(i), phi_5(i), ...)`
@@ -47,7 +48,7 @@ impl HammersleySampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        Ok(Self::new(read_spp(params)?))
+        Ok(Self::new(SppParams::read(params)?.checked(params)?))
     }
 
     fn dimension_seed(&self, dimension: u32) -> u64 {

@@ -1,17 +1,18 @@
 //! `independent`: uniform random numbers, no stratification.
 
 use lumis_core::{
-    ConcreteLanes, Params, PluginKind, PluginSpec, Result, Sampler, SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
+    UVec2, Vec2,
 };
 use lumis_sampling::{hash_u64, pixel_key, Pcg32};
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "independent",
     doc: "uniform random samples (PCG32, one stream per pixel); the baseline every other sampler is measured against",
-    params: &[SPP_PARAM],
+    params: SppParams::SPECS,
 };
 
 /// Uniform random samples from PCG32. Each (pixel, sample index, seed)
@@ -35,7 +36,7 @@ impl IndependentSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        Ok(Self::new(read_spp(params)?))
+        Ok(Self::new(SppParams::read(params)?.checked(params)?))
     }
 }
 

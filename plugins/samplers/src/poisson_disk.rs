@@ -1,27 +1,29 @@
 //! `poisson-disk`: Poisson disk patterns for the film plane.
 
 use lumis_core::{
-    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
-    SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
+    UVec2, Vec2,
 };
 use lumis_sampling::poisson_disk::{max_packing_distance, poisson_disk_pattern};
 use lumis_sampling::{hash_u64, pixel_key, Pcg32};
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "poisson-disk",
     doc: "film-plane positions from toroidal Poisson disk patterns (dart throwing), randomly chosen and shifted per pixel; other dimensions independent",
-    params: &[
-        SPP_PARAM,
-        ParamSpec::optional(
-            "min_distance",
-            ParamType::Float,
-            "minimum distance between a pixel's samples, in pixels (default 0.7 x the hexagonal packing distance sqrt(2 / (sqrt(3) spp)))",
-        ),
-    ],
+    params: PoissonDiskParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PoissonDiskParams {
+    #[param(flatten)]
+    pub spp: SppParams,
+    /// minimum distance between a pixel's samples, in pixels (default 0.7 x
+    /// the hexagonal packing distance sqrt(2 / (sqrt(3) spp)))
+    pub min_distance: Option<f32>,
+}
 
 /// Relative radius used when `min_distance` is not given: dart throwing
 /// saturates near 0.77 (Lagae and Dutre 2008), 0.7 still fills reliably.
@@ -65,18 +67,20 @@ impl PoissonDiskSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let spp = read_spp(params)?;
+        let p = PoissonDiskParams::read(params)?;
+        let key = PoissonDiskParams::KEYS.min_distance;
+        let spp = p.spp.checked(params)?;
         let packing = max_packing_distance(spp as usize);
-        let min_distance = match params.get_opt::<f32>("min_distance")? {
+        let min_distance = match p.min_distance {
             Some(d) if !(d >= 0.0 && d.is_finite()) => {
-                return Err(params.error("min_distance", format!("must be >= 0, got {d}")))
+                return Err(params.error(key, format!("must be >= 0, got {d}")))
             }
             Some(d) => d,
             None => DEFAULT_RELATIVE_DISTANCE * packing,
         };
         Self::new(spp, min_distance).ok_or_else(|| {
             params.error(
-                "min_distance",
+                key,
                 format!(
                     "{min_distance} is too large for {spp} samples per pixel: dart throwing \
                      cannot place them; use at most about {:.4} (0.75 x the densest packing \

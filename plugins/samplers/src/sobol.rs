@@ -4,7 +4,7 @@ use std::fmt;
 use std::marker::PhantomData;
 
 use lumis_core::{
-    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
@@ -12,33 +12,31 @@ use lumis_sampling::{
     sobol_reversed_run, sobol_reversed_tabulated, xor_scramble, SOBOL_DIMENSIONS,
 };
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "sobol",
     doc: "Sobol' points per pixel (the (0,2)-sequence in the film plane, Joe-Kuo dimensions beyond), Owen-scrambled per pixel; progressive: every power-of-two prefix is a (0,m,2)-net",
-    params: &[
-        SPP_PARAM,
-        ParamSpec::with_default(
-            "randomize",
-            ParamType::String,
-            "\"owen\"",
-            "owen (nested uniform scrambling), xor (random digital shift) or none (the same points in every pixel)",
-        )
-        .one_of(&["owen", "xor", "none"]),
-        ParamSpec::with_default(
-            "dimensions",
-            ParamType::String,
-            "\"sobol\"",
-            "sobol: dimension d is Sobol' dimension d; padded: every 1D/2D request is a shuffled (0,2)-sequence (Burley 2020)",
-        )
-        .one_of(&["sobol", "padded"]),
-    ],
+    params: SobolParams::SPECS,
 };
 
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct SobolParams {
+    #[param(flatten)]
+    pub spp: SppParams,
+    /// owen (nested uniform scrambling), xor (random digital shift) or none
+    /// (the same points in every pixel)
+    #[param(default = Owen)]
+    pub randomize: Randomize,
+    /// sobol: dimension d is Sobol' dimension d; padded: every 1D/2D request
+    /// is a shuffled (0,2)-sequence (Burley 2020)
+    #[param(default = Sobol)]
+    pub dimensions: Dimensions,
+}
+
 /// The `randomize` parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Randomize {
     Owen,
     Xor,
@@ -46,7 +44,7 @@ pub enum Randomize {
 }
 
 /// Which Sobol' dimensions serve dimensions past the film plane.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum Dimensions {
     /// Sampler dimension `d` is Sobol' dimension `d` (Joe-Kuo matrices);
     /// past 1024 they wrap around with fresh scrambles.
@@ -364,16 +362,12 @@ impl SobolSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Box<dyn Sampler>> {
-        let randomize = match params.get_choice("randomize")?.as_str() {
-            "owen" => Randomize::Owen,
-            "xor" => Randomize::Xor,
-            _ => Randomize::None,
-        };
-        let dimensions = match params.get_choice("dimensions")?.as_str() {
-            "padded" => Dimensions::Padded,
-            _ => Dimensions::Sobol,
-        };
-        Ok(Self::boxed(read_spp(params)?, randomize, dimensions))
+        let p = SobolParams::read(params)?;
+        Ok(Self::boxed(
+            p.spp.checked(params)?,
+            p.randomize,
+            p.dimensions,
+        ))
     }
 }
 

@@ -1,15 +1,21 @@
 //! The `spp` parameter every sampler shares.
 
-use lumis_core::{ParamSpec, ParamType, Params, Result};
+use lumis_core::{Params, PluginParams, Result};
 
-pub const SPP_PARAM: ParamSpec =
-    ParamSpec::with_default("spp", ParamType::Int, "16", "samples per pixel");
+/// Flattened into every sampler's parameters.
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct SppParams {
+    /// samples per pixel
+    #[param(default = 16)]
+    pub spp: u32,
+}
 
-/// Reads `spp`, refusing zero.
-pub fn read_spp(params: &Params) -> Result<u32> {
-    let spp: u32 = params.get("spp")?;
-    if spp == 0 {
-        return Err(params.error("spp", "must be at least 1"));
+impl SppParams {
+    /// `spp`, refusing zero.
+    pub fn checked(&self, params: &Params) -> Result<u32> {
+        if self.spp == 0 {
+            return Err(params.error(Self::KEYS.spp, "must be at least 1"));
+        }
+        Ok(self.spp)
     }
-    Ok(spp)
 }

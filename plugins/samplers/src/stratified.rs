@@ -2,29 +2,30 @@
 //! across dimensions by per-pixel random permutations (padding).
 
 use lumis_core::{
-    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
-    SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
+    UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, permutation_element, pixel_key, Pcg32, ONE_MINUS_EPSILON,
 };
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "stratified",
     doc: "jittered stratification: spp strata in 1D, an nx x ny grid (nx the largest divisor of spp <= sqrt(spp)) in 2D; dimensions padded by per-pixel permutations",
-    params: &[
-        SPP_PARAM,
-        ParamSpec::with_default(
-            "jitter",
-            ParamType::Bool,
-            "true",
-            "a random point in each stratum (false: its centre, which aliases)",
-        ),
-    ],
+    params: StratifiedParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct StratifiedParams {
+    #[param(flatten)]
+    pub spp: SppParams,
+    /// a random point in each stratum (false: its centre, which aliases)
+    #[param(default = true)]
+    pub jitter: bool,
+}
 
 /// Stratified sampling with padding (pbrt-v4 `StratifiedSampler`; Shirley
 /// 1991, "Discrepancy as a Quality Measure for Sample Distributions").
@@ -76,7 +77,8 @@ impl StratifiedSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        Ok(Self::new(read_spp(params)?, params.get("jitter")?))
+        let p = StratifiedParams::read(params)?;
+        Ok(Self::new(p.spp.checked(params)?, p.jitter))
     }
 
     /// The stratum sample `index` takes in `dimension`.

@@ -2,30 +2,38 @@
 //! pixels, for blue-noise error between neighbouring pixels.
 
 use lumis_core::{
-    ConcreteLanes, ParamSpec, ParamType, Params, PluginKind, PluginSpec, Result, Sampler,
+    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, laine_karras_permutation, reversed_to_unit_f32, sobol_reversed_u32,
 };
 
-use crate::spp::{read_spp, SPP_PARAM};
+use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "zsobol",
     doc: "Ahmed and Wonka's screen-space blue noise: pixels take consecutive blocks of one Sobol' sequence in Morton order, with randomly permuted base-4 digits; error is anti-correlated between neighbouring pixels (pbrt-v4's default)",
-    params: &[
-        SPP_PARAM,
-        ParamSpec::with_default(
-            "randomize",
-            ParamType::String,
-            "\"owen\"",
-            "owen: Owen-scrambled points and permuted digits; none: the plain Z-ordered sequence",
-        )
-        .one_of(&["owen", "none"]),
-    ],
+    params: ZSobolParams::SPECS,
 };
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct ZSobolParams {
+    #[param(flatten)]
+    pub spp: SppParams,
+    /// owen: Owen-scrambled points and permuted digits; none: the plain
+    /// Z-ordered sequence
+    #[param(default = Owen)]
+    pub randomize: ZSobolRandomize,
+}
+
+/// The `randomize` parameter of `zsobol`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum ZSobolRandomize {
+    Owen,
+    None,
+}
 
 /// Pixel coordinates are taken modulo 2^16 per axis.
 const PIXEL_BITS: u32 = 16;
@@ -112,8 +120,12 @@ impl ZSobolSampler {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let owen = params.get_choice("randomize")? == "owen";
-        Ok(Self::new(read_spp(params)?, owen))
+        let p = ZSobolParams::read(params)?;
+        let owen = match p.randomize {
+            ZSobolRandomize::Owen => true,
+            ZSobolRandomize::None => false,
+        };
+        Ok(Self::new(p.spp.checked(params)?, owen))
     }
 
     /// Permutes the base-4 digit of `self.morton_index` at bit `shift`,

@@ -29,7 +29,9 @@ use std::sync::Arc;
 use lumis_core::doc::{Table, Value};
 use lumis_core::glam::{Mat3, Mat4};
 use lumis_core::registry::TableRef;
-use lumis_core::{Error, LightShape, Location, ParamSpec, ParamType, Params, Result, Vec2, Vec3};
+use lumis_core::{
+    Error, LightShape, Location, ParamSpec, ParamType, ParamValue, Params, Result, Vec2, Vec3,
+};
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 use rayon::prelude::*;
 
@@ -63,7 +65,7 @@ pub(crate) const GLTF_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
         "crease_angle",
         ParamType::Float,
-        "30.0",
+        ParamValue::Float(30.0),
         "degrees; normals missing from the file are generated, smooth across edges whose faces meet at less than this; 0 = flat shading (nothing stored)",
     )
     .in_range(0.0, 180.0),

@@ -21,13 +21,13 @@
 mod batched;
 
 use lumis_core::{
-    BsdfSample, Integrator, LightKind, LightSample, LightSampleContext, ParamSpec, ParamType,
-    Params, PluginKind, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler,
-    SamplerLanes, Scene, SurfaceInteraction, Vec2, Vec3,
+    BsdfSample, Integrator, LightKind, LightSample, LightSampleContext, Params, PluginKind,
+    PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler, SamplerLanes,
+    Scene, SurfaceInteraction, Vec2, Vec3,
 };
 
 use crate::estimator::{bsdf_context, extra_sample_ray, SceneView, Vertex, VertexPlan};
-use crate::path::{self, PathIntegrator};
+use crate::path::{PathIntegrator, PathParams};
 use crate::path_state::PathState;
 use batched::{Batcher, BsdfLane};
 
@@ -35,26 +35,18 @@ pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "wavefront",
     doc: "the path tracer run a wave of paths at a time: each bounce traces all rays as packets and calls every BSDF and light once per wave, so plugins may compute lanes with SIMD; same estimate as path",
-    params: &PARAMS,
+    params: WavefrontParams::SPECS,
 };
 
-const PARAMS: [ParamSpec; 9] = [
-    path::PARAMS[0],
-    path::PARAMS[1],
-    path::PARAMS[2],
-    path::PARAMS[3],
-    path::PARAMS[4],
-    path::PARAMS[5],
-    path::PARAMS[6],
-    path::PARAMS[7],
-    ParamSpec::with_default(
-        "wave_size",
-        ParamType::Int,
-        "256",
-        "camera rays (paths) advanced together; more lanes fill the batched calls better, at the cost of memory",
-    )
-    .in_range(1.0, 65536.0),
-];
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct WavefrontParams {
+    #[param(flatten)]
+    pub path: PathParams,
+    /// camera rays (paths) advanced together; more lanes fill the batched
+    /// calls better, at the cost of memory
+    #[param(default = 256, range = (1, 65536))]
+    pub wave_size: usize,
+}
 
 /// Camera rays per wave lane that one [`Integrator::li_batch`] call takes.
 const REGENERATIONS: usize = 8;
@@ -74,8 +66,11 @@ impl WavefrontIntegrator {
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let wave_size = params.get_in_range("wave_size")? as usize;
-        Ok(Self::new(PathIntegrator::from_params(params)?, wave_size))
+        let p = WavefrontParams::read(params)?;
+        Ok(Self::new(
+            PathIntegrator::from_read(&p.path, params)?,
+            p.wave_size,
+        ))
     }
 }
 

@@ -1,319 +1,32 @@
 //! Typed access to a plugin's TOML table.
 //!
-//! A plugin declares its parameters once, as a `&'static [ParamSpec]`; that
-//! declaration drives validation here (unknown keys, types, defaults) and the
-//! `lumis plugins` listing. [`Params`] also records which keys the plugin
-//! read: [`Params::finish`] rejects keys that were given but not used, so a
-//! typo or a setting that does not apply never falls back silently.
+//! A plugin declares its parameters once, as a struct deriving
+//! [`PluginParams`]: the derive writes both the `&'static [ParamSpec]` that
+//! drives validation here (unknown keys, types, defaults, ranges, choices)
+//! and the `lumis plugins` listing, and the code that reads the struct.
+//! [`Params`] also records which keys were read: [`Params::finish`] rejects
+//! keys that were given but not used, so a typo or a setting that does not
+//! apply never falls back silently.
+//!
+//! The scene loader's own tables (`[film]`, `[camera]`, shapes) declare
+//! `ParamSpec` lists by hand and read them by name with [`Params::get`].
+
+mod convert;
+mod spec;
+mod typed;
 
 use std::borrow::Cow;
 use std::cell::RefCell;
 
-use glam::{UVec2, Vec2, Vec3};
+pub use convert::{FromParam, Param};
+pub use spec::{
+    check_unique, concat, declares, override_default, total_len, ParamDefault, ParamSpec,
+    ParamType, ParamValue,
+};
+pub use typed::{choice_from_node, ParamChoice, PluginParams};
 
 use crate::doc::{Node, Table, Value};
 use crate::error::{Error, Location, Result};
-use crate::spectrum::Rgb;
-
-/// The type of a parameter, as shown to users and checked on access.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ParamType {
-    Bool,
-    Int,
-    Float,
-    String,
-    /// `[r, g, b]` or one number for grey.
-    Rgb,
-    Vec2,
-    Vec3,
-    /// Two non-negative integers, e.g. a resolution.
-    UIntPair,
-    FloatArray,
-    /// `[[x, y, z], ...]`, e.g. mesh positions.
-    Vec3Array,
-    IntArray,
-    StringArray,
-    Table,
-}
-
-impl ParamType {
-    pub fn name(self) -> &'static str {
-        match self {
-            ParamType::Bool => "bool",
-            ParamType::Int => "int",
-            ParamType::Float => "float",
-            ParamType::String => "string",
-            ParamType::Rgb => "rgb",
-            ParamType::Vec2 => "vec2",
-            ParamType::Vec3 => "vec3",
-            ParamType::UIntPair => "[uint, uint]",
-            ParamType::FloatArray => "[float]",
-            ParamType::Vec3Array => "[vec3]",
-            ParamType::IntArray => "[int]",
-            ParamType::StringArray => "[string]",
-            ParamType::Table => "table",
-        }
-    }
-}
-
-/// Whether a parameter must be given, and what it is when it is not.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ParamDefault {
-    Required,
-    /// A TOML literal, e.g. `"0.5"`, `"[1.0, 1.0, 1.0]"` or `"\"power\""`.
-    Value(&'static str),
-    /// May be absent; absence has its own meaning (e.g. no emission).
-    Absent,
-}
-
-/// One declared parameter of a plugin.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ParamSpec {
-    pub name: &'static str,
-    pub ty: ParamType,
-    pub default: ParamDefault,
-    pub doc: &'static str,
-    /// The valid range of a number, `[min, max]`: documents it, and tells
-    /// `lumis check-plugin` which extremes to sweep.
-    pub range: Option<(f64, f64)>,
-    /// The valid values of a string, for the same two purposes.
-    pub choices: &'static [&'static str],
-}
-
-impl ParamSpec {
-    pub const fn required(name: &'static str, ty: ParamType, doc: &'static str) -> Self {
-        Self {
-            name,
-            ty,
-            default: ParamDefault::Required,
-            doc,
-            range: None,
-            choices: &[],
-        }
-    }
-
-    pub const fn with_default(
-        name: &'static str,
-        ty: ParamType,
-        default: &'static str,
-        doc: &'static str,
-    ) -> Self {
-        Self {
-            name,
-            ty,
-            default: ParamDefault::Value(default),
-            doc,
-            range: None,
-            choices: &[],
-        }
-    }
-
-    pub const fn optional(name: &'static str, ty: ParamType, doc: &'static str) -> Self {
-        Self {
-            name,
-            ty,
-            default: ParamDefault::Absent,
-            doc,
-            range: None,
-            choices: &[],
-        }
-    }
-
-    /// Declares the valid range of a number parameter.
-    pub const fn in_range(mut self, min: f64, max: f64) -> Self {
-        self.range = Some((min, max));
-        self
-    }
-
-    /// Declares the valid values of a string parameter.
-    pub const fn one_of(mut self, choices: &'static [&'static str]) -> Self {
-        self.choices = choices;
-        self
-    }
-
-    /// The default as a document node, if it has one.
-    pub fn default_node(&self) -> Result<Option<Node>> {
-        let ParamDefault::Value(text) = self.default else {
-            return Ok(None);
-        };
-        // Parse through a one-key document so defaults use the same converter.
-        let table = crate::doc::parse(&format!("v = {text}"), "<default>").map_err(|e| {
-            Error::msg(format!(
-                "plugin bug: parameter '{}' has an invalid default '{text}': {}",
-                self.name, e.message
-            ))
-        })?;
-        let mut node = table
-            .get("v")
-            .cloned()
-            .ok_or_else(|| Error::msg("default lost"))?;
-        set_builtin(&mut node);
-        Ok(Some(node))
-    }
-}
-
-fn set_builtin(node: &mut Node) {
-    node.location = Location::Builtin;
-    match &mut node.value {
-        Value::Array(items) => items.iter_mut().for_each(set_builtin),
-        Value::Table(t) => t.entries.iter_mut().for_each(|e| {
-            e.key_location = Location::Builtin;
-            set_builtin(&mut e.node);
-        }),
-        _ => {}
-    }
-}
-
-/// A value that can be read from a document node.
-pub trait FromParam: Sized {
-    /// Converts, or says what was expected.
-    fn from_node(node: &Node) -> std::result::Result<Self, String>;
-}
-
-/// A finite number: TOML's `nan` and `inf` are valid floats, but no scene
-/// value means them, and a NaN would pass every range check (all its
-/// comparisons are false) and poison the render.
-fn number(node: &Node) -> std::result::Result<f64, String> {
-    let v = match node.value {
-        Value::Float(f) => f,
-        Value::Int(i) => i as f64,
-        ref v => return Err(format!("expected a number, found {}", v.type_name())),
-    };
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("expected a finite number, found {v}"))
-    }
-}
-
-/// A finite number that fits an `f32`.
-fn single(node: &Node) -> std::result::Result<f32, String> {
-    let v = number(node)?;
-    let single = v as f32;
-    if single.is_finite() {
-        Ok(single)
-    } else {
-        Err(format!("{v} is beyond the range of a 32-bit float"))
-    }
-}
-
-/// `N` numbers in an array; `expected` opens every message.
-fn floats<const N: usize>(node: &Node, expected: &str) -> std::result::Result<[f32; N], String> {
-    let Value::Array(items) = &node.value else {
-        return Err(format!("{expected}, found {}", node.value.type_name()));
-    };
-    if items.len() != N {
-        return Err(format!("{expected}, found {} elements", items.len()));
-    }
-    let mut out = [0.0; N];
-    for (i, (o, item)) in out.iter_mut().zip(items).enumerate() {
-        *o = single(item).map_err(|e| format!("{expected}; element {i}: {e}"))?;
-    }
-    Ok(out)
-}
-
-impl FromParam for f64 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        number(node)
-    }
-}
-
-impl FromParam for f32 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        single(node)
-    }
-}
-
-impl FromParam for i64 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        match node.value {
-            Value::Int(i) => Ok(i),
-            ref v => Err(format!("expected an integer, found {}", v.type_name())),
-        }
-    }
-}
-
-impl FromParam for u32 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        let i = i64::from_node(node)?;
-        u32::try_from(i).map_err(|_| format!("expected an integer in [0, {}], found {i}", u32::MAX))
-    }
-}
-
-impl FromParam for bool {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        match node.value {
-            Value::Bool(b) => Ok(b),
-            ref v => Err(format!("expected true or false, found {}", v.type_name())),
-        }
-    }
-}
-
-impl FromParam for String {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        match &node.value {
-            Value::String(s) => Ok(s.clone()),
-            v => Err(format!("expected a string, found {}", v.type_name())),
-        }
-    }
-}
-
-impl FromParam for Rgb {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        match &node.value {
-            Value::Float(_) | Value::Int(_) => Ok(Rgb::splat(single(node)?)),
-            Value::Array(_) => floats::<3>(node, "expected [r, g, b] or one number").map(Rgb::from),
-            v => Err(format!(
-                "expected [r, g, b] or one number, found {}",
-                v.type_name()
-            )),
-        }
-    }
-}
-
-impl FromParam for Vec3 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        floats::<3>(node, "expected an array of 3 numbers").map(Vec3::from)
-    }
-}
-
-impl FromParam for Vec2 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        floats::<2>(node, "expected an array of 2 numbers").map(Vec2::from)
-    }
-}
-
-impl FromParam for UVec2 {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        let expected = "expected an array of 2 non-negative integers";
-        let Value::Array(items) = &node.value else {
-            return Err(format!("{expected}, found {}", node.value.type_name()));
-        };
-        match items.as_slice() {
-            [a, b] => Ok(UVec2::new(
-                u32::from_node(a).map_err(|e| format!("{expected}: {e}"))?,
-                u32::from_node(b).map_err(|e| format!("{expected}: {e}"))?,
-            )),
-            _ => Err(format!("{expected}, found {} elements", items.len())),
-        }
-    }
-}
-
-impl<T: FromParam> FromParam for Vec<T> {
-    fn from_node(node: &Node) -> std::result::Result<Self, String> {
-        let Value::Array(items) = &node.value else {
-            return Err(format!(
-                "expected an array, found {}",
-                node.value.type_name()
-            ));
-        };
-        items
-            .iter()
-            .enumerate()
-            .map(|(i, n)| T::from_node(n).map_err(|e| format!("element {i}: {e}")))
-            .collect()
-    }
-}
 
 /// A plugin's table, checked against its declaration.
 pub struct Params<'a> {
@@ -387,7 +100,7 @@ impl<'a> Params<'a> {
 
     /// The node for `name` (given, or its default), marking it read.
     /// Borrowed when the table has it, so large values (mesh positions) are
-    /// not copied before conversion; defaults are parsed on demand.
+    /// not copied before conversion; defaults are converted on demand.
     fn node(&self, name: &str) -> Result<Option<Cow<'a, Node>>> {
         let i = self.spec_index(name);
         self.read.borrow_mut()[i] = true;
@@ -405,7 +118,7 @@ impl<'a> Params<'a> {
                 ),
             )),
             ParamDefault::Absent => Ok(None),
-            ParamDefault::Value(_) => Ok(self.spec[i].default_node()?.map(Cow::Owned)),
+            ParamDefault::Value(value) => Ok(Some(Cow::Owned(value.to_node()))),
         }
     }
 
@@ -436,27 +149,36 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// A file path. A relative path is resolved against the directory of
-    /// the scene file that wrote it, so a scene and its assets move
-    /// together; given with `--set` (or built in), it is relative to the
-    /// working directory.
-    pub fn get_path(&self, name: &str) -> Result<std::path::PathBuf> {
-        let Some(node) = self.node(name)? else {
-            return Err(self.error(name, "plugin bug: optional path read with get_path()"));
-        };
-        let text: String = self.convert(name, &node)?;
-        if text.is_empty() {
-            return Err(self.error(name, "expected a file path, found an empty string"));
+    /// A declared parameter's value, or its default, checked against its
+    /// declared range: what `#[derive(PluginParams)]` reads a field with.
+    pub fn value<T: Param>(&self, name: &str) -> Result<T> {
+        let v: T = self.get(name)?;
+        self.check_range(name, &v)?;
+        Ok(v)
+    }
+
+    /// [`Self::value`] for a parameter that may be absent.
+    pub fn optional_value<T: Param>(&self, name: &str) -> Result<Option<T>> {
+        let v: Option<T> = self.get_opt(name)?;
+        if let Some(v) = &v {
+            self.check_range(name, v)?;
         }
-        let path = std::path::PathBuf::from(&text);
-        Ok(match &node.location {
-            Location::File { path: scene, .. } if path.is_relative() => {
-                std::path::Path::new(&**scene)
-                    .parent()
-                    .map_or(path.clone(), |dir| dir.join(&path))
-            }
-            _ => path,
-        })
+        Ok(v)
+    }
+
+    fn check_range<T: Param>(&self, name: &str, v: &T) -> Result<()> {
+        match self.spec[self.spec_index(name)].range {
+            Some(range) => v.check_range(range).map_err(|e| self.error(name, e)),
+            None => Ok(()),
+        }
+    }
+
+    /// Marks `name` as not read, for a parameter that does not apply with
+    /// the other values given: [`Self::finish`] then rejects it if the
+    /// scene gave it.
+    pub fn unread(&self, name: &str) {
+        let i = self.spec_index(name);
+        self.read.borrow_mut()[i] = false;
     }
 
     /// Whether the scene gave `name` explicitly (marks it read).
@@ -571,12 +293,23 @@ fn accepted(spec: &[ParamSpec], structural: &[&str]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spectrum::Rgb;
 
     const SPEC: &[ParamSpec] = &[
         ParamSpec::required("reflectance", ParamType::Rgb, "albedo"),
-        ParamSpec::with_default("max_depth", ParamType::Int, "8", "path segments"),
-        ParamSpec::with_default("heuristic", ParamType::String, "\"power\"", "MIS heuristic")
-            .one_of(&["balance", "power"]),
+        ParamSpec::with_default(
+            "max_depth",
+            ParamType::Int,
+            ParamValue::Int(8),
+            "path segments",
+        ),
+        ParamSpec::with_default(
+            "heuristic",
+            ParamType::String,
+            ParamValue::Str("power"),
+            "MIS heuristic",
+        )
+        .one_of(&["balance", "power"]),
         ParamSpec::optional("beta", ParamType::Float, "power heuristic exponent"),
     ];
 
@@ -675,13 +408,13 @@ mod tests {
         let t = crate::doc::parse("file = \"tables/a.binary\"\n", "/scenes/s.toml").unwrap();
         let p = Params::new("bsdf", &t, Location::Builtin, FILE, &[]).unwrap();
         assert_eq!(
-            p.get_path("file").unwrap(),
+            p.get::<std::path::PathBuf>("file").unwrap(),
             std::path::Path::new("/scenes/tables/a.binary")
         );
         let t = crate::doc::parse("file = \"/abs/a.binary\"\n", "/scenes/s.toml").unwrap();
         let p = Params::new("bsdf", &t, Location::Builtin, FILE, &[]).unwrap();
         assert_eq!(
-            p.get_path("file").unwrap(),
+            p.get::<std::path::PathBuf>("file").unwrap(),
             std::path::Path::new("/abs/a.binary")
         );
     }

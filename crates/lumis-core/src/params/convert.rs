@@ -1,0 +1,247 @@
+//! How a document node becomes a typed value ([`FromParam`]), and which
+//! [`ParamType`] each Rust type declares ([`Param`]).
+
+use std::path::PathBuf;
+
+use glam::{UVec2, Vec2, Vec3};
+
+use super::ParamType;
+use crate::doc::{Node, Value};
+use crate::error::Location;
+use crate::spectrum::Rgb;
+
+/// A value that can be read from a document node.
+pub trait FromParam: Sized {
+    /// Converts, or says what was expected.
+    fn from_node(node: &Node) -> std::result::Result<Self, String>;
+}
+
+/// A finite number: TOML's `nan` and `inf` are valid floats, but no scene
+/// value means them, and a NaN would pass every range check (all its
+/// comparisons are false) and poison the render.
+fn number(node: &Node) -> std::result::Result<f64, String> {
+    let v = match node.value {
+        Value::Float(f) => f,
+        Value::Int(i) => i as f64,
+        ref v => return Err(format!("expected a number, found {}", v.type_name())),
+    };
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("expected a finite number, found {v}"))
+    }
+}
+
+/// A finite number that fits an `f32`.
+fn single(node: &Node) -> std::result::Result<f32, String> {
+    let v = number(node)?;
+    let single = v as f32;
+    if single.is_finite() {
+        Ok(single)
+    } else {
+        Err(format!("{v} is beyond the range of a 32-bit float"))
+    }
+}
+
+/// `N` numbers in an array; `expected` opens every message.
+fn floats<const N: usize>(node: &Node, expected: &str) -> std::result::Result<[f32; N], String> {
+    let Value::Array(items) = &node.value else {
+        return Err(format!("{expected}, found {}", node.value.type_name()));
+    };
+    if items.len() != N {
+        return Err(format!("{expected}, found {} elements", items.len()));
+    }
+    let mut out = [0.0; N];
+    for (i, (o, item)) in out.iter_mut().zip(items).enumerate() {
+        *o = single(item).map_err(|e| format!("{expected}; element {i}: {e}"))?;
+    }
+    Ok(out)
+}
+
+impl FromParam for f64 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        number(node)
+    }
+}
+
+impl FromParam for f32 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        single(node)
+    }
+}
+
+impl FromParam for i64 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match node.value {
+            Value::Int(i) => Ok(i),
+            ref v => Err(format!("expected an integer, found {}", v.type_name())),
+        }
+    }
+}
+
+impl FromParam for u32 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        let i = i64::from_node(node)?;
+        u32::try_from(i).map_err(|_| format!("expected an integer in [0, {}], found {i}", u32::MAX))
+    }
+}
+
+impl FromParam for bool {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match node.value {
+            Value::Bool(b) => Ok(b),
+            ref v => Err(format!("expected true or false, found {}", v.type_name())),
+        }
+    }
+}
+
+impl FromParam for String {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match &node.value {
+            Value::String(s) => Ok(s.clone()),
+            v => Err(format!("expected a string, found {}", v.type_name())),
+        }
+    }
+}
+
+impl FromParam for Rgb {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match &node.value {
+            Value::Float(_) | Value::Int(_) => Ok(Rgb::splat(single(node)?)),
+            Value::Array(_) => floats::<3>(node, "expected [r, g, b] or one number").map(Rgb::from),
+            v => Err(format!(
+                "expected [r, g, b] or one number, found {}",
+                v.type_name()
+            )),
+        }
+    }
+}
+
+impl FromParam for Vec3 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        floats::<3>(node, "expected an array of 3 numbers").map(Vec3::from)
+    }
+}
+
+impl FromParam for Vec2 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        floats::<2>(node, "expected an array of 2 numbers").map(Vec2::from)
+    }
+}
+
+impl FromParam for UVec2 {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        let expected = "expected an array of 2 non-negative integers";
+        let Value::Array(items) = &node.value else {
+            return Err(format!("{expected}, found {}", node.value.type_name()));
+        };
+        match items.as_slice() {
+            [a, b] => Ok(UVec2::new(
+                u32::from_node(a).map_err(|e| format!("{expected}: {e}"))?,
+                u32::from_node(b).map_err(|e| format!("{expected}: {e}"))?,
+            )),
+            _ => Err(format!("{expected}, found {} elements", items.len())),
+        }
+    }
+}
+
+impl<T: FromParam> FromParam for Vec<T> {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        let Value::Array(items) = &node.value else {
+            return Err(format!(
+                "expected an array, found {}",
+                node.value.type_name()
+            ));
+        };
+        items
+            .iter()
+            .enumerate()
+            .map(|(i, n)| T::from_node(n).map_err(|e| format!("element {i}: {e}")))
+            .collect()
+    }
+}
+
+impl FromParam for usize {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        u32::from_node(node).map(|v| v as usize)
+    }
+}
+
+/// A file path. A relative path is resolved against the directory of the
+/// scene file that wrote it, so a scene and its assets move together; given
+/// with `--set` (or built in), it is relative to the working directory.
+impl FromParam for PathBuf {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        let text = String::from_node(node)?;
+        if text.is_empty() {
+            return Err("expected a file path, found an empty string".into());
+        }
+        let path = PathBuf::from(text);
+        Ok(match &node.location {
+            Location::File { path: scene, .. } if path.is_relative() => {
+                std::path::Path::new(&**scene)
+                    .parent()
+                    .map_or(path.clone(), |dir| dir.join(&path))
+            }
+            _ => path,
+        })
+    }
+}
+
+/// A type a declared parameter can have: the [`ParamType`] its declaration
+/// shows, and the checks every value of it gets.
+pub trait Param: FromParam {
+    const TYPE: ParamType;
+    /// The valid strings, for a choice ([`ParamChoice`](super::ParamChoice)).
+    const CHOICES: &'static [&'static str] = &[];
+
+    /// Whether the value lies in `[min, max]`, or says it does not; only
+    /// numbers declare ranges (`ParamSpec::in_range` refuses others).
+    fn check_range(&self, (min, max): (f64, f64)) -> std::result::Result<(), String> {
+        Err(format!(
+            "a range [{min}, {max}] is declared on a parameter of type {}",
+            Self::TYPE.name()
+        ))
+    }
+}
+
+macro_rules! number_param {
+    ($($ty:ty => $param:ident),*) => {$(
+        impl Param for $ty {
+            const TYPE: ParamType = ParamType::$param;
+
+            fn check_range(&self, (min, max): (f64, f64)) -> std::result::Result<(), String> {
+                let v = *self as f64;
+                if v >= min && v <= max {
+                    Ok(())
+                } else {
+                    Err(format!("must be in [{min}, {max}], got {self}"))
+                }
+            }
+        }
+    )*};
+}
+
+number_param!(f32 => Float, f64 => Float, i64 => Int, u32 => Int, usize => Int);
+
+macro_rules! plain_param {
+    ($($ty:ty => $param:ident),*) => {$(
+        impl Param for $ty {
+            const TYPE: ParamType = ParamType::$param;
+        }
+    )*};
+}
+
+plain_param!(
+    bool => Bool,
+    String => String,
+    PathBuf => String,
+    Rgb => Rgb,
+    Vec2 => Vec2,
+    Vec3 => Vec3,
+    UVec2 => UIntPair,
+    Vec<f32> => FloatArray,
+    Vec<i64> => IntArray,
+    Vec<String> => StringArray,
+    Vec<Vec3> => Vec3Array
+);

@@ -1,0 +1,103 @@
+//! The parameters that choose a metal's reflectance, shared by `conductor`
+//! and `mirror`: a named metal, or its complex index of refraction.
+
+use lumis_core::{ParamChoice, Params, PluginParams, Result, Rgb};
+
+use crate::conductor::ConductorFresnel;
+use crate::fresnel;
+
+/// The `material` choice: a metal of [`fresnel::METALS`], or none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum MetalName {
+    /// A perfect reflector, Fresnel = 1.
+    None,
+    #[choice("Ag")]
+    Ag,
+    #[choice("Al")]
+    Al,
+    #[choice("Au")]
+    Au,
+    #[choice("Cr")]
+    Cr,
+    #[choice("Cu")]
+    Cu,
+    #[choice("Fe")]
+    Fe,
+    #[choice("Pt")]
+    Pt,
+}
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct MetalParams {
+    /// named metal (complex IOR at 650/550/450 nm) or none: a perfect
+    /// reflector, Fresnel = 1
+    #[param(default = None)]
+    pub material: MetalName,
+    /// real part of the IOR per channel, with k; replaces material
+    pub eta: Option<Rgb>,
+    /// imaginary part (absorption) of the IOR per channel, with eta
+    pub k: Option<Rgb>,
+    /// multiplies the Fresnel term (not physical; for artistic tints), each
+    /// channel in [0, 1]
+    #[param(default = 1.0)]
+    pub specular_reflectance: Rgb,
+}
+
+impl MetalParams {
+    /// The metal's Fresnel term: named, or given as `eta` and `k`.
+    pub fn fresnel(&self, params: &Params) -> Result<ConductorFresnel> {
+        let keys = Self::KEYS;
+        match (self.eta, self.k) {
+            (None, None) => Ok(match self.material {
+                MetalName::None => ConductorFresnel::Perfect,
+                named => {
+                    let metal = fresnel::metal(named.name())
+                        .expect("every MetalName is tabulated in fresnel::METALS (tested)");
+                    ConductorFresnel::Complex {
+                        eta: metal.eta.into(),
+                        k: metal.k.into(),
+                    }
+                }
+            }),
+            (Some(eta), Some(k)) => {
+                if params.is_given(keys.material) {
+                    return Err(
+                        params.error(keys.material, "give either material or eta and k, not both")
+                    );
+                }
+                if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
+                    return Err(params.error(
+                        keys.eta,
+                        format!("eta must be > 0 and k >= 0 per channel, got eta {eta:?}, k {k:?}"),
+                    ));
+                }
+                Ok(ConductorFresnel::Complex { eta, k })
+            }
+            (Some(_), None) => Err(params.error(keys.eta, "needs k too (the absorption)")),
+            (None, Some(_)) => Err(params.error(keys.k, "needs eta too (the real part)")),
+        }
+    }
+
+    /// `specular_reflectance`, each channel in [0, 1].
+    pub fn scale(&self, params: &Params) -> Result<Rgb> {
+        let scale = self.specular_reflectance;
+        if !(scale.min_component() >= 0.0 && scale.max_component() <= 1.0) {
+            return Err(params.error(
+                Self::KEYS.specular_reflectance,
+                format!("each channel must be in [0, 1], got {scale:?}"),
+            ));
+        }
+        Ok(scale)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metal_names_are_the_choices() {
+        let names: Vec<&str> = fresnel::METALS.iter().map(|m| m.name).collect();
+        assert_eq!(&MetalName::NAMES[1..], names.as_slice());
+    }
+}
