@@ -311,7 +311,7 @@ const fn contains(names: &[&str], name: &str) -> bool {
 
 const PLACEHOLDER: ParamSpec = ParamSpec::required("", ParamType::Bool, "");
 
-/// The number of parameters in `parts`, for [`concat`]'s length.
+/// The number of parameters in `parts`, for [`concat()`]'s length.
 pub const fn total_len(parts: &[&[ParamSpec]]) -> usize {
     let mut n = 0;
     let mut i = 0;
