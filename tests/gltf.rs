@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use lumis_core::registry::TableRef;
-use lumis_core::{BsdfContext, Location, Ray, Scene, Vec2, Vec3};
+use lumis_core::entity::TYPE_KEY;
+use lumis_core::{Bsdf, BsdfContext, Location, PluginEntity, PluginKind, Ray, Scene, Vec2, Vec3};
 use lumis_render::{render, RenderSettings};
 use lumis_scene::LoadedScene;
 use lumis_tests::gltf_writer::{self, Asset, Camera, Container, Material, Mesh, Node, Primitive};
@@ -336,16 +336,15 @@ fn dielectric(rgb: [f32; 3]) -> [f32; 3] {
     let text = format!("type = \"plastic\"\n{}", plastic_params(rgb, 1.0));
     let table = lumis_core::doc::parse(&text, "expected").unwrap();
     let registry = lumis_cli::builtin_registry().unwrap();
-    let bsdf = registry
-        .create_bsdf(&TableRef {
-            owner: "expected",
-            table: &table,
-            location: &Location::Builtin,
-            type_name: "plastic",
-            type_location: &Location::Builtin,
-            structural: &["type"],
-        })
-        .unwrap();
+    let entity = PluginEntity::from_table(
+        PluginKind::Bsdf,
+        "expected",
+        table,
+        Location::Builtin,
+        TYPE_KEY,
+    )
+    .unwrap();
+    let bsdf = registry.create::<dyn Bsdf>(&entity, ()).unwrap();
     let f = bsdf.f(&BsdfContext::default(), Vec3::Z, Vec3::Z);
     let pi = std::f32::consts::PI;
     [f.r * pi, f.g * pi, f.b * pi]

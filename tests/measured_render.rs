@@ -63,20 +63,15 @@ fn temp_dir(tag: &str) -> PathBuf {
 fn bsdf(toml: &str) -> std::sync::Arc<dyn Bsdf> {
     let registry = lumis_cli::builtin_registry().unwrap();
     let table = lumis_core::doc::parse(toml, "<test>").unwrap();
-    let type_name = match table.get("type").map(|n| &n.value) {
-        Some(lumis_core::doc::Value::String(s)) => s.clone(),
-        _ => panic!("no type in {toml}"),
-    };
-    registry
-        .create_bsdf(&lumis_core::registry::TableRef {
-            owner: "bsdf",
-            table: &table,
-            location: &lumis_core::Location::Builtin,
-            type_name: &type_name,
-            type_location: &lumis_core::Location::Builtin,
-            structural: &["type"],
-        })
-        .unwrap()
+    let entity = lumis_core::PluginEntity::from_table(
+        lumis_core::PluginKind::Bsdf,
+        "bsdf",
+        table,
+        lumis_core::Location::Builtin,
+        lumis_core::entity::TYPE_KEY,
+    )
+    .unwrap();
+    registry.create::<dyn Bsdf>(&entity, ()).unwrap()
 }
 
 /// Directional albedo (luminance) from `wo` by the BSDF's own sampling,

@@ -19,10 +19,9 @@ use std::sync::Arc;
 
 use lumis_core::doc::{self, Table};
 use lumis_core::params::ParamDefault;
-use lumis_core::registry::TableRef;
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginKind, PluginSpec, Registry,
-    Result, Rgb, TransportMode, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginEntity, PluginKind, PluginSpec,
+    Registry, Result, Rgb, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -204,14 +203,14 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
 /// The BSDF plugin `name` with the parameters of `variant`.
 pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
     let owner = format!("bsdf \"{name}\" [{}]", variant.label);
-    registry.create_bsdf(&TableRef {
-        owner: &owner,
-        table: &variant.table,
-        location: &Location::Builtin,
-        type_name: name,
-        type_location: &Location::Builtin,
-        structural: &[],
-    })
+    let entity = PluginEntity::new(
+        PluginKind::Bsdf,
+        owner,
+        name,
+        variant.table.clone(),
+        Location::Builtin,
+    );
+    registry.create::<dyn Bsdf>(&entity, ())
 }
 
 fn direction(cos_theta: f32, phi: f32) -> Vec3 {

@@ -7,8 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use lumis_core::registry::TableRef;
-use lumis_core::{Error, Location, Registry, Result};
+use lumis_core::{Bsdf, Error, Location, PluginEntity, PluginKind, Registry, Result};
 use lumis_measured::grid::Grid;
 use lumis_measured::merl::{write_atomic, MerlTable, THETA_H_RES};
 use lumis_measured::precompute::{prepare, Plan};
@@ -51,14 +50,14 @@ pub struct PrecomputeArgs {
 pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String> {
     let table = parameter_table(&args.set)?;
     let owner = format!("bsdf \"{}\"", args.bsdf);
-    let bsdf = registry.create_bsdf(&TableRef {
-        owner: &owner,
-        table: &table,
-        location: &Location::Builtin,
-        type_name: &args.bsdf,
-        type_location: &Location::Builtin,
-        structural: &[],
-    })?;
+    let entity = PluginEntity::new(
+        PluginKind::Bsdf,
+        owner,
+        &args.bsdf,
+        table,
+        Location::Builtin,
+    );
+    let bsdf = registry.create::<dyn Bsdf>(&entity, ())?;
     let progress = if args.quiet {
         ProgressBar::hidden()
     } else {

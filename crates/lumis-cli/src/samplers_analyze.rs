@@ -12,8 +12,7 @@ use lumis_analysis::plot::{self, Axes, Series};
 use lumis_analysis::spectrum::{periodogram, radial_average};
 use lumis_analysis::{l2_star_discrepancy, sample_points, PointSet};
 use lumis_core::doc;
-use lumis_core::registry::TableRef;
-use lumis_core::{Error, Location, PluginKind, Registry, Result, Sampler, UVec2};
+use lumis_core::{Error, Location, PluginEntity, PluginKind, Registry, Result, Sampler, UVec2};
 
 use crate::assignments::parameter_text;
 
@@ -71,14 +70,14 @@ fn make_sampler(
 ) -> Result<Box<dyn Sampler>> {
     let text = format!("spp = {count}\n{}", parameter_text(params)?);
     let table = doc::parse(&text, "--set")?;
-    registry.create_sampler(&TableRef {
-        owner: "sampler",
-        table: &table,
-        location: &Location::Builtin,
-        type_name: name,
-        type_location: &Location::Builtin,
-        structural: &[],
-    })
+    let entity = PluginEntity::new(
+        PluginKind::Sampler,
+        "sampler",
+        name,
+        table,
+        Location::Builtin,
+    );
+    registry.create::<dyn Sampler>(&entity, ())
 }
 
 fn sampler_names(registry: &Registry, requested: &str) -> Result<Vec<String>> {

@@ -92,6 +92,63 @@ impl Table {
     pub fn keys(&self) -> impl Iterator<Item = &str> {
         self.entries.iter().map(|e| e.key.as_str())
     }
+
+    /// Takes `key` out of the table.
+    pub fn remove(&mut self, key: &str) -> Option<Entry> {
+        let i = self.entries.iter().position(|e| e.key == key)?;
+        Some(self.entries.remove(i))
+    }
+
+    /// A table built in code: every key and value (nested ones too) is
+    /// said to come from `location`.
+    pub fn built<'k>(
+        location: &Location,
+        entries: impl IntoIterator<Item = (&'k str, Value)>,
+    ) -> Table {
+        let mut table = Table::default();
+        for (key, value) in entries {
+            let mut node = Node {
+                value,
+                location: location.clone(),
+            };
+            relocate(&mut node, location);
+            table.insert(key, node);
+        }
+        table
+    }
+}
+
+impl From<bool> for Value {
+    fn from(b: bool) -> Self {
+        Value::Bool(b)
+    }
+}
+
+impl From<f32> for Value {
+    /// Exact: reading the value back as an `f32` gives `f`.
+    fn from(f: f32) -> Self {
+        Value::Float(f64::from(f))
+    }
+}
+
+impl From<&str> for Value {
+    fn from(s: &str) -> Self {
+        Value::String(s.to_string())
+    }
+}
+
+impl From<[f32; 3]> for Value {
+    /// An array of three numbers (located by [`Table::built`]).
+    fn from(v: [f32; 3]) -> Self {
+        Value::Array(
+            v.into_iter()
+                .map(|c| Node {
+                    value: c.into(),
+                    location: Location::Builtin,
+                })
+                .collect(),
+        )
+    }
 }
 
 /// Maps byte offsets to 1-based line and column.
@@ -345,5 +402,32 @@ mod tests {
         assert!(apply_override(&mut doc, "bsdf.blue.reflectance=1").is_err());
         assert!(apply_override(&mut doc, "film.resolution.x=1").is_err());
         assert!(apply_override(&mut doc, "film..x=1").is_err());
+    }
+}
+
+#[cfg(test)]
+mod built_tables {
+    use super::*;
+
+    #[test]
+    fn built_values_are_exact_and_located() {
+        let at = Location::Override(Arc::from("here"));
+        let third = 1.0f32 / 3.0;
+        let table = Table::built(
+            &at,
+            [
+                ("x", Value::from(third)),
+                ("rgb", Value::from([0.1f32, 0.2, 0.3])),
+            ],
+        );
+        let Value::Float(x) = table.get("x").unwrap().value else {
+            panic!("a float")
+        };
+        assert_eq!(x as f32, third);
+        let Value::Array(rgb) = &table.get("rgb").unwrap().value else {
+            panic!("an array")
+        };
+        assert!(rgb.iter().all(|n| n.location == at));
+        assert_eq!(table.entry("rgb").unwrap().key_location, at);
     }
 }

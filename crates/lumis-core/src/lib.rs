@@ -11,6 +11,7 @@ extern crate self as lumis_core;
 
 pub mod bsdf;
 pub mod doc;
+pub mod entity;
 pub mod error;
 pub mod integrator;
 pub mod interaction;
@@ -27,6 +28,7 @@ pub mod spectrum;
 pub mod stats;
 
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
+pub use entity::PluginEntity;
 pub use error::{Error, Location, Result};
 pub use integrator::Integrator;
 pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
@@ -35,7 +37,7 @@ pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;
 pub use params::{ParamChoice, ParamSpec, ParamType, ParamValue, Params, PluginParams};
 pub use ray::Ray;
-pub use registry::{PluginKind, PluginSpec, Registry};
+pub use registry::{PluginInterface, PluginKind, PluginSpec, Registry};
 pub use sampler::{ConcreteLanes, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;

@@ -9,8 +9,8 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::bsdf::Bsdf;
-use crate::doc::Table;
-use crate::error::{Error, Location, Result};
+use crate::entity::PluginEntity;
+use crate::error::{Error, Result};
 use crate::integrator::Integrator;
 use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
@@ -73,15 +73,6 @@ pub type LightFactory = fn(&Params, &LightShape) -> Result<Box<dyn Light>>;
 pub type LightSamplerFactory = fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>>;
 pub type IntegratorFactory = fn(&Params) -> Result<Box<dyn Integrator>>;
 
-#[derive(Clone, Copy)]
-enum Factory {
-    Sampler(SamplerFactory),
-    Bsdf(BsdfFactory),
-    Light(LightFactory),
-    LightSampler(LightSamplerFactory),
-    Integrator(IntegratorFactory),
-}
-
 /// A registered plugin and where it came from.
 #[derive(Clone)]
 pub struct Registered {
@@ -102,19 +93,6 @@ impl Default for Registry {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// Where a plugin table sits in the scene, for error messages.
-pub struct TableRef<'a> {
-    /// E.g. `bsdf "white"` or `integrator`.
-    pub owner: &'a str,
-    pub table: &'a Table,
-    pub location: &'a Location,
-    /// The `type = "..."` value and where it was written.
-    pub type_name: &'a str,
-    pub type_location: &'a Location,
-    /// Keys the scene loader reads itself (`type`, `name`, ...).
-    pub structural: &'a [&'a str],
 }
 
 impl Registry {
@@ -202,89 +180,287 @@ impl Registry {
         all
     }
 
-    /// Looks up the plugin named by `table.type_name` and checks the table
-    /// against its declaration.
-    fn lookup<'t>(&self, kind: PluginKind, table: &TableRef<'t>) -> Result<(Factory, Params<'t>)> {
-        let Some(plugin) = self.find(kind, table.type_name) else {
-            let mut names: Vec<&str> = self
-                .plugins
-                .iter()
-                .filter(|p| p.spec.kind == kind)
-                .map(|p| p.spec.name)
-                .collect();
-            names.sort_unstable();
+    /// Creates the plugin `entity` describes: looks it up by kind and
+    /// `type`, checks its table against the plugin's declaration, calls the
+    /// factory with `input` and rejects keys the plugin did not read. The
+    /// one path by which any plugin is made:
+    /// `registry.create::<dyn Bsdf>(&entity, ())`.
+    pub fn create<P: PluginInterface + ?Sized>(
+        &self,
+        entity: &PluginEntity,
+        input: P::Input<'_>,
+    ) -> Result<P::Made> {
+        if entity.kind != P::KIND {
             return Err(Error::at(
-                table.type_location,
+                &entity.location,
                 format!(
-                    "unknown {kind} type \"{}\" for {}; available: {}",
-                    table.type_name,
-                    table.owner,
-                    if names.is_empty() {
-                        "none".into()
-                    } else {
-                        names.join(", ")
-                    }
+                    "{}: a {} plugin where a {} plugin is expected",
+                    entity.owner,
+                    entity.kind,
+                    P::KIND
                 ),
             ));
+        }
+        let Some(plugin) = self.find(P::KIND, &entity.type_name) else {
+            return Err(self.unknown_type(entity));
         };
-        let owner = format!("{} (type = \"{}\")", table.owner, table.type_name);
         let params = Params::new(
-            owner,
-            table.table,
-            table.location.clone(),
+            format!("{} (type = \"{}\")", entity.owner, entity.type_name),
+            &entity.table,
+            entity.location.clone(),
             plugin.spec.params,
-            table.structural,
+            entity.structural,
         )?;
-        Ok((plugin.factory, params))
-    }
-
-    pub fn create_sampler(&self, table: &TableRef) -> Result<Box<dyn Sampler>> {
-        let (Factory::Sampler(f), params) = self.lookup(PluginKind::Sampler, table)? else {
-            unreachable!("kind checked at registration")
-        };
-        let made = f(&params)?;
+        let made = P::call(plugin.factory, &params, input)?;
         params.finish()?;
         Ok(made)
     }
 
-    pub fn create_bsdf(&self, table: &TableRef) -> Result<Arc<dyn Bsdf>> {
-        let (Factory::Bsdf(f), params) = self.lookup(PluginKind::Bsdf, table)? else {
-            unreachable!("kind checked at registration")
-        };
-        let made = f(&params)?;
-        params.finish()?;
-        Ok(made)
+    fn unknown_type(&self, entity: &PluginEntity) -> Error {
+        let mut names: Vec<&str> = self
+            .plugins
+            .iter()
+            .filter(|p| p.spec.kind == entity.kind)
+            .map(|p| p.spec.name)
+            .collect();
+        names.sort_unstable();
+        Error::at(
+            &entity.type_location,
+            format!(
+                "unknown {} type \"{}\" for {}; available: {}",
+                entity.kind,
+                entity.type_name,
+                entity.owner,
+                if names.is_empty() {
+                    "none".into()
+                } else {
+                    names.join(", ")
+                }
+            ),
+        )
+    }
+}
+
+/// A plugin interface: its kind, what its factory takes besides the
+/// parameters, and what it makes. Implemented for the five plugin traits
+/// (`dyn Sampler`, `dyn Bsdf`, ...), which name the kind in
+/// [`Registry::create`].
+pub trait PluginInterface: sealed::Sealed {
+    const KIND: PluginKind;
+    /// What the factory returns.
+    type Made;
+    /// What the factory takes besides its parameters: the shape an area
+    /// light is attached to, the lights a light sampler chooses among.
+    type Input<'i>;
+    #[doc(hidden)]
+    fn call(
+        factory: sealed::Factory,
+        params: &Params,
+        input: Self::Input<'_>,
+    ) -> Result<Self::Made>;
+}
+
+mod sealed {
+    use super::*;
+
+    pub trait Sealed {}
+
+    /// A registered factory, by kind.
+    #[derive(Clone, Copy)]
+    pub enum Factory {
+        Sampler(SamplerFactory),
+        Bsdf(BsdfFactory),
+        Light(LightFactory),
+        LightSampler(LightSamplerFactory),
+        Integrator(IntegratorFactory),
     }
 
-    pub fn create_light(&self, table: &TableRef, shape: &LightShape) -> Result<Box<dyn Light>> {
-        let (Factory::Light(f), params) = self.lookup(PluginKind::Light, table)? else {
-            unreachable!("kind checked at registration")
+    impl Sealed for dyn Sampler {}
+    impl Sealed for dyn Bsdf {}
+    impl Sealed for dyn Light {}
+    impl Sealed for dyn LightSampler {}
+    impl Sealed for dyn Integrator {}
+}
+
+use sealed::Factory;
+
+/// Registration checks that a plugin's factory is of its declared kind, and
+/// [`Registry::create`] looks plugins up by kind: a factory of another kind
+/// never reaches these calls.
+const KIND_CHECKED: &str = "factory kind checked at registration and lookup";
+
+impl PluginInterface for dyn Sampler {
+    const KIND: PluginKind = PluginKind::Sampler;
+    type Made = Box<dyn Sampler>;
+    type Input<'i> = ();
+    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Sampler(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
         };
-        let made = f(&params, shape)?;
-        params.finish()?;
-        Ok(made)
+        f(params)
+    }
+}
+
+impl PluginInterface for dyn Bsdf {
+    const KIND: PluginKind = PluginKind::Bsdf;
+    type Made = Arc<dyn Bsdf>;
+    type Input<'i> = ();
+    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Bsdf(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params)
+    }
+}
+
+impl PluginInterface for dyn Light {
+    const KIND: PluginKind = PluginKind::Light;
+    type Made = Box<dyn Light>;
+    type Input<'i> = &'i LightShape;
+    fn call(factory: Factory, params: &Params, shape: &LightShape) -> Result<Self::Made> {
+        let Factory::Light(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params, shape)
+    }
+}
+
+impl PluginInterface for dyn LightSampler {
+    const KIND: PluginKind = PluginKind::LightSampler;
+    type Made = Box<dyn LightSampler>;
+    type Input<'i> = &'i [Box<dyn Light>];
+    fn call(factory: Factory, params: &Params, lights: &[Box<dyn Light>]) -> Result<Self::Made> {
+        let Factory::LightSampler(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params, lights)
+    }
+}
+
+impl PluginInterface for dyn Integrator {
+    const KIND: PluginKind = PluginKind::Integrator;
+    type Made = Box<dyn Integrator>;
+    type Input<'i> = ();
+    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Integrator(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Vec2, Vec3};
+
+    use super::*;
+    use crate::bsdf::{BsdfContext, BsdfFlags, BsdfSample};
+    use crate::doc::{self, Table, Value};
+    use crate::entity::TYPE_KEY;
+    use crate::error::Location;
+    use crate::params::ParamType;
+    use crate::spectrum::Rgb;
+
+    /// A BSDF of one parameter, `albedo`, returned by `f`.
+    struct Grey(Rgb);
+
+    impl Bsdf for Grey {
+        fn flags(&self) -> BsdfFlags {
+            BsdfFlags::DIFFUSE_REFLECTION
+        }
+        fn f(&self, _: &BsdfContext, _: Vec3, _: Vec3) -> Rgb {
+            self.0
+        }
+        fn sample_f(&self, _: &BsdfContext, _: Vec3, _: f32, _: Vec2) -> Option<BsdfSample> {
+            None
+        }
+        fn pdf(&self, _: &BsdfContext, _: Vec3, _: Vec3) -> f32 {
+            0.0
+        }
     }
 
-    pub fn create_light_sampler(
-        &self,
-        table: &TableRef,
-        lights: &[Box<dyn Light>],
-    ) -> Result<Box<dyn LightSampler>> {
-        let (Factory::LightSampler(f), params) = self.lookup(PluginKind::LightSampler, table)?
-        else {
-            unreachable!("kind checked at registration")
-        };
-        let made = f(&params, lights)?;
-        params.finish()?;
-        Ok(made)
+    const GREY: PluginSpec = PluginSpec {
+        kind: PluginKind::Bsdf,
+        name: "grey",
+        doc: "test",
+        params: &[ParamSpec::required("albedo", ParamType::Rgb, "albedo")],
+    };
+
+    fn registry() -> Registry {
+        let mut registry = Registry::new();
+        registry
+            .add_bsdf(GREY, |p| Ok(Arc::new(Grey(p.get("albedo")?))))
+            .unwrap();
+        registry
     }
 
-    pub fn create_integrator(&self, table: &TableRef) -> Result<Box<dyn Integrator>> {
-        let (Factory::Integrator(f), params) = self.lookup(PluginKind::Integrator, table)? else {
-            unreachable!("kind checked at registration")
-        };
-        let made = f(&params)?;
-        params.finish()?;
-        Ok(made)
+    fn entity(text: &str, kind: PluginKind) -> PluginEntity {
+        let table = doc::parse(text, "s.toml").unwrap();
+        PluginEntity::from_table(kind, "bsdf \"a\"", table, Location::Builtin, TYPE_KEY).unwrap()
+    }
+
+    #[test]
+    fn creates_from_a_document_table_and_from_a_built_one() {
+        let registry = registry();
+        let read = entity("type = \"grey\"\nalbedo = 0.25\n", PluginKind::Bsdf);
+        let bsdf = registry.create::<dyn Bsdf>(&read, ()).unwrap();
+        let ctx = BsdfContext::default();
+        assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.25));
+
+        let table = Table::built(&Location::Builtin, [("albedo", Value::from([0.5f32; 3]))]);
+        let built = PluginEntity::new(PluginKind::Bsdf, "x", "grey", table, Location::Builtin);
+        let bsdf = registry.create::<dyn Bsdf>(&built, ()).unwrap();
+        assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.5));
+    }
+
+    #[test]
+    fn errors_name_the_type_key_and_kind() {
+        let registry = registry();
+        let unknown = entity("type = \"gray\"\n", PluginKind::Bsdf);
+        let err = registry.create::<dyn Bsdf>(&unknown, ()).err().unwrap();
+        let text = err.to_string();
+        assert!(
+            text.starts_with("s.toml:1:8")
+                && text.contains("unknown bsdf type \"gray\" for bsdf \"a\"; available: grey"),
+            "{text}"
+        );
+
+        let typo = entity(
+            "type = \"grey\"\nalbedo = 0.5\nalbedoo = 1\n",
+            PluginKind::Bsdf,
+        );
+        let err = registry.create::<dyn Bsdf>(&typo, ()).err().unwrap();
+        assert!(
+            err.to_string().starts_with("s.toml:3:1") && err.message.contains("'albedoo'"),
+            "{err}"
+        );
+
+        let light = entity("type = \"grey\"\nalbedo = 0.5\n", PluginKind::Light);
+        let err = registry.create::<dyn Bsdf>(&light, ()).err().unwrap();
+        assert!(
+            err.message
+                .contains("a light plugin where a bsdf plugin is expected"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_table_without_a_type_is_refused_or_defaulted() {
+        let table = doc::parse("albedo = 0.5\n", "s.toml").unwrap();
+        let err = PluginEntity::from_table(
+            PluginKind::Bsdf,
+            "bsdf \"a\"",
+            table.clone(),
+            Location::Builtin,
+            TYPE_KEY,
+        )
+        .err()
+        .unwrap();
+        assert!(err.message.contains("bsdf \"a\" needs a type"), "{err}");
+        let defaulted =
+            PluginEntity::from_table_or(PluginKind::Bsdf, "b", table, Location::Builtin, "grey")
+                .unwrap();
+        assert_eq!(defaulted.type_name, "grey");
+        assert!(registry().create::<dyn Bsdf>(&defaulted, ()).is_ok());
     }
 }

@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::accel::{Compaction, AUTO_COMPACT_TRIANGLES};
+use crate::description::{Compaction, AUTO_COMPACT_TRIANGLES};
 use crate::render_scene::SceneCounts;
 
 /// Times and sizes measured while a scene loads.
@@ -97,7 +97,6 @@ impl LoadReport {
 #[derive(Debug, Clone, Copy)]
 pub(crate) enum Phase {
     Parse,
-    Attributes,
     Bvh,
 }
 
@@ -109,7 +108,6 @@ impl LoadReport {
         let elapsed = start.elapsed();
         match phase {
             Phase::Parse => self.parse += elapsed,
-            Phase::Attributes => self.attributes += elapsed,
             Phase::Bvh => self.bvh += elapsed,
         }
         out

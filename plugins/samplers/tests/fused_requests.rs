@@ -4,8 +4,7 @@
 //! same holds for its batched form over a sampler's lanes.
 
 use lumis_core::doc;
-use lumis_core::registry::TableRef;
-use lumis_core::{Location, PluginKind, Registry, Sampler, UVec2};
+use lumis_core::{Location, PluginEntity, PluginKind, Registry, Sampler, UVec2};
 
 const SPP: u32 = 512;
 
@@ -35,15 +34,15 @@ fn variants(registry: &Registry) -> Vec<(String, Box<dyn Sampler>)> {
                     }
                 }
                 let table = doc::parse(&text, "test.toml").unwrap();
+                let entity = PluginEntity::new(
+                    PluginKind::Sampler,
+                    "sampler",
+                    plugin.spec.name,
+                    table,
+                    Location::Builtin,
+                );
                 let sampler = registry
-                    .create_sampler(&TableRef {
-                        owner: "sampler",
-                        table: &table,
-                        location: &Location::Builtin,
-                        type_name: plugin.spec.name,
-                        type_location: &Location::Builtin,
-                        structural: &[],
-                    })
+                    .create::<dyn Sampler>(&entity, ())
                     .unwrap_or_else(|e| panic!("{}: {e}", plugin.spec.name));
                 out.push((format!("{} {text:?}", plugin.spec.name), sampler));
             }

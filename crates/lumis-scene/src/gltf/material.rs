@@ -1,10 +1,11 @@
 //! glTF metallic-roughness materials to lumis BSDF plugins and emission.
 //!
-//! The mapping is one function, [`bsdf_table`], that writes the TOML table
-//! of a BSDF plugin, which the registry then instantiates like any
+//! The mapping is one function, [`bsdf_entity`], that describes a BSDF
+//! plugin as a [`PluginEntity`], which the assembly then creates like any
 //! `[[bsdf]]`.
 
-use lumis_core::Rgb;
+use lumis_core::doc::{Table, Value};
+use lumis_core::{Location, PluginEntity, PluginKind, Rgb};
 
 /// Materials at least this metallic are rendered as metal; glTF's blend
 /// of a metal and a dielectric lobe by `metallic` has no lumis BSDF.
@@ -13,8 +14,8 @@ const METALLIC_THRESHOLD: f32 = 0.5;
 /// The glTF dielectric's coat: IOR 1.5 (its specular F0 of 0.04).
 const DIELECTRIC_IOR: f32 = 1.5;
 
-/// A BSDF plugin table (`type = ...` and its parameters) for `material`,
-/// and what the mapping had to leave out. Both kinds have GGX normals of
+/// The BSDF plugin for `material` (its parameters located at `at`, named
+/// `owner` in messages), and what the mapping had to leave out. Both kinds have GGX normals of
 /// `alpha = roughness^2` (the glTF specification's remapping; below the
 /// plugins' 1e-3 floor the lobe is a mirror).
 ///
@@ -30,10 +31,12 @@ const DIELECTRIC_IOR: f32 = 1.5;
 /// colour texture tints the conductor's reflectance or the plastic's base
 /// (the caller wraps the BSDF). What is approximated is said in the
 /// warnings.
-pub(crate) fn bsdf_table(
+pub(crate) fn bsdf_entity(
     material: &gltf::Material,
     label: &str,
-) -> Result<(String, Vec<String>), String> {
+    owner: String,
+    at: &Location,
+) -> Result<(PluginEntity, Vec<String>), String> {
     let pbr = material.pbr_metallic_roughness();
     let [r, g, b, _alpha] = pbr.base_color_factor();
     if ![r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) {
@@ -42,13 +45,18 @@ pub(crate) fn bsdf_table(
             [r, g, b]
         ));
     }
+    let rgb = [r, g, b];
+    let entity = |type_name: &str, params: Vec<(&str, Value)>| {
+        let table = Table::built(at, params);
+        PluginEntity::new(PluginKind::Bsdf, owner, type_name, table, at.clone())
+    };
     let mut warnings = Vec::new();
     // The default material (no index) is metallic 1 and roughness 1 by the
     // spec's defaults, a rough white metal; lumis renders it as the matte
     // grey most exporters mean by "no material", and reports nothing.
     let Some(_) = material.index() else {
         return Ok((
-            format!("type = \"diffuse\"\nreflectance = [{r:?}, {g:?}, {b:?}]\n"),
+            entity("diffuse", vec![("reflectance", rgb.into())]),
             warnings,
         ));
     };
@@ -66,16 +74,28 @@ pub(crate) fn bsdf_table(
         ));
     }
     let alpha = (roughness * roughness).clamp(0.0, 1.0);
-    let table = if metallic >= METALLIC_THRESHOLD {
-        format!(
-            "type = \"conductor\"\ndistribution = \"ggx\"\nroughness = {alpha:?}\nspecular_reflectance = [{r:?}, {g:?}, {b:?}]\n"
+    let bsdf = if metallic >= METALLIC_THRESHOLD {
+        entity(
+            "conductor",
+            vec![
+                ("distribution", "ggx".into()),
+                ("roughness", alpha.into()),
+                ("specular_reflectance", rgb.into()),
+            ],
         )
     } else {
-        format!(
-            "type = \"plastic\"\ndiffuse_reflectance = [{r:?}, {g:?}, {b:?}]\nint_ior = {DIELECTRIC_IOR:?}\next_ior = 1.0\ndistribution = \"ggx\"\nroughness = {alpha:?}\n"
+        entity(
+            "plastic",
+            vec![
+                ("diffuse_reflectance", rgb.into()),
+                ("int_ior", DIELECTRIC_IOR.into()),
+                ("ext_ior", 1.0f32.into()),
+                ("distribution", "ggx".into()),
+                ("roughness", alpha.into()),
+            ],
         )
     };
-    Ok((table, warnings))
+    Ok((bsdf, warnings))
 }
 
 /// Emitted radiance of `material`: `emissiveFactor` times
@@ -94,10 +114,18 @@ pub(crate) fn emission(material: &gltf::Material, label: &str) -> Result<Option<
     Ok((radiance.max_component() > 0.0).then_some(radiance))
 }
 
-/// The light plugin table of an emissive material's triangles.
-pub(crate) fn emission_table(radiance: Rgb, two_sided: bool) -> String {
-    format!(
-        "radiance = [{:?}, {:?}, {:?}]\ntwo_sided = {two_sided}\n",
-        radiance.r, radiance.g, radiance.b
-    )
+/// The light plugin every triangle of an emissive material gets (its
+/// parameters located at `at`, named `owner` in messages).
+pub(crate) fn emission_entity(
+    radiance: Rgb,
+    two_sided: bool,
+    owner: String,
+    at: &Location,
+) -> PluginEntity {
+    let params = vec![
+        ("radiance", [radiance.r, radiance.g, radiance.b].into()),
+        ("two_sided", two_sided.into()),
+    ];
+    let table = Table::built(at, params);
+    PluginEntity::new(PluginKind::Light, owner, "triangle", table, at.clone())
 }

@@ -1,43 +1,69 @@
 //! Which BSDF, emission and texture coordinates each material of an asset
-//! gets: the TOML's `bsdf` and `bsdf_overrides` first, else the mapping of
-//! [`super::material`], with base colour textures decoded here while the
-//! asset's buffers are still loaded.
+//! gets: the scene's `bsdf` and `bsdf_overrides` first, else the mapping of
+//! [`super::material`], with textures decoded here while the asset's
+//! buffers are still loaded.
 
 use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use lumis_core::doc::{self, Node, Table, Value};
-use lumis_core::registry::TableRef;
-use lumis_core::{Error, Location, Result};
+use lumis_core::{Error, PluginEntity, Result};
 
-use super::{buffers, material, texture, two_sided, GltfShape};
-use crate::Assembly;
+use super::texture::{Texture, Wrap};
+use super::{buffers, material, ImportRequest};
+use crate::bsdf_ref::BsdfRef;
 
-/// What a glTF material became: a BSDF of the scene and, if it emits, the
-/// light table its triangles share.
-#[derive(Clone)]
-pub(crate) struct Resolved {
-    pub bsdf: u32,
-    pub emission: Option<Table>,
-    /// An emissive texture scaling the emission, read at the same uv set.
-    pub emission_texture: Option<Arc<texture::Texture>>,
-    /// The TEXCOORD set the BSDF's texture reads, if it has one.
+/// What a glTF material becomes.
+pub(crate) struct ImportedMaterial {
+    pub bsdf: MaterialBsdf,
+    /// The light its triangles share, if it emits.
+    pub emission: Option<AssetEmission>,
+    /// The TEXCOORD set its textures read, if it has any.
     pub uv_set: Option<u32>,
 }
 
+/// A material's BSDF: the scene's, or the asset's own.
+pub(crate) enum MaterialBsdf {
+    /// Replaced by a `[[bsdf]]` of the scene.
+    Scene(BsdfRef),
+    Asset(AssetBsdf),
+}
+
+/// The BSDF of a material the scene does not replace.
+pub(crate) struct AssetBsdf {
+    pub entity: PluginEntity,
+    /// `doubleSided`: the BSDF is seen from both sides.
+    pub two_sided: bool,
+    /// `baseColorTexture`: multiplies the BSDF's albedo.
+    pub albedo_texture: Option<Arc<Texture>>,
+}
+
+/// The light plugin of an emissive material's triangles.
+pub(crate) struct AssetEmission {
+    pub entity: PluginEntity,
+    /// `emissiveTexture`: scales the radiance, read at the material's uvs.
+    pub texture: Option<Arc<Texture>>,
+}
+
+/// Every material of an asset, and what mapping them left out.
+pub(crate) struct ResolvedMaterials {
+    pub materials: HashMap<Option<usize>, ImportedMaterial>,
+    pub warnings: Vec<String>,
+    pub texture_bytes: usize,
+}
+
 /// Maps every material the asset's primitives use (and the default
-/// material) to a BSDF of the scene, honouring `bsdf` and `bsdf_overrides`.
+/// material) to a BSDF, honouring `bsdf` and `bsdf_overrides`.
 pub(crate) fn resolve_materials(
-    owner: &str,
-    shape: &GltfShape,
+    request: &ImportRequest,
     asset: &buffers::Asset,
-    asm: &mut Assembly,
-) -> Result<HashMap<Option<usize>, Resolved>> {
-    let at = &shape.file_location;
-    let err = |e: String| Error::at(at, format!("{owner}: '{}': {e}", shape.label));
+) -> Result<ResolvedMaterials> {
+    let owner = &request.owner;
+    let label = &request.label;
+    let at = &request.file_location;
+    let err = |e: String| Error::at(at, format!("{owner}: '{label}': {e}"));
     let document = &asset.document;
-    for (name, _, location) in &shape.overrides {
+    for (name, bsdf) in &request.overrides {
         if !document
             .materials()
             .any(|m| m.name() == Some(name.as_str()))
@@ -47,23 +73,19 @@ pub(crate) fn resolve_materials(
                 .filter_map(|m| m.name().map(|n| format!("\"{n}\"")))
                 .collect();
             return Err(Error::at(
-                location,
+                &bsdf.location,
                 format!(
-                    "{owner} bsdf_overrides: '{}' has no material named \"{name}\"; named materials: {}",
-                    shape.label,
+                    "{owner} bsdf_overrides: '{label}' has no material named \"{name}\"; named materials: {}",
                     if names.is_empty() { "none".into() } else { names.join(", ") }
                 ),
             ));
         }
     }
-    let named = |name: &str, location: &Location, asm: &Assembly| -> Result<u32> {
-        asm.bsdfs
-            .iter()
-            .position(|(n, _)| n == name)
-            .map(|i| i as u32)
-            .ok_or_else(|| Error::at(location, format!("{owner}: no [[bsdf]] named \"{name}\"")))
+    let mut out = ResolvedMaterials {
+        materials: HashMap::new(),
+        warnings: Vec::new(),
+        texture_bytes: 0,
     };
-    let mut out = HashMap::new();
     let materials = std::iter::once(None).chain(document.materials().map(|m| m.index()));
     for index in materials {
         let material = match index {
@@ -84,70 +106,56 @@ pub(crate) fn resolve_materials(
                 m
             }
         };
-        let label = match (material.name(), index) {
+        let material_label = match (material.name(), index) {
             (Some(n), _) => format!("\"{n}\""),
             (None, Some(i)) => format!("#{i}"),
             (None, None) => "(default)".into(),
         };
-        let override_ = match &shape.bsdf {
-            Some((b, l)) => Some((b.clone(), l.clone())),
-            None => shape
+        let replacement = match &request.bsdf {
+            Some(bsdf) => Some(bsdf.clone()),
+            None => request
                 .overrides
                 .iter()
-                .find(|(m, _, _)| Some(m.as_str()) == material.name())
-                .map(|(_, b, l)| (b.clone(), l.clone())),
+                .find(|(m, _)| Some(m.as_str()) == material.name())
+                .map(|(_, bsdf)| bsdf.clone()),
         };
         let mut uv_set = None;
-        let bsdf = match override_ {
-            Some((name, location)) => named(&name, &location, asm)?,
+        let bsdf = match replacement {
+            Some(bsdf) => MaterialBsdf::Scene(bsdf),
             None => {
-                let (text, warnings) = material::bsdf_table(&material, &label).map_err(err)?;
-                asm.report.warnings.extend(
-                    warnings
-                        .into_iter()
-                        .map(|w| format!("'{}': {w}", shape.label)),
-                );
-                let source = format!("{} material {label}", shape.label);
-                let table = doc::parse(&text, &source)?;
-                let Some(Node {
-                    value: Value::String(kind),
-                    ..
-                }) = table.get("type")
-                else {
-                    unreachable!("bsdf_table writes a type")
-                };
-                let mut bsdf = asm.registry.create_bsdf(&TableRef {
-                    owner: &format!("{owner} material {label}"),
-                    table: &table,
-                    location: at,
-                    type_name: kind,
-                    type_location: at,
-                    structural: &["type"],
-                })?;
-                if material.index().is_some() && material.double_sided() {
-                    bsdf = Arc::new(two_sided::TwoSided { inner: bsdf });
-                }
+                let (entity, warnings) = material::bsdf_entity(
+                    &material,
+                    &material_label,
+                    format!("{owner} material {material_label}"),
+                    at,
+                )
+                .map_err(err)?;
+                out.warnings
+                    .extend(warnings.into_iter().map(|w| format!("'{label}': {w}")));
+                let mut albedo_texture = None;
                 if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
-                    match texture_of(asset, &info, &shape.path) {
+                    match texture_of(asset, &info, &request.path) {
                         Ok((t, set)) => {
-                            asm.report.texture_bytes += t.byte_size();
-                            bsdf = Arc::new(texture::AlbedoTextured::new(bsdf, Arc::new(t)));
+                            out.texture_bytes += t.byte_size();
+                            albedo_texture = Some(Arc::new(t));
                             uv_set = Some(set);
                         }
-                        Err(why) => asm.report.warnings.push(format!(
-                            "'{}': material {label}: baseColorTexture ignored ({why}); using baseColorFactor",
-                            shape.label
+                        Err(why) => out.warnings.push(format!(
+                            "'{label}': material {material_label}: baseColorTexture ignored ({why}); using baseColorFactor"
                         )),
                     }
                 }
-                asm.bsdfs.push((format!("{}#{label}", shape.label), bsdf));
-                asm.bsdfs.len() as u32 - 1
+                MaterialBsdf::Asset(AssetBsdf {
+                    entity,
+                    two_sided: material.index().is_some() && material.double_sided(),
+                    albedo_texture,
+                })
             }
         };
-        let emission = material::emission(&material, &label).map_err(err)?;
+        let radiance = material::emission(&material, &material_label).map_err(err)?;
         let mut emission_texture = None;
-        if let (Some(_), Some(info)) = (emission, material.emissive_texture()) {
-            let loaded = match (texture_of(asset, &info, &shape.path), uv_set) {
+        if let (Some(_), Some(info)) = (radiance, material.emissive_texture()) {
+            let loaded = match (texture_of(asset, &info, &request.path), uv_set) {
                 (Ok((_, set)), Some(base)) if base != set => Err(format!(
                     "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
                 )),
@@ -155,29 +163,29 @@ pub(crate) fn resolve_materials(
             };
             match loaded {
                 Ok((t, set)) => {
-                    asm.report.texture_bytes += t.byte_size();
+                    out.texture_bytes += t.byte_size();
                     emission_texture = Some(Arc::new(t));
                     uv_set = Some(set);
                 }
-                Err(why) => asm.report.warnings.push(format!(
-                    "'{}': material {label}: emissiveTexture ignored ({why}); using emissiveFactor",
-                    shape.label
+                Err(why) => out.warnings.push(format!(
+                    "'{label}': material {material_label}: emissiveTexture ignored ({why}); using emissiveFactor"
                 )),
             }
         }
-        let emission = match emission {
-            Some(radiance) => Some(doc::parse(
-                &material::emission_table(radiance, material.double_sided()),
-                &format!("{} material {label} emission", shape.label),
-            )?),
-            None => None,
-        };
-        out.insert(
+        let emission = radiance.map(|radiance| AssetEmission {
+            entity: material::emission_entity(
+                radiance,
+                material.double_sided(),
+                format!("{owner} emission"),
+                at,
+            ),
+            texture: emission_texture,
+        });
+        out.materials.insert(
             index,
-            Resolved {
+            ImportedMaterial {
                 bsdf,
                 emission,
-                emission_texture,
                 uv_set,
             },
         );
@@ -192,7 +200,7 @@ fn texture_of(
     asset: &buffers::Asset,
     info: &gltf::texture::Info,
     asset_path: &Path,
-) -> std::result::Result<(texture::Texture, u32), String> {
+) -> std::result::Result<(Texture, u32), String> {
     let t = load_texture(asset, &info.texture(), asset_path)?;
     Ok(match info.texture_transform() {
         Some(x) => (
@@ -209,7 +217,7 @@ fn load_texture(
     asset: &buffers::Asset,
     texture: &gltf::Texture,
     asset_path: &Path,
-) -> std::result::Result<texture::Texture, String> {
+) -> std::result::Result<Texture, String> {
     let image = texture.source();
     let (bytes, mime): (Vec<u8>, Option<&str>) = match image.source() {
         gltf::image::Source::View { view, mime_type } => {
@@ -232,9 +240,9 @@ fn load_texture(
     const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
     const JPEG_MAGIC: &[u8] = &[0xff, 0xd8, 0xff];
     let decoded = if bytes.starts_with(PNG_MAGIC) {
-        texture::Texture::from_png(&bytes)
+        Texture::from_png(&bytes)
     } else if bytes.starts_with(JPEG_MAGIC) {
-        texture::Texture::from_jpeg(&bytes)
+        Texture::from_jpeg(&bytes)
     } else {
         return Err(format!(
             "image #{} is {}, only PNG and JPEG are supported",
@@ -244,9 +252,9 @@ fn load_texture(
     };
     let sampler = texture.sampler();
     let wrap = |mode: gltf::texture::WrappingMode| match mode {
-        gltf::texture::WrappingMode::Repeat => texture::Wrap::Repeat,
-        gltf::texture::WrappingMode::MirroredRepeat => texture::Wrap::Mirror,
-        gltf::texture::WrappingMode::ClampToEdge => texture::Wrap::Clamp,
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
     };
     let nearest = sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest);
     decoded

@@ -6,7 +6,7 @@ use lumis_core::params::FromParam;
 use lumis_core::{ParamSpec, ParamType, ParamValue, Params, Result};
 use lumis_embree::{BuildQuality, SceneOptions};
 
-use crate::as_table;
+use super::document::Located;
 
 /// `compact = "auto"` builds a compact BVH from this many unique triangles.
 ///
@@ -99,16 +99,16 @@ pub(crate) struct AccelOptions {
 }
 
 /// Reads `[accel]` (all defaults when absent).
-pub(crate) fn accel_options(root: &Table) -> Result<AccelOptions> {
-    let Some(node) = root.get("accel") else {
+pub(crate) fn accel_options(accel: Option<Located<Table>>) -> Result<AccelOptions> {
+    let Some((table, location)) = accel else {
         return Ok(AccelOptions::default());
     };
-    let table = as_table(node, "accel")?;
-    let params = Params::new("[accel]", table, node.location.clone(), ACCEL_PARAMS, &[])?;
+    let params = Params::new("[accel]", &table, location, ACCEL_PARAMS, &[])?;
     let quality = match params.get_choice("quality")?.as_str() {
         "low" => BuildQuality::Low,
+        "medium" => BuildQuality::Medium,
         "high" => BuildQuality::High,
-        _ => BuildQuality::Medium,
+        other => unreachable!("quality \"{other}\" is one of the declared choices"),
     };
     let options = AccelOptions {
         embree: SceneOptions {
@@ -128,8 +128,9 @@ mod tests {
     use super::*;
 
     fn parse(accel: &str) -> std::result::Result<AccelOptions, String> {
-        let root = lumis_core::doc::parse(&format!("[accel]\n{accel}"), "s.toml").unwrap();
-        accel_options(&root).map_err(|e| e.to_string())
+        let mut root = lumis_core::doc::parse(&format!("[accel]\n{accel}"), "s.toml").unwrap();
+        let accel = crate::description::document::take_table(&mut root, "accel").unwrap();
+        accel_options(accel).map_err(|e| e.to_string())
     }
 
     #[test]
@@ -144,10 +145,7 @@ mod tests {
     fn auto_compacts_from_the_threshold_on() {
         let auto = parse("").unwrap().compaction;
         assert_eq!(auto, Compaction::Auto);
-        assert_eq!(
-            accel_options(&Table::default()).unwrap().compaction,
-            Compaction::Auto
-        );
+        assert_eq!(accel_options(None).unwrap().compaction, Compaction::Auto);
         assert!(!auto.decide(0));
         assert!(!auto.decide(AUTO_COMPACT_TRIANGLES - 1));
         assert!(auto.decide(AUTO_COMPACT_TRIANGLES));

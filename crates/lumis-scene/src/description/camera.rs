@@ -1,0 +1,147 @@
+//! `[camera]`: a perspective camera written out, or one of a glTF asset.
+
+use std::path::Path;
+
+use lumis_core::doc::Table;
+use lumis_core::glam::Mat4;
+use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2, Vec3};
+use lumis_render::PerspectiveCamera;
+
+use super::document::{type_of, Located};
+use super::transform::parse_transform;
+use crate::gltf::camera::{find_camera, CameraChoice};
+
+const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
+    ParamSpec::required("origin", ParamType::Vec3, "eye position"),
+    ParamSpec::required("target", ParamType::Vec3, "point looked at"),
+    ParamSpec::with_default(
+        "up",
+        ParamType::Vec3,
+        ParamValue::Array(&[
+            ParamValue::Float(0.0),
+            ParamValue::Float(1.0),
+            ParamValue::Float(0.0),
+        ]),
+        "up direction",
+    ),
+    ParamSpec::required(
+        "fov",
+        ParamType::Float,
+        "full angle of the smaller image axis, degrees, in (0, 180)",
+    ),
+];
+
+const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
+    ParamSpec::required(
+        "file",
+        ParamType::String,
+        "glTF 2.0 asset (.gltf or .glb), relative to the scene file",
+    ),
+    ParamSpec::optional(
+        "name",
+        ParamType::String,
+        "the camera's name in the asset (default: the first camera a node uses)",
+    ),
+    ParamSpec::optional(
+        "index",
+        ParamType::Int,
+        "the camera's index in the asset's cameras array",
+    ),
+    ParamSpec::optional(
+        "transform",
+        ParamType::Table,
+        "placement applied on top of the node's, as for [[shape]] type = \"gltf\"",
+    ),
+];
+
+/// Reads `[camera]` for a film of `resolution`.
+pub(crate) fn camera(
+    (table, location): Located<Table>,
+    dir: &Path,
+    resolution: UVec2,
+) -> Result<PerspectiveCamera> {
+    let (kind, kind_location) = type_of(&table, &location, "[camera]")?;
+    match kind {
+        "perspective" => perspective(&table, location, resolution),
+        "gltf" => gltf_camera(&table, location, dir, resolution),
+        other => Err(Error::at(
+            &kind_location,
+            format!("unknown camera type \"{other}\"; available: perspective, gltf"),
+        )),
+    }
+}
+
+fn perspective(table: &Table, location: Location, resolution: UVec2) -> Result<PerspectiveCamera> {
+    let cam = Params::new(
+        "[camera] (type = \"perspective\")",
+        table,
+        location.clone(),
+        PERSPECTIVE_PARAMS,
+        &["type"],
+    )?;
+    let fov: f32 = cam.get("fov")?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(cam.error("fov", format!("must be in (0, 180) degrees, got {fov}")));
+    }
+    let camera = PerspectiveCamera::new(
+        cam.get("origin")?,
+        cam.get("target")?,
+        cam.get("up")?,
+        fov,
+        resolution,
+    )
+    .map_err(|e| Error::at(&location, format!("[camera]: {}", e.message)))?;
+    cam.finish()?;
+    Ok(camera)
+}
+
+/// `type = "gltf"`: the asset's camera, chosen by name or index, placed by
+/// its node and the optional `transform`.
+fn gltf_camera(
+    table: &Table,
+    location: Location,
+    dir: &Path,
+    resolution: UVec2,
+) -> Result<PerspectiveCamera> {
+    let owner = "[camera] (type = \"gltf\")";
+    let params = Params::new(
+        owner,
+        table,
+        location.clone(),
+        GLTF_CAMERA_PARAMS,
+        &["type"],
+    )?;
+    let file: String = params.get("file")?;
+    let base = match params.table("transform")? {
+        Some((t, at)) => parse_transform(&format!("{owner} transform"), t, at)?,
+        None => Mat4::IDENTITY,
+    };
+    let choice = match (params.get_opt("name")?, params.get_opt::<i64>("index")?) {
+        (Some(_), Some(_)) => {
+            return Err(params.error("index", "give either 'name' or 'index', not both"))
+        }
+        (Some(name), None) => CameraChoice::Named(name),
+        (None, Some(index)) => CameraChoice::Index(index),
+        (None, None) => CameraChoice::First,
+    };
+    let found = find_camera(&dir.join(&file), &file, &choice, base)
+        .map_err(|e| params.error(e.key, e.message))?;
+    // lumis's fov is the full angle of the smaller image axis; glTF's yfov
+    // is vertical, and the film's aspect ratio decides the horizontal one.
+    let (w, h) = (resolution.x as f32, resolution.y as f32);
+    let yfov = found.yfov;
+    let fov = if w >= h {
+        yfov
+    } else {
+        2.0 * ((0.5 * yfov).tan() * w / h).atan()
+    };
+    // A glTF camera looks down its local -z with +y up.
+    let world = found.world;
+    let origin = world.transform_point3(Vec3::ZERO);
+    let target = world.transform_point3(Vec3::NEG_Z);
+    let up = world.transform_vector3(Vec3::Y);
+    let camera = PerspectiveCamera::new(origin, target, up, fov.to_degrees(), resolution)
+        .map_err(|e| Error::at(&location, format!("{owner}: {}", e.message)))?;
+    params.finish()?;
+    Ok(camera)
+}

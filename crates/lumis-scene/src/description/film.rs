@@ -1,0 +1,69 @@
+//! `[film]`: the image's size, where it goes, and its pixel filter.
+
+use std::path::{Path, PathBuf};
+
+use lumis_core::doc::Table;
+use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2};
+
+use super::document::{type_of, Located};
+
+const FILM_PARAMS: &[ParamSpec] = &[
+    ParamSpec::with_default(
+        "resolution",
+        ParamType::UIntPair,
+        ParamValue::Array(&[ParamValue::Int(256), ParamValue::Int(256)]),
+        "image width and height in pixels",
+    ),
+    ParamSpec::optional(
+        "output",
+        ParamType::String,
+        "output EXR path, relative to the scene file",
+    ),
+    ParamSpec::optional(
+        "filter",
+        ParamType::Table,
+        "pixel filter: { type = \"box\" } (the default)",
+    ),
+];
+
+/// What `[film]` asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FilmDescription {
+    pub resolution: UVec2,
+    /// `output`, resolved against the scene file's directory.
+    pub output: Option<PathBuf>,
+}
+
+/// Reads `[film]` (all defaults when absent; `file` locates its absence).
+pub(crate) fn film(
+    table: Option<Located<Table>>,
+    file: &Location,
+    dir: &Path,
+) -> Result<FilmDescription> {
+    let (table, location) = table.unwrap_or_else(|| (Table::default(), file.clone()));
+    let film = Params::new("[film]", &table, location, FILM_PARAMS, &[])?;
+    let resolution: UVec2 = film.get("resolution")?;
+    if resolution.x == 0 || resolution.y == 0 {
+        return Err(film.error("resolution", "width and height must be at least 1"));
+    }
+    let output = film.get_opt::<String>("output")?.map(|o| dir.join(o));
+    if let Some((filter, location)) = film.table("filter")? {
+        match type_of(filter, &location, "[film] filter")? {
+            ("box", _) if filter.entries.len() == 1 => {}
+            ("box", _) => {
+                return Err(Error::at(
+                    &location,
+                    "the box filter takes no parameters (radius 1/2 pixel)",
+                ))
+            }
+            (other, loc) => {
+                return Err(Error::at(
+                    &loc,
+                    format!("unknown pixel filter \"{other}\"; available: box"),
+                ));
+            }
+        }
+    }
+    film.finish()?;
+    Ok(FilmDescription { resolution, output })
+}

@@ -1,0 +1,180 @@
+//! The first stage: the TOML document to a typed [`SceneDescription`].
+//!
+//! Every key is checked here, against what the scene layer reads itself
+//! (film, camera, shapes, `[accel]`) or against the plugin kind a table
+//! names (its parameters are checked when the plugin is created). Every
+//! plugin is described the same way, as a [`PluginEntity`] that keeps the
+//! locations of its table, so the later stages can still point at the
+//! line that caused an error. Nothing is created and no asset is read
+//! here, except the glTF asset a `[camera] type = "gltf"` names.
+
+mod accel;
+mod bsdfs;
+mod camera;
+mod document;
+mod film;
+mod gltf_shape;
+mod plugin_libraries;
+mod shapes;
+mod transform;
+
+use std::path::Path;
+
+use lumis_core::doc::{Table, Value};
+use lumis_core::entity::TYPE_KEY;
+use lumis_core::{Error, Location, PluginEntity, PluginKind, Result};
+use lumis_render::PerspectiveCamera;
+
+pub(crate) use accel::AccelOptions;
+pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
+pub(crate) use bsdfs::NamedBsdf;
+pub(crate) use film::FilmDescription;
+pub(crate) use plugin_libraries::PluginLibraries;
+pub(crate) use shapes::{ShapeEntity, ShapeSource, Surface, SurfaceGeometry};
+
+use document::{take_required_table, take_table, take_tables};
+
+const TOP_LEVEL_KEYS: &[&str] = &[
+    "film",
+    "camera",
+    "sampler",
+    "integrator",
+    "light_sampler",
+    "bsdf",
+    "shape",
+    "light",
+    "seed",
+    "plugins",
+    "accel",
+];
+
+/// A scene as its file describes it, checked and typed.
+pub(crate) struct SceneDescription {
+    pub seed: u64,
+    pub film: FilmDescription,
+    pub camera: PerspectiveCamera,
+    pub plugin_libraries: PluginLibraries,
+    pub accel: AccelOptions,
+    pub sampler: PluginEntity,
+    pub integrator: PluginEntity,
+    /// `[light_sampler]`, or the uniform one when the scene has none.
+    pub light_sampler: PluginEntity,
+    pub bsdfs: Vec<NamedBsdf>,
+    pub shapes: Vec<ShapeEntity>,
+    /// `[[light]]` tables (emitting shapes describe their own lights).
+    pub lights: Vec<PluginEntity>,
+}
+
+impl SceneDescription {
+    /// Describes the scene `root` (the whole document, overrides applied);
+    /// `file` locates what the document lacks, relative paths resolve
+    /// against `dir`.
+    pub fn from_document(mut root: Table, file: &Location, dir: &Path) -> Result<Self> {
+        check_top_level_keys(&root)?;
+        let seed = seed_of(&root)?;
+        let plugin_libraries =
+            plugin_libraries::plugin_libraries(take_table(&mut root, "plugins")?, dir)?;
+        let film = film::film(take_table(&mut root, "film")?, file, dir)?;
+        let camera = camera::camera(
+            take_required_table(&mut root, "camera", file)?,
+            dir,
+            film.resolution,
+        )?;
+        let bsdfs = bsdfs::named_bsdfs(take_tables(&mut root, "bsdf")?)?;
+        let accel = accel::accel_options(take_table(&mut root, "accel")?)?;
+        let shapes = take_tables(&mut root, "shape")?
+            .into_iter()
+            .enumerate()
+            .map(|(i, table)| shapes::shape(i, table, dir))
+            .collect::<Result<Vec<_>>>()?;
+        let lights = take_tables(&mut root, "light")?
+            .into_iter()
+            .enumerate()
+            .map(|(i, (table, location))| {
+                let owner = format!("[[light]] #{}", i + 1);
+                PluginEntity::from_table(PluginKind::Light, owner, table, location, TYPE_KEY)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let light_sampler = match take_table(&mut root, "light_sampler")? {
+            Some((table, location)) => PluginEntity::from_table_or(
+                PluginKind::LightSampler,
+                "light_sampler",
+                table,
+                location,
+                DEFAULT_LIGHT_SAMPLER,
+            )?,
+            None => default_light_sampler(),
+        };
+        let sampler = required_plugin(&mut root, PluginKind::Sampler, file)?;
+        let integrator = required_plugin(&mut root, PluginKind::Integrator, file)?;
+        Ok(Self {
+            seed,
+            film,
+            camera,
+            plugin_libraries,
+            accel,
+            sampler,
+            integrator,
+            light_sampler,
+            bsdfs,
+            shapes,
+            lights,
+        })
+    }
+}
+
+/// The light sampler of a scene without `[light_sampler]`, or whose table
+/// names no type.
+const DEFAULT_LIGHT_SAMPLER: &str = "uniform";
+
+fn default_light_sampler() -> PluginEntity {
+    PluginEntity::new(
+        PluginKind::LightSampler,
+        "light_sampler",
+        DEFAULT_LIGHT_SAMPLER,
+        Table::default(),
+        Location::Builtin,
+    )
+}
+
+/// The top-level table of a plugin `kind` the scene must have
+/// (`[sampler]`, `[integrator]`).
+fn required_plugin(root: &mut Table, kind: PluginKind, file: &Location) -> Result<PluginEntity> {
+    let key = kind.table_name();
+    let (table, location) = take_required_table(root, key, file)?;
+    PluginEntity::from_table(kind, key, table, location, TYPE_KEY)
+}
+
+fn check_top_level_keys(root: &Table) -> Result<()> {
+    match root
+        .entries
+        .iter()
+        .find(|e| !TOP_LEVEL_KEYS.contains(&e.key.as_str()))
+    {
+        Some(entry) => Err(Error::at(
+            &entry.key_location,
+            format!(
+                "unknown top-level key '{}'; accepted: {}",
+                entry.key,
+                TOP_LEVEL_KEYS.join(", ")
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+fn seed_of(root: &Table) -> Result<u64> {
+    match root.get("seed") {
+        None => Ok(0),
+        Some(node) => match node.value {
+            Value::Int(s) if s >= 0 => Ok(s as u64),
+            _ => Err(Error::at(
+                &node.location,
+                "seed: expected a non-negative integer",
+            )),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,55 @@
+//! `[plugins] load = [...]`: plugin libraries the scene needs.
+
+use std::path::{Path, PathBuf};
+
+use lumis_core::doc::Table;
+use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result};
+
+use super::document::Located;
+
+const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
+    "load",
+    ParamType::StringArray,
+    ParamValue::Array(&[]),
+    "plugin libraries to load, relative to the scene file",
+)];
+
+/// The libraries of `[plugins] load`, resolved against the scene's directory.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct PluginLibraries {
+    pub paths: Vec<PathBuf>,
+    /// Where `load` was written.
+    pub location: Option<Location>,
+}
+
+impl PluginLibraries {
+    /// An error about loading one of the libraries, located at `load`.
+    pub fn error(&self, message: impl std::fmt::Display) -> Error {
+        let message = format!("[plugins] key 'load': {message}");
+        match &self.location {
+            Some(location) => Error::at(location, message),
+            None => Error::msg(message),
+        }
+    }
+}
+
+/// Reads `[plugins]` (no libraries when absent).
+pub(crate) fn plugin_libraries(
+    table: Option<Located<Table>>,
+    dir: &Path,
+) -> Result<PluginLibraries> {
+    let Some((table, location)) = table else {
+        return Ok(PluginLibraries::default());
+    };
+    let params = Params::new("[plugins]", &table, location.clone(), PLUGINS_PARAMS, &[])?;
+    let libraries: Vec<String> = params.get("load")?;
+    params.finish()?;
+    Ok(PluginLibraries {
+        paths: libraries.iter().map(|l| dir.join(l)).collect(),
+        location: Some(
+            table
+                .get("load")
+                .map_or(location, |node| node.location.clone()),
+        ),
+    })
+}

@@ -1,0 +1,117 @@
+//! The description keeps every plugin as a located entity and fills in
+//! defaults as entities, never as TOML text.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use lumis_core::{Location, PluginKind};
+
+use super::{SceneDescription, ShapeSource, SurfaceGeometry};
+
+const BASE: &str = r#"[camera]
+type = "perspective"
+origin = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fov = 40.0
+[sampler]
+type = "independent"
+[integrator]
+type = "path"
+[[bsdf]]
+name = "white"
+type = "diffuse"
+"#;
+
+fn describe(extra: &str) -> SceneDescription {
+    let root = lumis_core::doc::parse(&format!("{BASE}{extra}"), "s.toml").unwrap();
+    let file = Location::File {
+        path: Arc::from("s.toml"),
+        line: 1,
+        column: 1,
+    };
+    SceneDescription::from_document(root, &file, Path::new(".")).unwrap()
+}
+
+#[test]
+fn plugin_entities_keep_their_locations() {
+    let scene = describe("");
+    let white = &scene.bsdfs[0];
+    assert_eq!(white.name, "white");
+    assert_eq!(white.entity.kind, PluginKind::Bsdf);
+    assert_eq!(white.entity.owner, "bsdf \"white\"");
+    assert_eq!(white.entity.type_location.to_string(), "s.toml:12:8");
+    assert_eq!(scene.sampler.type_name, "independent");
+    assert_eq!(scene.integrator.location.to_string(), "s.toml:8:1");
+}
+
+#[test]
+fn the_default_light_sampler_is_a_typed_entity() {
+    let absent = describe("").light_sampler;
+    assert_eq!(absent.kind, PluginKind::LightSampler);
+    assert_eq!(absent.type_name, "uniform");
+    assert!(absent.table.entries.is_empty());
+    let untyped = describe("[light_sampler]\n").light_sampler;
+    assert_eq!(untyped.type_name, "uniform");
+    let power = describe("[light_sampler]\ntype = \"power\"\n").light_sampler;
+    assert_eq!(power.type_name, "power");
+    assert_eq!(power.type_location.to_string(), "s.toml:14:8");
+}
+
+#[test]
+fn emission_takes_the_light_of_its_geometry_unless_named() {
+    let scene = describe(
+        r#"[[shape]]
+type = "quad"
+corner = [0.0, 0.0, 0.0]
+edge_u = [1.0, 0.0, 0.0]
+edge_v = [0.0, 1.0, 0.0]
+bsdf = "white"
+emission = { radiance = 1.0 }
+[[shape]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+bsdf = "white"
+emission = { radiance = 1.0 }
+[[shape]]
+type = "mesh"
+positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+indices = [0, 1, 2]
+bsdf = "white"
+emission = { type = "my_triangle", radiance = 1.0 }
+"#,
+    );
+    let lights: Vec<(&str, String)> = scene
+        .shapes
+        .iter()
+        .map(|shape| {
+            let ShapeSource::Surface(surface) = &shape.source else {
+                panic!("{} is a surface", shape.owner)
+            };
+            let kind = match surface.geometry {
+                SurfaceGeometry::Quad { .. } => "quad",
+                SurfaceGeometry::Sphere { .. } => "sphere",
+                SurfaceGeometry::Mesh(_) => "mesh",
+                SurfaceGeometry::Obj(_) => "obj",
+            };
+            let emission = surface.emission.as_ref().expect("it emits");
+            assert_eq!(emission.kind, PluginKind::Light);
+            (kind, emission.type_name.clone())
+        })
+        .collect();
+    assert_eq!(
+        lights,
+        [
+            ("quad", "quad".to_string()),
+            ("sphere", "sphere".to_string()),
+            ("mesh", "my_triangle".to_string())
+        ]
+    );
+    let ShapeSource::Surface(quad) = &scene.shapes[0].source else {
+        panic!("a surface")
+    };
+    let emission = quad.emission.as_ref().unwrap();
+    assert_eq!(emission.owner, "[[shape]] #1 (type = \"quad\") emission");
+    assert_eq!(emission.location.to_string(), "s.toml:19:12");
+    assert_eq!(quad.bsdf.location.to_string(), "s.toml:18:8");
+}

@@ -1,0 +1,65 @@
+//! The second stage: plugins from their entities.
+//!
+//! Every plugin, of every kind, is made by [`Registry::create`] from a
+//! [`PluginEntity`]: the ones the description names here, area lights and
+//! the BSDFs of imported materials during the assembly, the light sampler
+//! once the lights exist. Only the plugins a scene names are created.
+
+mod bsdf_table;
+
+use lumis_core::{Bsdf, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler};
+
+pub(crate) use bsdf_table::BsdfTable;
+
+use crate::description::{NamedBsdf, PluginLibraries};
+
+/// The plugins a scene names outside its shapes.
+pub(crate) struct Plugins {
+    pub sampler: Box<dyn Sampler>,
+    pub integrator: Box<dyn Integrator>,
+    pub bsdfs: BsdfTable,
+    /// `[[light]]`s, in file order.
+    pub lights: Vec<Box<dyn Light>>,
+}
+
+/// Creates the `[[bsdf]]`s, `[[light]]`s, sampler and integrator.
+pub(crate) fn instantiate(
+    registry: &Registry,
+    bsdfs: &[NamedBsdf],
+    lights: &[PluginEntity],
+    sampler: &PluginEntity,
+    integrator: &PluginEntity,
+) -> Result<Plugins> {
+    let named = bsdfs
+        .iter()
+        .map(|b| Ok((b.name.clone(), registry.create::<dyn Bsdf>(&b.entity, ())?)))
+        .collect::<Result<Vec<_>>>()?;
+    let lights = lights
+        .iter()
+        .map(|l| registry.create::<dyn Light>(l, &LightShape::None))
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Plugins {
+        sampler: registry.create::<dyn Sampler>(sampler, ())?,
+        integrator: registry.create::<dyn Integrator>(integrator, ())?,
+        bsdfs: BsdfTable::named(named),
+        lights,
+    })
+}
+
+/// A copy of `registry` extended with the scene's plugin libraries, or
+/// `None` when it loads none: the caller's registry stays as it was, and
+/// nothing but what this scene names is registered.
+pub(crate) fn scene_registry(
+    libraries: &PluginLibraries,
+    registry: &Registry,
+) -> Result<Option<Registry>> {
+    if libraries.location.is_none() {
+        return Ok(None);
+    }
+    let mut extended = registry.clone();
+    for library in &libraries.paths {
+        lumis_loader::load_library(library, &mut extended)
+            .map_err(|e| libraries.error(e.message))?;
+    }
+    Ok(Some(extended))
+}
