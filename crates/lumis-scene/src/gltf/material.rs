@@ -39,13 +39,12 @@ pub(crate) fn bsdf_entity(
 ) -> Result<(PluginEntity, Vec<String>), String> {
     let pbr = material.pbr_metallic_roughness();
     let [r, g, b, _alpha] = pbr.base_color_factor();
-    if ![r, g, b].iter().all(|c| (0.0..=1.0).contains(c)) {
+    let rgb = [r, g, b];
+    if !rgb.iter().all(|c| (0.0..=1.0).contains(c)) {
         return Err(format!(
-            "material {label}: baseColorFactor {:?} must lie in [0, 1]",
-            [r, g, b]
+            "material {label}: baseColorFactor {rgb:?} must lie in [0, 1]"
         ));
     }
-    let rgb = [r, g, b];
     let entity = |type_name: &str, params: Vec<(&str, Value)>| {
         let table = Table::built(at, params);
         PluginEntity::new(PluginKind::Bsdf, owner, type_name, table, at.clone())
