@@ -11,6 +11,7 @@ use lumis_analysis::convergence::loglog_slope;
 use lumis_analysis::image_error::{check_same_size, error_metrics};
 use lumis_analysis::plot::{self, Axes, Series};
 use lumis_core::doc::{self, Value};
+use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Registry, Result};
 use lumis_image::read_exr;
 use lumis_render::{render, RenderSettings};
@@ -199,6 +200,9 @@ pub struct ConvergeReport {
     pub interrupted: bool,
 }
 
+/// A variants file is a short TOML list written by hand.
+const VARIANTS_FILE: FileKind = FileKind::new("variants", 16 * MIB);
+
 /// Renders every variant at each spp and seed and measures its error.
 /// When `stop` becomes true (Ctrl-C) it finishes the render in flight,
 /// then writes and reports everything measured so far.
@@ -211,8 +215,7 @@ pub fn converge(
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
     let provenance = reference_provenance(args);
     let variants_path = args.variants.display().to_string();
-    let text = std::fs::read_to_string(&args.variants)
-        .map_err(|e| Error::msg(format!("{variants_path}: {e}")))?;
+    let text = read_text_bounded(&args.variants, VARIANTS_FILE).map_err(Error::msg)?;
     let variants = parse_variants(&text, &variants_path)?;
     if args.seeds == 0 || args.spp.contains(&0) {
         return Err(Error::msg(

@@ -9,6 +9,7 @@ use lumis_analysis::image_error::{
 };
 use lumis_analysis::plot::{self, Grid};
 use lumis_core::doc::{self, Node, Value};
+use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Result};
 use lumis_image::{read_exr, Image};
 
@@ -34,6 +35,9 @@ pub struct Region {
     pub name: String,
     pub rect: Rect,
 }
+
+/// A region mask is a short TOML list written by hand.
+const MASK_FILE: FileKind = FileKind::new("region mask", 16 * MIB);
 
 fn read(path: &Path) -> Result<Image> {
     read_exr(path).map_err(|e| Error::msg(e.to_string()))
@@ -151,8 +155,7 @@ pub fn diff(args: &DiffArgs) -> Result<String> {
     })?;
     let regions = match &args.mask {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| Error::msg(format!("{}: {e}", path.display())))?;
+            let text = read_text_bounded(path, MASK_FILE).map_err(Error::msg)?;
             parse_regions(&text, &path.display().to_string(), a.width, a.height)?
         }
         None => Vec::new(),

@@ -13,6 +13,7 @@ pub mod bsdf;
 pub mod doc;
 pub mod entity;
 pub mod error;
+pub mod files;
 pub mod integrator;
 pub mod interaction;
 pub mod light;

@@ -5,6 +5,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use lumis_core::doc;
+use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Integrator, LightSampler, Location, Registry, Result, Sampler};
 use lumis_render::PerspectiveCamera;
 
@@ -27,10 +28,13 @@ pub struct LoadedScene {
     pub output: Option<PathBuf>,
 }
 
+/// A scene is text a person writes: far below this bound, which refuses
+/// a file that is not a scene before it fills memory.
+pub const SCENE_FILE: FileKind = FileKind::new("scene", 64 * MIB);
+
 /// Reads and loads a scene file.
 pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Result<LoadedScene> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::msg(format!("cannot read scene '{}': {e}", path.display())))?;
+    let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let name = path
         .file_stem()

@@ -1,23 +1,52 @@
 //! Wavefront OBJ files to one triangle mesh (faces triangulated, every
 //! object merged).
+//!
+//! `tobj` parses; lumis reads the file itself (bounded, with the OS's
+//! reason on failure) and counts the lines `tobj` consumes, so a parse
+//! error names its line. Materials (`mtllib`) are not read: the scene's
+//! `bsdf` shades the mesh.
 
+use std::io::{BufRead, Read};
 use std::path::Path;
 
+use lumis_core::files::{read_bounded, FileKind, GIB};
 use lumis_core::Vec3;
 
 use crate::triangle_mesh::TriangleMesh;
 
-/// Reads `path`. Errors say what is wrong with the file (the caller says
-/// which shape and key named it).
+/// Far above the 100-million-triangle meshes lumis is meant to render.
+const OBJ_FILE: FileKind = FileKind::new("OBJ mesh", 16 * GIB);
+
+/// Reads `path`. Errors say what is wrong with the file and where (the
+/// caller says which shape and key named it).
 pub(crate) fn import(path: &Path) -> Result<TriangleMesh, String> {
+    let bytes = read_bounded(path, OBJ_FILE)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj(path, &options)
-        .map_err(|e| format!("cannot load OBJ '{}': {e}", path.display()))?;
+    let mut reader = LineCounter::new(&bytes);
+    let no_materials = |_: &Path| Ok(Default::default());
+    let (models, _) = tobj::load_obj_buf(&mut reader, &options, no_materials).map_err(|e| {
+        let line = match e {
+            // Checked when an object ends, so the line read last is not
+            // the face at fault.
+            tobj::LoadError::FaceVertexOutOfBounds => first_face_out_of_bounds(&bytes),
+            _ => Some(reader.line()),
+        };
+        // The bytes are in memory, so a read error is a line that is not
+        // UTF-8.
+        let what = match e {
+            tobj::LoadError::ReadError => "not UTF-8 text".to_string(),
+            e => e.to_string(),
+        };
+        match line {
+            Some(line) => format!("'{}' line {line}: {what}", path.display()),
+            None => format!("'{}': {what}", path.display()),
+        }
+    })?;
     let mut positions = Vec::new();
     let mut indices = Vec::new();
     let mut normals = Vec::new();
@@ -70,4 +99,134 @@ pub(crate) fn import(path: &Path) -> Result<TriangleMesh, String> {
             .then_some(normals)
             .filter(|n| !n.is_empty()),
     })
+}
+
+/// A reader over the file's bytes that counts the lines handed out.
+struct LineCounter<'a> {
+    rest: &'a [u8],
+    /// Newlines consumed.
+    newlines: usize,
+    /// Whether bytes after the last newline were consumed.
+    mid_line: bool,
+}
+
+impl<'a> LineCounter<'a> {
+    fn new(bytes: &'a [u8]) -> Self {
+        Self {
+            rest: bytes,
+            newlines: 0,
+            mid_line: false,
+        }
+    }
+
+    /// The 1-based number of the line consumed last.
+    fn line(&self) -> usize {
+        self.newlines + usize::from(self.mid_line)
+    }
+}
+
+impl Read for LineCounter<'_> {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.fill_buf()?.len().min(out.len());
+        out[..n].copy_from_slice(&self.rest[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl BufRead for LineCounter<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        Ok(self.rest)
+    }
+
+    fn consume(&mut self, n: usize) {
+        let (taken, rest) = self.rest.split_at(n);
+        if !taken.is_empty() {
+            let newlines = taken.iter().filter(|&&b| b == b'\n').count();
+            self.newlines += newlines;
+            self.mid_line = if newlines == 0 {
+                self.mid_line || !taken.is_empty()
+            } else {
+                taken.last() != Some(&b'\n')
+            };
+        }
+        self.rest = rest;
+    }
+}
+
+/// The first `f` line naming a vertex past the file's last `v` (indices
+/// are 1-based; negative ones count back from the vertices read so far).
+fn first_face_out_of_bounds(bytes: &[u8]) -> Option<usize> {
+    let text = String::from_utf8_lossy(bytes);
+    let total = text
+        .lines()
+        .filter(|l| l.split_whitespace().next() == Some("v"))
+        .count() as i64;
+    let mut seen = 0i64;
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => seen += 1,
+            Some("f") => {
+                let out_of_bounds = words.any(|w| {
+                    let index = w.split('/').next().and_then(|v| v.parse::<i64>().ok());
+                    match index {
+                        Some(i) if i > 0 => i > total,
+                        Some(i) if i < 0 => seen + i < 0,
+                        _ => false,
+                    }
+                });
+                if out_of_bounds {
+                    return Some(n + 1);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn error_of(text: &[u8]) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.obj");
+        std::fs::write(&path, text).unwrap();
+        import(&path).map(|_| ()).unwrap_err()
+    }
+
+    #[test]
+    fn parse_errors_name_their_line() {
+        let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 x 0\nf 1 2 3\n");
+        assert!(err.contains("line 3: position parse error"), "{err}");
+        let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\nv 0 0 1");
+        assert!(
+            err.contains("line 5: face vertex index out of bounds"),
+            "{err}"
+        );
+        let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nvn 0 0");
+        assert!(err.contains("line 5: normal parse error"), "{err}");
+        let err = error_of(b"v 0 0 0\nv 1 \xff 0\n");
+        assert!(err.contains("line 2: not UTF-8 text"), "{err}");
+    }
+
+    #[test]
+    fn materials_are_not_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.obj");
+        std::fs::write(
+            &path,
+            "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+        assert_eq!(import(&path).unwrap().indices.len(), 1);
+    }
+
+    #[test]
+    fn devices_are_refused() {
+        let err = import(Path::new("/dev/zero")).map(|_| ()).unwrap_err();
+        assert!(err.contains("not a regular file"), "{err}");
+    }
 }

@@ -28,6 +28,7 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
+use lumis_core::files::{read_bounded, FileKind};
 use lumis_core::{Error, Result, Rgb, Vec3};
 use lumis_sampling::halfdiff::HalfDiff;
 
@@ -109,8 +110,10 @@ impl std::fmt::Debug for MerlTable {
 impl MerlTable {
     /// Reads a table, with an error naming the file and what is wrong.
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path)
-            .map_err(|e| Error::msg(format!("cannot read MERL table {}: {e}", path.display())))?;
+        // One byte over the format's size, so that a slightly longer file
+        // gets `from_bytes`'s "trailing data" message.
+        let kind = FileKind::new("MERL table", FILE_BYTES as u64 + 1);
+        let bytes = read_bounded(path, kind).map_err(Error::msg)?;
         Self::from_bytes(&bytes, &path.display().to_string())
     }
 

@@ -10,6 +10,16 @@ use std::path::{Path, PathBuf};
 
 use base64::Engine;
 use gltf::buffer::Source;
+use lumis_core::files::{read_bounded, read_prefix, FileKind, GIB};
+
+/// A `.gltf` (JSON, perhaps with data URIs) or `.glb` file: GLB's length
+/// field is 32 bits, and no JSON asset lumis can hold in memory is larger.
+const GLTF_FILE: FileKind = FileKind::new("glTF asset", 4 * GIB);
+/// An external buffer: read up to its declared `byteLength` (a file may
+/// carry padding past it), which may not pass this.
+const BUFFER_FILE: FileKind = FileKind::new("glTF buffer", 16 * GIB);
+/// Images a material names: far above any texture a renderer can hold.
+pub(crate) const IMAGE_FILE: FileKind = FileKind::new("glTF image", GIB);
 
 /// A parsed and validated glTF document with its buffer data.
 pub(crate) struct Asset {
@@ -32,8 +42,7 @@ pub(crate) fn document(
     path: &Path,
     label: &str,
 ) -> Result<(gltf::Document, Option<Vec<u8>>), String> {
-    let bytes =
-        std::fs::read(path).map_err(|e| format!("cannot read glTF '{}': {e}", path.display()))?;
+    let bytes = read_bounded(path, GLTF_FILE)?;
     let gltf = gltf::Gltf::from_slice(&bytes)
         .map_err(|e| format!("'{label}' is not a valid glTF 2.0 file: {e}"))?;
     Ok((gltf.document, gltf.blob))
@@ -53,7 +62,10 @@ pub(crate) fn load(path: &Path, label: &str) -> Result<Asset, String> {
             Source::Bin => blob.take().ok_or_else(|| {
                 format!("{what} refers to the GLB binary chunk, which is missing")
             })?,
-            Source::Uri(uri) => read_uri(uri, &dir).map_err(|e| format!("{what}: {e}"))?,
+            Source::Uri(uri) => {
+                let declared = Some(buffer.length() as u64);
+                read_uri(uri, &dir, BUFFER_FILE, declared).map_err(|e| format!("{what}: {e}"))?
+            }
         };
         if data.len() < buffer.length() {
             return Err(format!(
@@ -71,8 +83,15 @@ pub(crate) fn load(path: &Path, label: &str) -> Result<Asset, String> {
     })
 }
 
-/// A buffer's bytes from a `data:` URI or a file relative to the asset.
-pub(crate) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
+/// A buffer's or image's bytes from a `data:` URI or a file relative to the
+/// asset: the first `declared` bytes of the file if its length is
+/// declared, else all of it, within `kind`'s bound either way.
+pub(crate) fn read_uri(
+    uri: &str,
+    dir: &Path,
+    kind: FileKind,
+    declared: Option<u64>,
+) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let (_, payload) = rest
             .split_once(";base64,")
@@ -82,7 +101,10 @@ pub(crate) fn read_uri(uri: &str, dir: &Path) -> Result<Vec<u8>, String> {
             .map_err(|e| format!("bad base64 in data URI: {e}"));
     }
     let path: PathBuf = dir.join(percent_decode(uri));
-    std::fs::read(&path).map_err(|e| format!("cannot read '{}': {e}", path.display()))
+    match declared {
+        Some(len) => read_prefix(&path, len, kind),
+        None => read_bounded(&path, kind),
+    }
 }
 
 /// URIs in glTF are percent-encoded (`my%20mesh.bin`).

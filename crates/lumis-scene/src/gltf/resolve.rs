@@ -234,7 +234,10 @@ fn load_texture(
         }
         gltf::image::Source::Uri { uri, mime_type } => {
             let dir = asset_path.parent().unwrap_or(Path::new("."));
-            (buffers::read_uri(uri, dir)?, mime_type)
+            (
+                buffers::read_uri(uri, dir, buffers::IMAGE_FILE, None)?,
+                mime_type,
+            )
         }
     };
     const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
