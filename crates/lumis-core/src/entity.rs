@@ -43,8 +43,17 @@ impl PluginEntity {
         structural: &'static [&'static str],
     ) -> Result<Self> {
         let owner = owner.into();
-        let (type_name, type_location) = type_of(&table, &owner)?
-            .ok_or_else(|| Error::at(&location, format!("{owner} needs a type = \"...\"")))?;
+        let (type_name, type_location) = type_of(&table, &owner)?.ok_or_else(|| {
+            // A table an override made (`--spp` sets `sampler.spp`) is
+            // missing from the file itself, which is what to fix.
+            let missing = match location {
+                Location::Override(_) => {
+                    ": the scene file has no such table, and an override only changes a key of it (--spp and --seed are applied as overrides)"
+                }
+                _ => "",
+            };
+            Error::at(&location, format!("{owner} needs a type = \"...\"{missing}"))
+        })?;
         Ok(Self {
             kind,
             owner,

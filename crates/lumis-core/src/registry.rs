@@ -211,7 +211,18 @@ impl Registry {
             plugin.spec.params,
             entity.structural,
         )?;
-        let made = P::call(plugin.factory, &params, input)?;
+        // A factory's own error (a degenerate light shape, a file it could
+        // not read) is placed at the entity that asked for it.
+        let made = P::call(plugin.factory, &params, input).map_err(|e| match e.location {
+            Some(_) => e,
+            None => Error::at(
+                &entity.location,
+                format!(
+                    "{} (type = \"{}\"): {}",
+                    entity.owner, entity.type_name, e.message
+                ),
+            ),
+        })?;
         params.finish()?;
         Ok(made)
     }

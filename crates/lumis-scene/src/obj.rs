@@ -27,25 +27,17 @@ pub(crate) fn import(path: &Path) -> Result<TriangleMesh, String> {
         ignore_points: true,
         ignore_lines: true,
     };
+    check_face_indices(&bytes).map_err(|e| format!("'{}' {e}", path.display()))?;
     let mut reader = LineCounter::new(&bytes);
     let no_materials = |_: &Path| Ok(Default::default());
     let (models, _) = tobj::load_obj_buf(&mut reader, &options, no_materials).map_err(|e| {
-        let line = match e {
-            // Checked when an object ends, so the line read last is not
-            // the face at fault.
-            tobj::LoadError::FaceVertexOutOfBounds => first_face_out_of_bounds(&bytes),
-            _ => Some(reader.line()),
-        };
         // The bytes are in memory, so a read error is a line that is not
         // UTF-8.
         let what = match e {
             tobj::LoadError::ReadError => "not UTF-8 text".to_string(),
             e => e.to_string(),
         };
-        match line {
-            Some(line) => format!("'{}' line {line}: {what}", path.display()),
-            None => format!("'{}': {what}", path.display()),
-        }
+        format!("'{}' line {}: {what}", path.display(), reader.line())
     })?;
     let mut positions = Vec::new();
     let mut indices = Vec::new();
@@ -154,36 +146,63 @@ impl BufRead for LineCounter<'_> {
     }
 }
 
-/// The first `f` line naming a vertex past the file's last `v` (indices
-/// are 1-based; negative ones count back from the vertices read so far).
-fn first_face_out_of_bounds(bytes: &[u8]) -> Option<usize> {
+/// Checks that every face index names an element the file has: a
+/// positive index one of the file's elements of its kind, a negative one
+/// (counting back) one read before it.
+///
+/// `tobj` finds a bad index only when the object ends, so not its line,
+/// and computes with extreme ones in arithmetic that overflows.
+fn check_face_indices(bytes: &[u8]) -> Result<(), String> {
+    const KINDS: [(&str, &str); 3] = [
+        ("v", "vertex"),
+        ("vt", "texture coordinate"),
+        ("vn", "normal"),
+    ];
     let text = String::from_utf8_lossy(bytes);
-    let total = text
-        .lines()
-        .filter(|l| l.split_whitespace().next() == Some("v"))
-        .count() as i64;
-    let mut seen = 0i64;
-    for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => seen += 1,
-            Some("f") => {
-                let out_of_bounds = words.any(|w| {
-                    let index = w.split('/').next().and_then(|v| v.parse::<i64>().ok());
-                    match index {
-                        Some(i) if i > 0 => i > total,
-                        Some(i) if i < 0 => seen + i < 0,
-                        _ => false,
-                    }
-                });
-                if out_of_bounds {
-                    return Some(n + 1);
-                }
-            }
-            _ => {}
+    let mut total = [0i64; 3];
+    for line in text.lines() {
+        if let Some(k) = KINDS
+            .iter()
+            .position(|(tag, _)| line.split_whitespace().next() == Some(tag))
+        {
+            total[k] += 1;
         }
     }
-    None
+    let mut seen = [0i64; 3];
+    for (n, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let Some(tag) = words.next() else { continue };
+        if let Some(k) = KINDS.iter().position(|(t, _)| *t == tag) {
+            seen[k] += 1;
+            continue;
+        }
+        if tag != "f" {
+            continue;
+        }
+        for word in words {
+            for (k, index) in word.split('/').enumerate().take(3) {
+                // Empty fields (`1//2`) and malformed ones are tobj's to judge.
+                let Ok(index) = index.parse::<i64>() else {
+                    continue;
+                };
+                let names_one = match index {
+                    i if i > 0 => i <= total[k],
+                    i if i < 0 => seen[k].checked_add(i).is_some_and(|at| at >= 0),
+                    _ => true,
+                };
+                if !names_one {
+                    return Err(format!(
+                        "line {}: face index {index} names no {} (the file has {}, {} before this line)",
+                        n + 1,
+                        KINDS[k].1,
+                        total[k],
+                        seen[k]
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -203,7 +222,17 @@ mod tests {
         assert!(err.contains("line 3: position parse error"), "{err}");
         let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 9\nv 0 0 1");
         assert!(
-            err.contains("line 5: face vertex index out of bounds"),
+            err.contains("line 5: face index 9 names no vertex"),
+            "{err}"
+        );
+        let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//-2 3//1\n");
+        assert!(
+            err.contains("line 5: face index -2 names no normal"),
+            "{err}"
+        );
+        let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9223372036854775808\n");
+        assert!(
+            err.contains("line 4: face index -9223372036854775808"),
             "{err}"
         );
         let err = error_of(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nvn 0 0");

@@ -41,7 +41,8 @@ pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
 pub const CHANNEL_SCALE: [f64; 3] = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// What the measurement code writes for a sample it does not have.
 pub const INVALID_MARKER: f64 = -1.0;
-const HEADER_BYTES: usize = 12;
+/// Three int32 dimensions.
+pub const HEADER_BYTES: usize = 12;
 /// The size of every valid file.
 pub const FILE_BYTES: usize = HEADER_BYTES + 3 * SAMPLES * 8;
 

@@ -10,6 +10,7 @@ use lumis_core::{Bsdf, Error, Light, LightShape, Location, Result, Vec2, Vec3};
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 
 use super::bvh::{PendingInstance, PendingPrototype};
+use super::has_area;
 use super::state::Assembly;
 use crate::gltf::texture::{AlbedoTextured, TexturedEmitter};
 use crate::gltf::two_sided::TwoSided;
@@ -169,7 +170,7 @@ fn triangle_lights(
     let mut out = Vec::new();
     for (p, vertices) in triangles {
         let [a, b, c] = p;
-        if (b - a).cross(c - a).length_squared() == 0.0 {
+        if !has_area([a, b, c]) {
             out.push(NO_LIGHT);
             continue;
         }

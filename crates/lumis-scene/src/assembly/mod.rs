@@ -137,6 +137,14 @@ fn classify_lights(
     infinite
 }
 
+/// Whether a triangle can be an area light: a finite, non-zero area, which
+/// the `triangle` light requires. Degenerate triangles (and non-finite
+/// ones, which Embree skips too) emit nothing instead of failing the load.
+fn has_area([a, b, c]: [Vec3; 3]) -> bool {
+    let twice_area = (b - a).cross(c - a).length();
+    twice_area > 0.0 && twice_area.is_finite()
+}
+
 fn embree_error(e: lumis_embree::EmbreeError) -> Error {
     Error::msg(e.to_string())
 }

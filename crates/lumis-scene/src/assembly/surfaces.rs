@@ -6,6 +6,7 @@ use std::sync::Arc;
 use lumis_core::{Error, LightShape, PluginEntity, Result, Vec3};
 use lumis_embree::PaddedBuffer;
 
+use super::has_area;
 use super::state::Assembly;
 use crate::description::{Surface, SurfaceGeometry};
 use crate::render_scene::{Geometry, MeshData, NO_LIGHT};
@@ -110,7 +111,7 @@ fn triangle_lights(
     for t in &mesh.indices {
         let [a, b, c] = t.map(|i| Vec3::from(mesh.positions[i as usize]));
         // Zero-area triangles cannot emit; they keep no light.
-        if (b - a).cross(c - a).length_squared() == 0.0 {
+        if !has_area([a, b, c]) {
             per_triangle.push(NO_LIGHT);
             continue;
         }

@@ -35,10 +35,7 @@ pub(crate) fn named_bsdfs(tables: Vec<Located<Table>>) -> Result<Vec<NamedBsdf>>
             None => {
                 return Err(Error::at(
                     &location,
-                    format!(
-                        "[[bsdf]] #{} needs a name = \"...\" that shapes refer to",
-                        i + 1
-                    ),
+                    format!("[[bsdf]] #{i} needs a name = \"...\" that shapes refer to"),
                 ))
             }
         };

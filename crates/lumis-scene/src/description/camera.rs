@@ -140,8 +140,11 @@ fn gltf_camera(
     let origin = world.transform_point3(Vec3::ZERO);
     let target = world.transform_point3(Vec3::NEG_Z);
     let up = world.transform_vector3(Vec3::Y);
-    let camera = PerspectiveCamera::new(origin, target, up, fov.to_degrees(), resolution)
-        .map_err(|e| Error::at(&location, format!("{owner}: {}", e.message)))?;
+    let camera =
+        PerspectiveCamera::new(origin, target, up, fov.to_degrees(), resolution).map_err(|e| {
+            let placed = format!("the camera's node in '{file}' places it so that");
+            Error::at(&location, format!("{owner}: {placed} {}", e.message))
+        })?;
     params.finish()?;
     Ok(camera)
 }

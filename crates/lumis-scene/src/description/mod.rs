@@ -91,7 +91,7 @@ impl SceneDescription {
             .into_iter()
             .enumerate()
             .map(|(i, (table, location))| {
-                let owner = format!("[[light]] #{}", i + 1);
+                let owner = format!("[[light]] #{i}");
                 PluginEntity::from_table(PluginKind::Light, owner, table, location, TYPE_KEY)
             })
             .collect::<Result<Vec<_>>>()?;

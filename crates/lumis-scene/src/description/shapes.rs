@@ -141,7 +141,8 @@ pub(crate) fn shape(
     (table, location): Located<Table>,
     scene_dir: &Path,
 ) -> Result<ShapeEntity> {
-    let owner = format!("[[shape]] #{}", index + 1);
+    // Numbered from 0, as `--set shape.N` addresses it.
+    let owner = format!("[[shape]] #{index}");
     let (kind, kind_location) = type_of(&table, &location, &owner)?;
     let spec = SHAPE_TYPES
         .iter()

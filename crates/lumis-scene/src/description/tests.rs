@@ -111,7 +111,7 @@ emission = { type = "my_triangle", radiance = 1.0 }
         panic!("a surface")
     };
     let emission = quad.emission.as_ref().unwrap();
-    assert_eq!(emission.owner, "[[shape]] #1 (type = \"quad\") emission");
+    assert_eq!(emission.owner, "[[shape]] #0 (type = \"quad\") emission");
     assert_eq!(emission.location.to_string(), "s.toml:19:12");
     assert_eq!(quad.bsdf.location.to_string(), "s.toml:18:8");
 }

@@ -43,9 +43,49 @@ pub(crate) fn document(
     label: &str,
 ) -> Result<(gltf::Document, Option<Vec<u8>>), String> {
     let bytes = read_bounded(path, GLTF_FILE)?;
-    let gltf = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| format!("'{label}' is not a valid glTF 2.0 file: {e}"))?;
-    Ok((gltf.document, gltf.blob))
+    let invalid =
+        |e: &dyn std::fmt::Display| format!("'{label}' is not a valid glTF 2.0 file: {e}");
+    // gltf 1.4 subtracts the 12-byte GLB header from the declared length
+    // without checking that it is at least that.
+    if let Some(declared) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|length| u32::from_le_bytes(length.try_into().expect("4 bytes")))
+    {
+        if declared < 12 {
+            return Err(invalid(&format!(
+                "the GLB header declares a length of {declared} bytes, less than the header's own 12"
+            )));
+        }
+    }
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| invalid(&e))?;
+    let json = gltf.document.into_json();
+    check_position_indices(&json).map_err(|e| invalid(&e))?;
+    let document = gltf::Document::from_json(json).map_err(|e| invalid(&e))?;
+    Ok((document, gltf.blob))
+}
+
+/// The `gltf` crate's validation indexes the accessors with each
+/// primitive's `POSITION` before it checks that index (gltf-json 1.4,
+/// `primitive_validate_hook`), and panics on one out of range; checked here
+/// first.
+fn check_position_indices(json: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::Checked;
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive
+                .attributes
+                .get(&Checked::Valid(gltf::Semantic::Positions));
+            if let Some(index) = position.filter(|i| i.value() >= accessors) {
+                return Err(format!(
+                    "meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} does not exist ({accessors} accessors)",
+                    index.value()
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Reads the asset and every buffer it declares.

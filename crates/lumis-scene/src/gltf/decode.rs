@@ -326,8 +326,9 @@ fn dense_triangles(asset: &Asset, accessor: &gltf::Accessor) -> Option<Vec<[u32;
     Some(out)
 }
 
-/// Checks an accessor's type and that its bytes lie within its buffer
-/// view and the view within its buffer.
+/// Checks an accessor's type and that its bytes, and its sparse indices
+/// and values, lie within their buffer views and the views within their
+/// buffers, so the `gltf` crate's reader only ever slices in bounds.
 fn check_accessor(
     asset: &Asset,
     accessor: &gltf::Accessor,
@@ -343,49 +344,120 @@ fn check_accessor(
             accessor.data_type()
         ));
     }
-    // lumis indexes vertices with u32; larger counts are also what a
-    // corrupt count would look like, refused before anything is allocated.
-    if accessor.count() > u32::MAX as usize {
+    // glTF 2.0 requires count >= 1. lumis indexes vertices with u32;
+    // larger counts are also what a corrupt count would look like,
+    // refused before anything is allocated.
+    if accessor.count() == 0 || accessor.count() > u32::MAX as usize {
         return Err(format!(
-            "{name} has {} elements, more than lumis indexes (2^32 - 1)",
+            "{name} has {} elements; lumis reads 1 to 2^32 - 1",
             accessor.count()
         ));
     }
-    let Some(view) = accessor.view() else {
-        // Sparse-only accessors have no view; the reader fills them in from
-        // the sparse values, so their count must be backed by those.
-        return match accessor.sparse() {
-            Some(sparse) if accessor.count() <= sparse.count() * 64 + (1 << 20) => Ok(()),
-            Some(_) => Err(format!(
-                "{name} has no buffer view and {} elements for {} sparse values",
-                accessor.count(),
-                accessor.sparse().map_or(0, |s| s.count())
-            )),
-            None => Err(format!(
-                "{name} has neither a buffer view nor sparse values"
-            )),
+    let size = accessor.size();
+    if let Some(view) = accessor.view() {
+        let span = Span {
+            offset: accessor.offset(),
+            count: accessor.count(),
+            size,
         };
-    };
+        check_span(asset, &view, span, &name)?;
+    }
+    match accessor.sparse() {
+        Some(sparse) => {
+            // Without a view the reader makes `count` zeros for the sparse
+            // values to land on: bounded by what the values could mean.
+            if accessor.view().is_none()
+                && accessor.count() > sparse.count().saturating_mul(64) + (1 << 20)
+            {
+                return Err(format!(
+                    "{name} has no buffer view and {} elements for {} sparse values",
+                    accessor.count(),
+                    sparse.count()
+                ));
+            }
+            if sparse.count() == 0 || sparse.count() > accessor.count() {
+                return Err(format!(
+                    "{name} has {} sparse values for {} elements",
+                    sparse.count(),
+                    accessor.count()
+                ));
+            }
+            let indices = sparse.indices();
+            let span = Span {
+                offset: indices.offset(),
+                count: sparse.count(),
+                size: indices.index_type().size(),
+            };
+            check_span(
+                asset,
+                &indices.view(),
+                span,
+                &format!("{name}'s sparse indices"),
+            )?;
+            let values = sparse.values();
+            let span = Span {
+                offset: values.offset(),
+                count: sparse.count(),
+                size,
+            };
+            check_span(
+                asset,
+                &values.view(),
+                span,
+                &format!("{name}'s sparse values"),
+            )
+        }
+        None if accessor.view().is_none() => Err(format!(
+            "{name} has neither a buffer view nor sparse values"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// `count` elements of `size` bytes from `offset` in a buffer view.
+struct Span {
+    offset: usize,
+    count: usize,
+    size: usize,
+}
+
+/// Checks that `span` lies within `view` and `view` within its buffer.
+/// Offsets and lengths come from the file: a sum past `usize::MAX` is as
+/// out of bounds as any other.
+fn check_span(
+    asset: &Asset,
+    view: &gltf::buffer::View,
+    span: Span,
+    name: &str,
+) -> Result<(), String> {
     let buffer = view.buffer();
     let data_len = asset.buffer(buffer.index()).len();
-    let view_end = view.offset() + view.length();
-    if view_end > data_len {
+    let view_end = view.offset().checked_add(view.length());
+    if view_end.is_none_or(|end| end > data_len) {
+        let view_end = view_end.map_or("beyond 2^64".to_string(), |e| e.to_string());
         return Err(format!(
             "{name}: buffer view #{} ends at byte {view_end}, past the {data_len} bytes of buffer #{} (truncated buffer?)",
             view.index(),
             buffer.index()
         ));
     }
-    if accessor.count() == 0 {
-        return Ok(());
+    let stride = view.stride().unwrap_or(span.size);
+    if stride < span.size {
+        return Err(format!(
+            "{name}: buffer view #{} has a byteStride of {stride}, less than the {}-byte elements",
+            view.index(),
+            span.size
+        ));
     }
-    let size = accessor.size();
-    let stride = view.stride().unwrap_or(size);
-    let end = accessor.offset() + stride * (accessor.count() - 1) + size;
-    if end > view.length() {
+    let end = stride
+        .checked_mul(span.count - 1)
+        .and_then(|e| e.checked_add(span.size))
+        .and_then(|e| e.checked_add(span.offset));
+    if end.is_none_or(|end| end > view.length()) {
+        let end = end.map_or("more than 2^64".to_string(), |e| e.to_string());
         return Err(format!(
             "{name}: {} elements need {end} bytes but buffer view #{} has {}",
-            accessor.count(),
+            span.count,
             view.index(),
             view.length()
         ));

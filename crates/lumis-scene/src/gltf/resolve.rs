@@ -126,7 +126,7 @@ pub(crate) fn resolve_materials(
                 let (entity, warnings) = material::bsdf_entity(
                     &material,
                     &material_label,
-                    format!("{owner} material {material_label}"),
+                    format!("{owner} '{label}' material {material_label}"),
                     at,
                 )
                 .map_err(err)?;
@@ -176,7 +176,7 @@ pub(crate) fn resolve_materials(
             entity: material::emission_entity(
                 radiance,
                 material.double_sided(),
-                format!("{owner} emission"),
+                format!("{owner} '{label}' material {material_label} emission"),
                 at,
             ),
             texture: emission_texture,
@@ -219,11 +219,29 @@ fn load_texture(
     asset_path: &Path,
 ) -> std::result::Result<Texture, String> {
     let image = texture.source();
+    // `Image::source` unwraps the uri when there is no buffer view, and the
+    // mimeType when there is one (gltf 1.4): both are checked first.
+    let json = &asset.document.as_json().images[image.index()];
+    match (&json.uri, &json.buffer_view, &json.mime_type) {
+        (None, None, _) => {
+            return Err(format!(
+                "images[{}] has neither a uri nor a bufferView",
+                image.index()
+            ))
+        }
+        (_, Some(_), None) => {
+            return Err(format!(
+                "images[{}] has a bufferView but no mimeType, which glTF 2.0 requires with one",
+                image.index()
+            ))
+        }
+        _ => {}
+    }
     let (bytes, mime): (Vec<u8>, Option<&str>) = match image.source() {
         gltf::image::Source::View { view, mime_type } => {
             let data = asset.buffer(view.buffer().index());
-            let end = view.offset() + view.length();
-            let bytes = data.get(view.offset()..end).ok_or_else(|| {
+            let range = view.offset()..view.offset().saturating_add(view.length());
+            let bytes = data.get(range).ok_or_else(|| {
                 format!(
                     "image #{} lies past the end of buffer #{} (truncated?)",
                     image.index(),
