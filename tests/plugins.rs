@@ -247,3 +247,160 @@ fn a_truncated_library_is_an_error() {
         "{err}"
     );
 }
+
+/// `cargo build -p lumis-cli`, returning the path of the `lumis` it wrote.
+fn build_lumis() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = Command::new(cargo)
+        .args(["build", "-p", "lumis-cli", "--message-format=json"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    stdout
+        .split('"')
+        .find(|s| s.ends_with("/lumis") && std::path::Path::new(s).is_file())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| panic!("cargo reported no lumis executable:\n{stdout}"))
+}
+
+/// A panic in a loaded plugin, in `register`, its factory or any method,
+/// is an error naming the plugin, its parameters, its library and the
+/// method: `lumis` exits 1, never aborts (exit 134), and writes no image.
+/// In `check-plugin` the cases of the panicking variants fail with it and
+/// the sweep goes on.
+#[test]
+fn a_panicking_plugin_is_an_error_not_an_abort() {
+    let library = build_plugin("panicking-plugin", "panicking_plugin");
+    let lumis = build_lumis();
+    let dir = tempfile::tempdir().unwrap();
+    let run = |args: &[&str], register_panics: bool| {
+        let mut command = Command::new(&lumis);
+        command.args(args).env_remove("LUMIS_PLUGIN_PATH");
+        if register_panics {
+            command.env("LUMIS_TEST_PANIC_IN_REGISTER", "1");
+        }
+        let out = command.output().expect("lumis runs");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let lib = library.to_str().unwrap();
+
+    let (code, _, stderr) = run(&["plugins", "--load", lib], true);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        stderr.contains("panicked in register: the fixture panics in register as asked"),
+        "{stderr}"
+    );
+
+    // `f` and `pdf` are reached through `eval`, the call that crosses the
+    // boundary.
+    for (panic_in, method) in [
+        ("factory", "its factory"),
+        ("f", "Bsdf::eval"),
+        ("sample-f", "Bsdf::sample_f"),
+        ("pdf", "Bsdf::eval"),
+    ] {
+        let scene = dir.path().join(format!("{panic_in}.toml"));
+        let text = scene_with_plugin(lib, panic_in);
+        std::fs::write(&scene, text).unwrap();
+        let output = dir.path().join(panic_in);
+        let (code, _, stderr) = run(
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "-q",
+                "-o",
+                output.to_str().unwrap(),
+            ],
+            false,
+        );
+        assert_eq!(code, Some(1), "{panic_in}: {stderr}");
+        for part in [
+            format!("panicked in {method}: the fixture panics in"),
+            format!("panic_in = \"{panic_in}\""),
+            lib.to_string(),
+        ] {
+            assert!(
+                stderr.contains(&part),
+                "{panic_in}: no '{part}' in {stderr}"
+            );
+        }
+        assert!(!output.with_extension("exr").exists(), "{panic_in}");
+    }
+
+    let out_dir = dir.path().join("check");
+    std::fs::create_dir_all(&out_dir).unwrap();
+    let (code, stdout, stderr) = run(
+        &[
+            "check-plugin",
+            lib,
+            "--samples",
+            "20000",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        false,
+    );
+    assert_eq!(code, Some(1), "{stdout}{stderr}");
+    for method in ["its factory", "Bsdf::f", "Bsdf::sample_f", "Bsdf::pdf"] {
+        assert!(
+            stdout.contains(&format!("panicked in {method}")),
+            "{method}: {stdout}"
+        );
+    }
+    let nowhere_passes = stdout
+        .lines()
+        .filter(|l| l.contains("panic_in = \"nowhere\"") || l.contains("base"))
+        .any(|l| l.trim_end().ends_with("ok"));
+    assert!(nowhere_passes, "{stdout}");
+}
+
+fn scene_with_plugin(library: &str, panic_in: &str) -> String {
+    format!(
+        r#"[plugins]
+load = ["{library}"]
+[film]
+resolution = [8, 8]
+[camera]
+type = "perspective"
+origin = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fov = 40.0
+[sampler]
+type = "independent"
+spp = 4
+[integrator]
+type = "path"
+[[bsdf]]
+name = "faulty"
+type = "panicking"
+panic_in = "{panic_in}"
+[[shape]]
+type = "quad"
+corner = [-1.0, -1.0, 0.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 2.0, 0.0]
+bsdf = "faulty"
+[[bsdf]]
+name = "white"
+type = "diffuse"
+reflectance = 0.5
+[[shape]]
+type = "quad"
+corner = [1.2, -0.5, 1.5]
+edge_u = [0.0, 1.0, 0.0]
+edge_v = [1.0, 0.0, 0.0]
+bsdf = "white"
+emission = {{ radiance = [4.0, 4.0, 4.0] }}
+"#
+    )
+}

@@ -265,7 +265,7 @@ fn mutate_glb_json(rng: &mut Rng, glb: &[u8]) -> Vec<u8> {
     let json_len = u32_at(12);
     let doc: Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
     let mut json = serde_json::to_vec(&mutate::json(rng, &doc)).unwrap();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let rest = &glb[20 + json_len..];

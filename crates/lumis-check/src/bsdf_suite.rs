@@ -202,7 +202,7 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
 
 /// The BSDF plugin `name` with the parameters of `variant`.
 pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
-    let owner = format!("bsdf \"{name}\" [{}]", variant.label);
+    let owner = owner(name, variant);
     let entity = PluginEntity::new(
         PluginKind::Bsdf,
         owner,
@@ -211,6 +211,36 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
         Location::Builtin,
     );
     registry.create::<dyn Bsdf>(&entity, ())
+}
+
+/// The failed case of a variant the plugin could not make.
+fn unmade(name: &str, variant: &Variant, cos_theta_o: f32, error: &Error) -> CaseResult {
+    CaseResult {
+        bsdf: name.to_string(),
+        variant: variant.label.clone(),
+        cos_theta_o,
+        chi_square: ChiSquareReport {
+            statistic: f64::NAN,
+            degrees_of_freedom: 0,
+            p_value: f64::NAN,
+            pdf_integral: f64::NAN,
+            sampled_fraction: f64::NAN,
+            defect: Some("not tested: the plugin was not made".into()),
+            passed: false,
+            observed: Vec::new(),
+            expected: Vec::new(),
+        },
+        zoom: f64::NAN,
+        albedo: f64::NAN,
+        albedo_se: f64::NAN,
+        problems: vec![error.to_string()],
+    }
+}
+
+/// How the plugin made for `variant` is named, in messages and in the
+/// registry's record of faults.
+fn owner(name: &str, variant: &Variant) -> String {
+    format!("bsdf \"{name}\" [{}]", variant.label)
 }
 
 fn direction(cos_theta: f32, phi: f32) -> Vec3 {
@@ -454,12 +484,14 @@ pub fn check_bsdf_variants(
     cfg: &BsdfCheckConfig,
 ) -> Result<Vec<CaseResult>> {
     let cases = variants.len() * cfg.cos_theta_o.len();
-    let bsdfs = variants
+    // A variant the plugin cannot make fails its cases; the others go on.
+    let bsdfs: Vec<_> = variants
         .iter()
         .map(|v| instantiate(registry, name, v))
-        .collect::<Result<Vec<_>>>()?;
+        .collect();
     let tests: usize = bsdfs
         .iter()
+        .flatten()
         .map(|b| hemispheres(b.as_ref()).len() * cfg.cos_theta_o.len())
         .sum();
     let chi_cfg = ChiSquareConfig {
@@ -472,9 +504,13 @@ pub fn check_bsdf_variants(
             work.push((work.len(), variant, bsdf, i, c));
         }
     }
-    Ok(work
+    let mut results: Vec<CaseResult> = work
         .into_par_iter()
         .map(|(case, variant, bsdf, i, c)| {
+            let bsdf = match bsdf {
+                Ok(bsdf) => bsdf,
+                Err(e) => return unmade(name, variant, c, e),
+            };
             let wo = direction(c, 0.3 + i as f32);
             // Each case (and hemisphere) draws its own samples, so the
             // tests are independent as the Sidak correction assumes.
@@ -508,7 +544,21 @@ pub fn check_bsdf_variants(
                 problems,
             }
         })
-        .collect())
+        .collect();
+    // A loaded plugin that panicked answered with neutral values (see
+    // lumis_core::guard); every case of its variant fails with the panic.
+    for (result, variant) in results.iter_mut().zip(
+        variants
+            .iter()
+            .flat_map(|v| std::iter::repeat_n(v, cfg.cos_theta_o.len())),
+    ) {
+        for fault in registry.faults().faults_of(&owner(name, variant)) {
+            if !result.problems.iter().any(|p| p.contains(&fault.message)) {
+                result.problems.push(fault.to_string());
+            }
+        }
+    }
+    Ok(results)
 }
 
 /// Where a chi-square test looks for samples.

@@ -12,7 +12,7 @@ use lumis_cli::{
     registry_with_search_path, render_reference, render_scene_file, tabulate_bsdf, AnalyzeArgs,
     ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
 };
-use lumis_core::{Error, PluginKind, Result};
+use lumis_core::{Error, PluginKind, Registry, Result};
 
 #[derive(Parser)]
 #[command(
@@ -225,15 +225,19 @@ fn check_plugin(
     let fixed = lumis_cli::fixed_parameters(set)?;
     let mut registry = registry_with_search_path()?;
     if let Some(library) = &library {
-        lumis_loader::load_library(library, &mut registry)?;
-        let source = library.display().to_string();
-        names.extend(
+        // The library's BSDFs are the ones it added (its path as the
+        // registry labels them is the resolved one, not the one given).
+        let bsdfs = |registry: &Registry| -> Vec<String> {
             registry
                 .plugins()
                 .into_iter()
-                .filter(|p| p.spec.kind == PluginKind::Bsdf && *p.source == *source)
-                .map(|p| p.spec.name.to_string()),
-        );
+                .filter(|p| p.spec.kind == PluginKind::Bsdf)
+                .map(|p| p.spec.name.to_string())
+                .collect()
+        };
+        let before = bsdfs(&registry);
+        lumis_loader::load_library(library, &mut registry)?;
+        names.extend(bsdfs(&registry).into_iter().filter(|n| !before.contains(n)));
     }
     if names.is_empty() {
         return Err(Error::msg(
@@ -251,7 +255,7 @@ fn check_plugin(
         for (i, r) in results
             .iter()
             .enumerate()
-            .filter(|(_, r)| !r.chi_square.passed)
+            .filter(|(_, r)| !r.chi_square.passed && !r.chi_square.observed.is_empty())
         {
             let path = out.join(format!("check-{name}-{i}.png"));
             write_histogram_png(&r.chi_square, &cfg.chi_square, &path)?;

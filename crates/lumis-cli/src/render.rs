@@ -204,6 +204,9 @@ pub fn render_scene_file(
     );
     let profile = profile.map(Profile::finish);
     let out = out?;
+    // A loaded plugin that panicked answered with neutral values: the image
+    // is not the scene's, and the panic is the error.
+    registry.faults().check()?;
     lumis_image::write_exr(&exr, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     lumis_image::write_png(&png, &out.image).map_err(|e| Error::msg(e.to_string()))?;
     Ok(RenderReport {

@@ -44,6 +44,38 @@ impl Value {
     }
 }
 
+/// TOML-like text of a value, for messages that repeat what was written.
+impl std::fmt::Display for Value {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Bool(b) => write!(f, "{b}"),
+            Value::Int(i) => write!(f, "{i}"),
+            Value::Float(x) => write!(f, "{x:?}"),
+            Value::String(s) | Value::Datetime(s) => write!(f, "{s:?}"),
+            Value::Array(items) => {
+                f.write_str("[")?;
+                for (i, item) in items.iter().enumerate() {
+                    let sep = if i == 0 { "" } else { ", " };
+                    write!(f, "{sep}{}", item.value)?;
+                }
+                f.write_str("]")
+            }
+            Value::Table(table) => write!(f, "{{ {table} }}"),
+        }
+    }
+}
+
+/// `key = value, ...`: a table's entries in the order written.
+impl std::fmt::Display for Table {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, entry) in self.entries.iter().enumerate() {
+            let sep = if i == 0 { "" } else { ", " };
+            write!(f, "{sep}{} = {}", entry.key, entry.node.value)?;
+        }
+        Ok(())
+    }
+}
+
 /// One `key = value` of a table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entry {

@@ -14,6 +14,7 @@ pub mod doc;
 pub mod entity;
 pub mod error;
 pub mod files;
+pub mod guard;
 pub mod integrator;
 pub mod interaction;
 pub mod light;

@@ -12,7 +12,7 @@ use crate::error::Result;
 use crate::registry::Registry;
 
 /// Bumped whenever [`PluginDeclaration`] or the plugin traits change shape.
-pub const PLUGIN_ABI_VERSION: u32 = 8;
+pub const PLUGIN_ABI_VERSION: u32 = 9;
 /// The compiler that built this copy of lumis-core.
 pub const RUSTC_VERSION: &str = env!("LUMIS_RUSTC_VERSION");
 /// The version of this copy of lumis-core.
@@ -110,15 +110,20 @@ impl PluginDeclaration {
 /// ```
 ///
 /// The entry point only returns a pointer to a static, so no panic can
-/// cross it; the host calls `register` inside `catch_unwind`.
+/// cross it. `register` runs under the plugin's own `catch_unwind`, and so
+/// do the factories it adds and the plugins they make (`crate::guard`): a
+/// panic in the plugin is an error the host reports, not an abort.
 #[macro_export]
 macro_rules! lumis_plugin {
     ($register:path) => {
         #[allow(unsafe_code)]
         #[no_mangle]
         pub extern "C" fn lumis_plugin_declaration() -> *const $crate::plugin::PluginDeclaration {
+            fn register_guarded(registry: &mut $crate::Registry) -> $crate::Result<()> {
+                $crate::guard::register_guarded(registry, $register)
+            }
             static DECLARATION: $crate::plugin::PluginDeclaration =
-                $crate::plugin::PluginDeclaration::new($register);
+                $crate::plugin::PluginDeclaration::new(register_guarded);
             &DECLARATION
         }
     };

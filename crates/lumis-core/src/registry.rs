@@ -11,6 +11,7 @@ use std::sync::Arc;
 use crate::bsdf::Bsdf;
 use crate::entity::PluginEntity;
 use crate::error::{Error, Result};
+use crate::guard::{FaultSink, Guarded, PluginGuard};
 use crate::integrator::Integrator;
 use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
@@ -73,6 +74,28 @@ pub type LightFactory = fn(&Params, &LightShape) -> Result<Box<dyn Light>>;
 pub type LightSamplerFactory = fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>>;
 pub type IntegratorFactory = fn(&Params) -> Result<Box<dyn Integrator>>;
 
+// Factories as registered: the plugin's own function, or that function
+// guarded; shared, since registries are cloned per scene.
+type MakeSampler = Arc<dyn Fn(&Params) -> Result<Box<dyn Sampler>> + Send + Sync>;
+type MakeBsdf = Arc<dyn Fn(&Params) -> Result<Arc<dyn Bsdf>> + Send + Sync>;
+type MakeLight = Arc<dyn Fn(&Params, &LightShape) -> Result<Box<dyn Light>> + Send + Sync>;
+type MakeLightSampler =
+    Arc<dyn Fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>> + Send + Sync>;
+type MakeIntegrator = Arc<dyn Fn(&Params) -> Result<Box<dyn Integrator>> + Send + Sync>;
+
+/// Calls a loaded plugin's `factory` under `guard`, and guards what it
+/// makes. Labels the plugin with its table as written, for messages.
+fn guarded<M>(
+    guard: &PluginGuard,
+    params: &Params,
+    factory: impl FnOnce() -> Result<M>,
+    wrap: impl FnOnce(M, PluginGuard, Arc<str>) -> M,
+) -> Result<M> {
+    let label: Arc<str> = Arc::from(format!("{} {{ {} }}", params.owner(), params.written()));
+    let made = guard.call(&label, "its factory", factory)??;
+    Ok(wrap(made, guard.clone(), label))
+}
+
 /// A registered plugin and where it came from.
 #[derive(Clone)]
 pub struct Registered {
@@ -87,6 +110,11 @@ pub struct Registered {
 pub struct Registry {
     plugins: Vec<Registered>,
     source: Arc<str>,
+    /// Set while a library registers: its factories and their plugins are
+    /// then guarded (see [`crate::guard`]).
+    guard: Option<PluginGuard>,
+    /// Where guarded plugins report a panic; shared by clones.
+    faults: Arc<FaultSink>,
 }
 
 impl Default for Registry {
@@ -100,12 +128,28 @@ impl Registry {
         Self {
             plugins: Vec::new(),
             source: Arc::from("built-in"),
+            guard: None,
+            faults: Arc::default(),
         }
     }
 
-    /// Labels the plugins registered from now on (e.g. a library's path).
-    pub fn set_source(&mut self, source: &str) {
-        self.source = Arc::from(source);
+    /// Plugins registered from now on come from the library at `path`:
+    /// they are labelled with it, and guarded, until [`Registry::end_library`].
+    pub fn begin_library(&mut self, path: &str) {
+        self.source = Arc::from(path);
+        self.guard = Some(PluginGuard::new(path, self.faults.clone()));
+    }
+
+    /// Plugins registered from now on are built-in again.
+    pub fn end_library(&mut self) {
+        self.source = Arc::from("built-in");
+        self.guard = None;
+    }
+
+    /// Where a panic of any loaded plugin is recorded; a host checks it
+    /// after the calls it made ([`FaultSink::check`]).
+    pub fn faults(&self) -> &Arc<FaultSink> {
+        &self.faults
     }
 
     /// Where plugins registered now are said to come from.
@@ -138,19 +182,56 @@ impl Registry {
         Ok(())
     }
 
+    // In a library's registration, each `add_*` below runs in the
+    // library's own copy of this code, so the closures it makes, and their
+    // `catch_unwind`, are the library's (see `crate::guard`).
+
     pub fn add_sampler(&mut self, spec: PluginSpec, factory: SamplerFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Sampler)?;
-        self.add(spec, Factory::Sampler(factory))
+        let make: MakeSampler = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params),
+                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::Sampler(make))
     }
 
     pub fn add_bsdf(&mut self, spec: PluginSpec, factory: BsdfFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Bsdf)?;
-        self.add(spec, Factory::Bsdf(factory))
+        let make: MakeBsdf = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params),
+                    |made, guard, label| Arc::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::Bsdf(make))
     }
 
     pub fn add_light(&mut self, spec: PluginSpec, factory: LightFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Light)?;
-        self.add(spec, Factory::Light(factory))
+        let make: MakeLight = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params, shape: &LightShape| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params, shape),
+                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::Light(make))
     }
 
     pub fn add_light_sampler(
@@ -159,12 +240,34 @@ impl Registry {
         factory: LightSamplerFactory,
     ) -> Result<()> {
         Self::check_kind(&spec, PluginKind::LightSampler)?;
-        self.add(spec, Factory::LightSampler(factory))
+        let make: MakeLightSampler = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params, lights: &[Box<dyn Light>]| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params, lights),
+                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::LightSampler(make))
     }
 
     pub fn add_integrator(&mut self, spec: PluginSpec, factory: IntegratorFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Integrator)?;
-        self.add(spec, Factory::Integrator(factory))
+        let make: MakeIntegrator = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params),
+                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::Integrator(make))
     }
 
     pub fn find(&self, kind: PluginKind, name: &str) -> Option<&Registered> {
@@ -213,7 +316,7 @@ impl Registry {
         )?;
         // A factory's own error (a degenerate light shape, a file it could
         // not read) is placed at the entity that asked for it.
-        let made = P::call(plugin.factory, &params, input).map_err(|e| match e.location {
+        let made = P::call(&plugin.factory, &params, input).map_err(|e| match e.location {
             Some(_) => e,
             None => Error::at(
                 &entity.location,
@@ -265,7 +368,7 @@ pub trait PluginInterface: sealed::Sealed {
     type Input<'i>;
     #[doc(hidden)]
     fn call(
-        factory: sealed::Factory,
+        factory: &sealed::Factory,
         params: &Params,
         input: Self::Input<'_>,
     ) -> Result<Self::Made>;
@@ -276,14 +379,15 @@ mod sealed {
 
     pub trait Sealed {}
 
-    /// A registered factory, by kind.
-    #[derive(Clone, Copy)]
+    /// A registered factory, by kind: the plugin's own function, or that
+    /// function guarded.
+    #[derive(Clone)]
     pub enum Factory {
-        Sampler(SamplerFactory),
-        Bsdf(BsdfFactory),
-        Light(LightFactory),
-        LightSampler(LightSamplerFactory),
-        Integrator(IntegratorFactory),
+        Sampler(MakeSampler),
+        Bsdf(MakeBsdf),
+        Light(MakeLight),
+        LightSampler(MakeLightSampler),
+        Integrator(MakeIntegrator),
     }
 
     impl Sealed for dyn Sampler {}
@@ -304,7 +408,7 @@ impl PluginInterface for dyn Sampler {
     const KIND: PluginKind = PluginKind::Sampler;
     type Made = Box<dyn Sampler>;
     type Input<'i> = ();
-    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
         let Factory::Sampler(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -316,7 +420,7 @@ impl PluginInterface for dyn Bsdf {
     const KIND: PluginKind = PluginKind::Bsdf;
     type Made = Arc<dyn Bsdf>;
     type Input<'i> = ();
-    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
         let Factory::Bsdf(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -328,7 +432,7 @@ impl PluginInterface for dyn Light {
     const KIND: PluginKind = PluginKind::Light;
     type Made = Box<dyn Light>;
     type Input<'i> = &'i LightShape;
-    fn call(factory: Factory, params: &Params, shape: &LightShape) -> Result<Self::Made> {
+    fn call(factory: &Factory, params: &Params, shape: &LightShape) -> Result<Self::Made> {
         let Factory::Light(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -340,7 +444,7 @@ impl PluginInterface for dyn LightSampler {
     const KIND: PluginKind = PluginKind::LightSampler;
     type Made = Box<dyn LightSampler>;
     type Input<'i> = &'i [Box<dyn Light>];
-    fn call(factory: Factory, params: &Params, lights: &[Box<dyn Light>]) -> Result<Self::Made> {
+    fn call(factory: &Factory, params: &Params, lights: &[Box<dyn Light>]) -> Result<Self::Made> {
         let Factory::LightSampler(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -352,7 +456,7 @@ impl PluginInterface for dyn Integrator {
     const KIND: PluginKind = PluginKind::Integrator;
     type Made = Box<dyn Integrator>;
     type Input<'i> = ();
-    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
         let Factory::Integrator(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };

@@ -8,9 +8,11 @@
 //!   equal the host's, or nothing else in the library is touched;
 //! - a library already loaded is not loaded again;
 //! - the registry is passed in, never shared through globals;
-//! - the entry point and `register` run inside `catch_unwind`, which
-//!   catches a panic only where the library shares the host's panic
-//!   runtime (a `cdylib` carries its own, and its panics abort);
+//! - a `cdylib` carries its own panic runtime, whose panics the host
+//!   cannot catch: `lumis_plugin!` runs `register` under the library's own
+//!   `catch_unwind`, and the registry guards the library's factories and
+//!   plugins the same way (`lumis_core::guard`), so a panic in a plugin is
+//!   an error in the registry's fault sink;
 //! - a library is never unloaded (thread-local destructors and vtables of
 //!   objects it created must outlive every use), so it is leaked on purpose.
 
@@ -148,10 +150,9 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
              point the plugin's lumis-core dependency at this lumis and rebuild"
         )));
     }
-    let previous = registry.source().to_string();
-    registry.set_source(&shown.to_string());
+    registry.begin_library(&shown.to_string());
     let registered = catch_unwind(AssertUnwindSafe(|| (declaration.register)(registry)));
-    registry.set_source(&previous);
+    registry.end_library();
     match registered {
         Ok(Ok(())) => {}
         Ok(Err(e)) => return Err(e.context(format!("'{shown}' failed to register"))),

@@ -82,6 +82,11 @@ impl<'a> Params<'a> {
         Self::new(owner, table, Location::Builtin, spec, &["type", "name"])
     }
 
+    /// The table as written, for messages that repeat it.
+    pub fn written(&self) -> &Table {
+        self.table
+    }
+
     pub fn owner(&self) -> &str {
         &self.owner
     }
