@@ -15,6 +15,17 @@ fn build_example_plugin() -> PathBuf {
 
 /// `cargo build -p PACKAGE`, returning the path of the cdylib `LIB` it wrote.
 fn build_plugin(package: &str, lib: &str) -> PathBuf {
+    let name = format!(
+        "{}{lib}.{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_EXTENSION
+    );
+    cargo_build(package, &format!("/{name}"))
+}
+
+/// `cargo build -p PACKAGE`, returning the path of the file it wrote whose
+/// path ends with `suffix`.
+fn cargo_build(package: &str, suffix: &str) -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = Command::new(cargo)
         .args(["build", "-p", package, "--message-format=json"])
@@ -27,16 +38,11 @@ fn build_plugin(package: &str, lib: &str) -> PathBuf {
         String::from_utf8_lossy(&out.stderr)
     );
     let stdout = String::from_utf8(out.stdout).unwrap();
-    let name = format!(
-        "{}{lib}.{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_EXTENSION
-    );
     stdout
         .split('"')
-        .find(|s| s.ends_with(&name))
+        .find(|s| s.ends_with(suffix) && std::path::Path::new(s).is_file())
         .map(PathBuf::from)
-        .unwrap_or_else(|| panic!("cargo reported no {name}:\n{stdout}"))
+        .unwrap_or_else(|| panic!("cargo reported no {suffix}:\n{stdout}"))
 }
 
 fn scene(plugins: &str, seed: u32) -> String {
@@ -250,23 +256,7 @@ fn a_truncated_library_is_an_error() {
 
 /// `cargo build -p lumis-cli`, returning the path of the `lumis` it wrote.
 fn build_lumis() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args(["build", "-p", "lumis-cli", "--message-format=json"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("cargo runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    stdout
-        .split('"')
-        .find(|s| s.ends_with("/lumis") && std::path::Path::new(s).is_file())
-        .map(PathBuf::from)
-        .unwrap_or_else(|| panic!("cargo reported no lumis executable:\n{stdout}"))
+    cargo_build("lumis-cli", "/lumis")
 }
 
 /// A panic in a loaded plugin, in `register`, its factory or any method,
