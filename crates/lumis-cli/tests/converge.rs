@@ -40,6 +40,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
             ..Default::default()
         },
         &registry,
+        &std::sync::atomic::AtomicBool::new(false),
     )
     .unwrap();
     let variants = dir.join("variants.toml");

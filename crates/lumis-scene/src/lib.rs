@@ -9,6 +9,7 @@ mod accel;
 mod gltf;
 mod render_scene;
 mod report;
+mod scene_hash;
 mod shapes;
 mod transform;
 
@@ -26,6 +27,7 @@ use lumis_render::PerspectiveCamera;
 
 pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
+pub use scene_hash::{scene_hash, Fnv1a};
 
 use render_scene::{Geometry, MeshData, Placement, Prototype, SceneBsdf, NO_LIGHT};
 use report::Phase;
