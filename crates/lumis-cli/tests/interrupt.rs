@@ -1,0 +1,89 @@
+//! Ctrl-C and SIGTERM stop a render and keep its work; a second one quits
+//! at once.
+
+mod common;
+
+use common::*;
+
+/// The first SIGINT or SIGTERM abandons the pass in flight, writes the
+/// passes done with their true sample count and exits 130; the image is
+/// the one a render of that many samples makes, bit for bit.
+#[test]
+fn an_interrupt_writes_the_passes_done_and_exits_130() {
+    for sig in ["INT", "TERM"] {
+        let tmp = scratch(&format!("sig{sig}"));
+        let out = path_in(tmp.path(), "plates.exr");
+        let mut args = small_render(&out, "1000000");
+        args.extend(["--checkpoint", "--pass-spp", "2"]);
+        let mut child = spawn(&args);
+        wait_for(&mut child, &tmp.path().join("plates.checkpoint"));
+        signal(child.id(), sig);
+        let result = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8(result.stderr).unwrap();
+        assert_eq!(result.status.code(), Some(130), "SIG{sig}: {stderr}");
+        assert!(stderr.contains("interrupted at"), "{stderr}");
+        let exr = tmp.path().join("plates.exr");
+        let spp = header(&exr, "spp");
+        let n: u32 = spp.parse().unwrap();
+        assert!(n > 0 && n < 1_000_000 && n % 2 == 0, "{n} spp");
+        let whole = path_in(tmp.path(), "whole.exr");
+        assert!(lumis(&small_render(&whole, &spp)).status.success());
+        assert_eq!(exr_pixels(&exr), exr_pixels(&whole), "SIG{sig}");
+        // The lock is released; the checkpoint stays for --resume.
+        assert_eq!(
+            files_in(tmp.path()),
+            [
+                "plates.checkpoint",
+                "plates.exr",
+                "plates.png",
+                "whole.exr",
+                "whole.png"
+            ]
+        );
+    }
+}
+
+/// A second Ctrl-C while the first is saving a large image exits at once
+/// (with the status of an interrupted program), leaving the lock behind
+/// for the next run to take over.
+#[test]
+fn a_second_interrupt_quits_at_once() {
+    let tmp = scratch("sigint-twice");
+    let out = path_in(tmp.path(), "big.exr");
+    let mut child = spawn(&[
+        "render",
+        &scene("glossy-plates.toml"),
+        "--set",
+        "film.resolution=[1536, 1536]",
+        "--set",
+        "integrator.max_depth=1",
+        "--threads",
+        "2",
+        "--spp",
+        "1000000",
+        "--pass-spp",
+        "1",
+        "--checkpoint",
+        "-o",
+        &out,
+        "-q",
+    ]);
+    wait_for(&mut child, &tmp.path().join("big.checkpoint"));
+    // The first stops the render, which then saves a 1536x1536 film and
+    // image (tens of megabytes, synced to disk); the second comes while it
+    // does.
+    let pid = child.id().to_string();
+    let both = std::process::Command::new("sh")
+        .args([
+            "-c",
+            &format!("kill -INT {pid}; sleep 0.02; kill -INT {pid}"),
+        ])
+        .status()
+        .unwrap();
+    assert!(both.success());
+    let result = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert_eq!(result.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted again: quitting"), "{stderr}");
+    assert!(tmp.path().join("big.exr.lock").exists());
+}
