@@ -25,7 +25,7 @@ fn an_interrupt_writes_the_passes_done_and_exits_130() {
         let exr = tmp.path().join("plates.exr");
         let spp = header(&exr, "spp");
         let n: u32 = spp.parse().unwrap();
-        assert!(n > 0 && n < 1_000_000 && n % 2 == 0, "{n} spp");
+        assert!(n > 0 && n < 1_000_000 && n.is_multiple_of(2), "{n} spp");
         let whole = path_in(tmp.path(), "whole.exr");
         assert!(lumis(&small_render(&whole, &spp)).status.success());
         assert_eq!(exr_pixels(&exr), exr_pixels(&whole), "SIG{sig}");
