@@ -5,10 +5,12 @@
 //! `--set` overrides, tables with their keys in sorted order, so comments,
 //! whitespace, key order and number spelling (`1e3` or `1000.0`) do not
 //! count; and the bytes of every file the document names with a `file` key
-//! (meshes, glTF files, measured BRDF tables) or in `[plugins] load`. It
-//! leaves out what a render records on its own or what does not change the
-//! image: `seed`, `sampler.spp` and `film.output`. Files that a named file
-//! itself refers to (a glTF's external buffers) are not covered.
+//! (meshes, glTF files, measured BRDF tables). It leaves out what a render
+//! records on its own or what does not change the image: `seed`,
+//! `sampler.spp` and `film.output`. Not covered: files that a named file
+//! itself refers to (a glTF's external buffers), and the code of plugin
+//! libraries in `[plugins] load`, which count by their path only (a
+//! rebuild, whose bytes differ, is not another scene).
 
 use std::path::Path;
 
@@ -128,7 +130,7 @@ fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Resul
 
 /// Whether a string at this key path names a file whose bytes count.
 fn names_a_file(at: &[&str]) -> bool {
-    at.last() == Some(&"file") || at == ["plugins", "load"]
+    at.last() == Some(&"file")
 }
 
 #[cfg(test)]
