@@ -66,7 +66,9 @@ enum Command {
         set: Vec<String>,
     },
     /// Render a high-spp reference with the scene's own settings, saved
-    /// after every pass with its metadata (PATH.json); rerun to resume.
+    /// after every pass with its metadata in the EXR header; rerun to
+    /// resume. Refuses, without --force, to replace a reference that is
+    /// more converged or of another scene.
     Reference(ReferenceArgs),
     /// Error vs samples and vs time against a reference, for variants of a
     /// scene (sampler, strategy, heuristic, BSDF sampling...) over seeds:

@@ -40,6 +40,10 @@ fn help_documents_every_flag() {
         "--quiet",
         "--verbose",
         "--stats",
+        "--checkpoint",
+        "--no-checkpoint",
+        "--resume",
+        "--pass-spp",
     ] {
         assert!(help.contains(flag), "render --help lacks {flag}:\n{help}");
     }
