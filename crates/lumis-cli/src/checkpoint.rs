@@ -8,7 +8,7 @@
 //! behind a magic number and followed by an FNV-1a checksum of all of it:
 //!
 //! ```text
-//! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 passes:u64
+//! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 spp:u32 passes:u64
 //! seed:u64 scene_hash:u64 seconds:f64 sums:[f64; 3 * width * height] checksum:u64
 //! ```
 
@@ -21,12 +21,16 @@ use lumis_scene::Fnv1a;
 
 const MAGIC: &[u8; 8] = b"LUMISCKP";
 const VERSION: u32 = 1;
-const HEADER_BYTES: usize = 8 + 4 * 4 + 4 * 8;
+const HEADER_BYTES: usize = 8 + 5 * 4 + 4 * 8;
 
 /// A render's state between passes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Checkpoint {
     pub film: Film,
+    /// The samples per pixel the render aims at: samplers that stratify
+    /// over the whole count (`stratified`) place sample `i` by it, so it
+    /// cannot change on resuming.
+    pub spp: u32,
     pub passes: u64,
     pub seed: u64,
     pub scene_hash: u64,
@@ -45,7 +49,13 @@ impl Checkpoint {
         let film = &self.film;
         let mut out = Vec::with_capacity(HEADER_BYTES + film.sums.len() * 24 + 8);
         out.extend_from_slice(MAGIC);
-        for v in [VERSION, film.width as u32, film.height as u32, film.samples] {
+        for v in [
+            VERSION,
+            film.width as u32,
+            film.height as u32,
+            film.samples,
+            self.spp,
+        ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
         for v in [self.passes, self.seed, self.scene_hash] {
@@ -119,10 +129,11 @@ impl Checkpoint {
                 sums,
                 samples: u32_at(20),
             },
-            passes: u64_at(24),
-            seed: u64_at(32),
-            scene_hash: u64_at(40),
-            seconds: f64::from_bits(u64_at(48)),
+            spp: u32_at(24),
+            passes: u64_at(28),
+            seed: u64_at(36),
+            scene_hash: u64_at(44),
+            seconds: f64::from_bits(u64_at(52)),
         })
     }
 }
@@ -139,6 +150,7 @@ mod tests {
                 sums: vec![[1.0, -0.0, f64::MIN_POSITIVE], [3.5, 1e300, 0.1]],
                 samples: 7,
             },
+            spp: 16,
             passes: 3,
             seed: u64::MAX,
             scene_hash: 0xdead_beef,

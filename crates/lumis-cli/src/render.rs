@@ -54,7 +54,8 @@ pub struct RenderArgs {
     /// Without this flag a render checkpoints every 60 s.
     #[arg(long, value_name = "SECONDS", num_args = 0..=1, conflicts_with = "no_checkpoint")]
     pub checkpoint: Option<Option<f64>>,
-    /// Never write a checkpoint.
+    /// Never write a checkpoint while rendering (Ctrl-C still saves the
+    /// passes done).
     #[arg(long)]
     pub no_checkpoint: bool,
     /// Continue the render its checkpoint saved (same scene, overrides and
@@ -217,6 +218,7 @@ fn starting_state(
     let fresh = || -> Result<Checkpoint> {
         Ok(Checkpoint {
             film: Film::try_new(resolution)?,
+            spp,
             passes: 0,
             seed,
             scene_hash,
@@ -263,10 +265,10 @@ fn starting_state(
             saved.film.width, saved.film.height, resolution.x, resolution.y
         ));
     }
-    if saved.film.samples > spp {
+    if saved.spp != spp {
         return refuse(format!(
-            "it already has {} spp, more than the {spp} asked for",
-            saved.film.samples
+            "it is a render of {} spp, not {spp} (a sampler may place each sample by the total count)",
+            saved.spp
         ));
     }
     eprintln!(
