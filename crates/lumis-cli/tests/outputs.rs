@@ -47,7 +47,12 @@ fn a_failed_png_leaves_the_previous_exr() {
 fn temporary_files_of_dead_processes_are_removed() {
     let tmp = scratch("stale-tmp");
     let dead = dead_pid();
-    for name in ["plates.exr", "plates.png", "plates.checkpoint"] {
+    for name in [
+        "plates.exr",
+        "plates.png",
+        "plates.checkpoint",
+        "plates.exr.lock",
+    ] {
         std::fs::write(tmp.path().join(format!(".{name}.tmp-{dead}")), b"partial").unwrap();
     }
     let out = path_in(tmp.path(), "plates.exr");

@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::atomic::remove_stale_temporaries;
 use crate::process::process_is_running;
 use crate::ImageError;
 
@@ -34,10 +35,15 @@ impl OutputLock {
         };
         // The pid is written first and the lock made by linking that file
         // to its name, which fails if the name exists: no process ever sees
-        // a lock without its owner.
-        let mut claim_name = path.as_os_str().to_owned();
-        claim_name.push(format!(".claim-{}", std::process::id()));
-        let claim = PathBuf::from(claim_name);
+        // a lock without its owner. The claim is named like a temporary
+        // file of `write_atomically`, so that one left by a killed process
+        // is removed like those.
+        remove_stale_temporaries(&path);
+        let claim = path.with_file_name(format!(
+            ".{}.tmp-{}",
+            path.file_name().unwrap_or_default().to_string_lossy(),
+            std::process::id()
+        ));
         std::fs::write(&claim, format!("{}\n", std::process::id())).map_err(io_err)?;
         let result = Self::link(&claim, &path, output);
         let _ = std::fs::remove_file(&claim);
