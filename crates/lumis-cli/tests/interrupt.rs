@@ -70,20 +70,19 @@ fn a_second_interrupt_quits_at_once() {
     ]);
     wait_for(&mut child, &tmp.path().join("big.checkpoint"));
     // The first stops the render, which then saves a 1536x1536 film and
-    // image (tens of megabytes, synced to disk); the second comes while it
-    // does.
-    let pid = child.id().to_string();
-    let both = std::process::Command::new("sh")
-        .args([
-            "-c",
-            &format!("kill -INT {pid}; sleep 0.02; kill -INT {pid}"),
-        ])
-        .status()
-        .unwrap();
-    assert!(both.success());
-    let result = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8(result.stderr).unwrap();
-    assert_eq!(result.status.code(), Some(130), "{stderr}");
-    assert!(stderr.contains("interrupted again: quitting"), "{stderr}");
+    // image (tens of megabytes, synced to disk); the second comes once the
+    // first has been handled (its message is on stderr), while it saves.
+    signal(child.id(), "INT");
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut text = String::new();
+    while !text.contains("interrupted:") {
+        let read = std::io::BufRead::read_line(&mut stderr, &mut text).unwrap();
+        assert!(read > 0, "lumis ended without a message: {text}");
+    }
+    signal(child.id(), "INT");
+    std::io::Read::read_to_string(&mut stderr, &mut text).unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "{text}");
+    assert!(text.contains("interrupted again: quitting"), "{text}");
     assert!(tmp.path().join("big.exr.lock").exists());
 }
