@@ -5,12 +5,12 @@ mod common;
 
 use common::*;
 
-/// The first SIGINT or SIGTERM abandons the pass in flight, writes the
+/// The first SIGINT, SIGTERM or SIGHUP abandons the pass in flight, writes the
 /// passes done with their true sample count and exits 130; the image is
 /// the one a render of that many samples makes, bit for bit.
 #[test]
 fn an_interrupt_writes_the_passes_done_and_exits_130() {
-    for sig in ["INT", "TERM"] {
+    for sig in ["INT", "TERM", "HUP"] {
         let tmp = scratch(&format!("sig{sig}"));
         let out = path_in(tmp.path(), "plates.exr");
         let mut args = small_render(&out, "1000000");
