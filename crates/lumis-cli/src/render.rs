@@ -214,7 +214,8 @@ fn starting_state(
     spp: u32,
     resolution: lumis_core::UVec2,
 ) -> Result<Checkpoint> {
-    let saved = Checkpoint::read(checkpoint)?;
+    let saved = Checkpoint::read(checkpoint)
+        .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
     let fresh = || -> Result<Checkpoint> {
         Ok(Checkpoint {
             film: Film::try_new(resolution)?,

@@ -159,7 +159,9 @@ fn a_checkpoint_is_resumed_only_on_request_and_by_its_own_scene() {
     resume.push("--resume");
     let stderr = String::from_utf8(lumis(&resume).stderr).unwrap();
     assert!(
-        stderr.contains("plates.checkpoint: not a lumis checkpoint") && stderr.contains("checksum"),
+        stderr.contains("plates.checkpoint: not a lumis checkpoint")
+            && stderr.contains("checksum")
+            && stderr.contains("remove it to start over"),
         "{stderr}"
     );
 }
