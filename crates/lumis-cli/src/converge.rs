@@ -16,7 +16,7 @@ use lumis_core::{Error, Registry, Result};
 use lumis_image::read_exr;
 use lumis_render::{render, RenderSettings};
 
-use crate::reference::{fnv1a, metadata_path, ReferenceMetadata};
+use crate::metadata::ImageMetadata;
 use crate::render::{load, RenderArgs};
 
 #[derive(clap::Args, Debug, Clone)]
@@ -251,6 +251,8 @@ pub fn converge(
             loaded.sampler.as_ref(),
             &settings,
         )?;
+        // A loaded plugin that panicked answered with neutral values.
+        registry.faults().check()?;
         check_same_size(&out.image, &reference).map_err(|e| {
             Error::msg(format!(
                 "variant \"{}\" vs {}: {e}",
@@ -354,22 +356,18 @@ pub fn converge(
     })
 }
 
-/// What the reference's metadata (written by `lumis reference`) says, and a
-/// warning when it was rendered from another version of the scene file.
+/// What the reference's metadata (in its EXR header) says, and a warning
+/// when it was rendered from another version of the scene file.
 fn reference_provenance(args: &ConvergeArgs) -> String {
-    let Some(meta) = std::fs::read_to_string(metadata_path(&args.reference))
-        .ok()
-        .and_then(|t| ReferenceMetadata::from_json(&t))
-    else {
+    let Ok(Some(meta)) = ImageMetadata::read(&args.reference) else {
         return String::new();
     };
     let mut out = format!(
-        "reference: {} spp, {} passes from seed {}, {:.1} s\n",
-        meta.spp, meta.passes, meta.base_seed, meta.seconds
+        "reference: {} spp, {} passes from seed {}, {:.1} s (lumis {})\n",
+        meta.spp, meta.passes, meta.seed, meta.seconds, meta.version
     );
-    let same_scene = std::fs::read(&args.scene)
-        .map(|text| fnv1a(&text) == meta.scene_text_hash)
-        .unwrap_or(false);
+    let same_scene =
+        lumis_scene::scene_hash(&args.scene, &[]).is_ok_and(|hash| hash == meta.scene_file_hash);
     if !same_scene {
         out += "warning: the reference was rendered from a different version of the scene file\n";
     }

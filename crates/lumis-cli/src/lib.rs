@@ -4,20 +4,29 @@
 
 mod assignments;
 mod brdf;
+mod checkpoint;
 mod converge;
 mod diff;
+mod interrupt;
 mod listing;
+mod metadata;
+mod outputs;
 mod reference;
 mod render;
 mod samplers_analyze;
 
 pub use assignments::{fixed_parameters, parameter_table};
 pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
+pub use checkpoint::{checkpoint_path, Checkpoint};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
+pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
-pub use reference::{render_reference, ReferenceArgs, ReferenceMetadata};
-pub use render::{output_paths, render_scene_file, RenderArgs, RenderReport};
+pub use metadata::ImageMetadata;
+pub use reference::{render_reference, ReferenceArgs};
+pub use render::{
+    output_paths, render_scene_file, RenderArgs, RenderReport, DEFAULT_CHECKPOINT_SECONDS,
+};
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
 
 use lumis_core::{Registry, Result};

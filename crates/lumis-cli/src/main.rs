@@ -9,8 +9,9 @@ use lumis_check::bsdf_suite::{
 };
 use lumis_cli::{
     analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
-    registry_with_search_path, render_reference, render_scene_file, tabulate_bsdf, AnalyzeArgs,
-    ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
+    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
+    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs,
+    TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -65,7 +66,9 @@ enum Command {
         set: Vec<String>,
     },
     /// Render a high-spp reference with the scene's own settings, saved
-    /// after every pass with its metadata (PATH.json); rerun to resume.
+    /// after every pass with its metadata in the EXR header; rerun to
+    /// resume. Refuses, without --force, to replace a reference that is
+    /// more converged or of another scene.
     Reference(ReferenceArgs),
     /// Error vs samples and vs time against a reference, for variants of a
     /// scene (sampler, strategy, heuristic, BSDF sampling...) over seeds:
@@ -122,16 +125,28 @@ fn main() -> ExitCode {
     let matches = Cli::command().version(version).get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     let result = match cli.command {
-        Command::Render(args) => registry_with_search_path().and_then(|registry| {
-            render_scene_file(&args, &registry).map(|report| {
-                println!("{}", report.summary());
-                for line in report.profile.iter().flat_map(|p| p.lines()) {
-                    println!("{line}");
-                }
-                true
-            })
+        Command::Render(args) => interruptible(|stop| {
+            let registry = registry_with_search_path()?;
+            let report = render_scene_file(&args, &registry, stop)?;
+            println!("{}", report.summary());
+            for line in report.profile.iter().flat_map(|p| p.lines()) {
+                println!("{line}");
+            }
+            Ok(Outcome::Done)
         }),
-        Command::Plugins { load, markdown } => {
+        Command::Reference(args) => interruptible(|stop| {
+            let registry = registry_with_search_path()?;
+            let (path, meta) = render_reference(&args, &registry, stop)?;
+            println!(
+                "{}: {} spp in {:.1} s ({} passes; metadata in its header)",
+                path.display(),
+                meta.spp,
+                meta.seconds,
+                meta.passes
+            );
+            Ok(Outcome::Done)
+        }),
+        Command::Plugins { load, markdown } => plain(|| {
             registry_with_search_path().and_then(|mut registry| {
                 for library in &load {
                     lumis_loader::load_library(library, &mut registry)?;
@@ -141,9 +156,9 @@ fn main() -> ExitCode {
                 } else {
                     print!("{}", plugin_listing(&registry));
                 }
-                Ok(true)
+                Ok(Outcome::Done)
             })
-        }
+        }),
         Command::CheckPlugin {
             library,
             bsdf,
@@ -151,66 +166,106 @@ fn main() -> ExitCode {
             bins,
             out,
             set,
-        } => check_plugin(library, bsdf, samples, bins, &out, &set),
-        Command::Reference(args) => registry_with_search_path().and_then(|registry| {
-            let stop = stop_on_ctrl_c()?;
-            let (path, meta) = render_reference(&args, &registry, &stop)?;
-            println!(
-                "{}: {} spp in {:.1} s (metadata in {}.json)",
-                path.display(),
-                meta.spp,
-                meta.seconds,
-                path.display()
-            );
-            Ok(true)
+        } => plain(|| check_plugin(library, bsdf, samples, bins, &out, &set).map(Outcome::passed)),
+        Command::Converge(args) => plain(|| {
+            registry_with_search_path()
+                .and_then(|registry| converge(&args, &registry, &*stop_on_interrupt()?))
+                .map(|report| {
+                    print!("{}", report.table);
+                    println!("CSV, JSON and plots in {}", args.out.display());
+                    Outcome::Done
+                })
         }),
-        Command::Converge(args) => registry_with_search_path()
-            .and_then(|registry| converge(&args, &registry, &*stop_on_ctrl_c()?))
-            .map(|report| {
-                print!("{}", report.table);
-                println!("CSV, JSON and plots in {}", args.out.display());
-                true
-            }),
-        Command::Diff(args) => diff_images(&args).map(|report| {
-            print!("{report}");
-            true
-        }),
-        Command::Brdf(BrdfCommand::Tabulate(args)) => registry_with_search_path()
-            .and_then(|registry| tabulate_bsdf(&args, &registry))
-            .map(|line| {
-                println!("{line}");
-                true
-            }),
-        Command::Brdf(BrdfCommand::Precompute(args)) => precompute_table(&args).map(|line| {
-            println!("{line}");
-            true
-        }),
-        Command::Samplers(SamplersCommand::Analyze(args)) => registry_with_search_path()
-            .and_then(|registry| analyze_samplers(&args, &registry))
-            .map(|report| {
+        Command::Diff(args) => plain(|| {
+            diff_images(&args).map(|report| {
                 print!("{report}");
-                println!("pictures and CSV in {}", args.out.display());
-                true
-            }),
+                Outcome::Done
+            })
+        }),
+        Command::Brdf(BrdfCommand::Tabulate(args)) => plain(|| {
+            registry_with_search_path()
+                .and_then(|registry| tabulate_bsdf(&args, &registry))
+                .map(|line| {
+                    println!("{line}");
+                    Outcome::Done
+                })
+        }),
+        Command::Brdf(BrdfCommand::Precompute(args)) => plain(|| {
+            precompute_table(&args).map(|line| {
+                println!("{line}");
+                Outcome::Done
+            })
+        }),
+        Command::Samplers(SamplersCommand::Analyze(args)) => plain(|| {
+            registry_with_search_path()
+                .and_then(|registry| analyze_samplers(&args, &registry))
+                .map(|report| {
+                    print!("{report}");
+                    println!("pictures and CSV in {}", args.out.display());
+                    Outcome::Done
+                })
+        }),
     };
     match result {
-        Ok(true) => ExitCode::SUCCESS,
-        Ok(false) => ExitCode::FAILURE,
-        Err(e) => {
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::Failed) => ExitCode::FAILURE,
+        Ok(Outcome::Interrupted) => ExitCode::from(INTERRUPTED_EXIT_CODE),
+        Err(Interruptible::Interrupted(e)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(INTERRUPTED_EXIT_CODE)
+        }
+        Err(Interruptible::Failed(e)) => {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
     }
 }
 
-/// A flag Ctrl-C sets: long commands finish the render in flight and keep
-/// what they measured instead of dying.
-fn stop_on_ctrl_c() -> Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let flag = stop.clone();
-    ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::Relaxed))
-        .map_err(|e| Error::msg(format!("cannot install the Ctrl-C handler: {e}")))?;
-    Ok(stop)
+/// How a command ended, for its exit status.
+enum Outcome {
+    Done,
+    /// Ran, and found a failure it reported (`check-plugin`).
+    Failed,
+    /// Stopped by Ctrl-C, SIGTERM or SIGHUP after saving its work.
+    Interrupted,
+}
+
+impl Outcome {
+    fn passed(all_passed: bool) -> Self {
+        if all_passed {
+            Self::Done
+        } else {
+            Self::Failed
+        }
+    }
+}
+
+/// A command's error, and whether a signal had asked it to stop (then it
+/// exits 130 like any interrupted program, not 1).
+enum Interruptible {
+    Failed(Error),
+    Interrupted(Error),
+}
+
+/// Runs a command that a signal kills at once.
+fn plain(command: impl FnOnce() -> Result<Outcome>) -> std::result::Result<Outcome, Interruptible> {
+    command().map_err(Interruptible::Failed)
+}
+
+/// Runs a command that stops on Ctrl-C: interrupted, it ends as
+/// [`Outcome::Interrupted`] whether it saved its work or failed.
+fn interruptible(
+    command: impl FnOnce(&std::sync::atomic::AtomicBool) -> Result<Outcome>,
+) -> std::result::Result<Outcome, Interruptible> {
+    let stop = stop_on_interrupt().map_err(Interruptible::Failed)?;
+    let result = command(&stop);
+    let stopped = stop.load(std::sync::atomic::Ordering::SeqCst);
+    match result {
+        Ok(_) if stopped => Ok(Outcome::Interrupted),
+        Ok(outcome) => Ok(outcome),
+        Err(e) if stopped => Err(Interruptible::Interrupted(e)),
+        Err(e) => Err(Interruptible::Failed(e)),
+    }
 }
 
 /// `lumis check-plugin`: returns whether every case passed.

@@ -1,12 +1,19 @@
-//! `lumis render`: load, render, write EXR and PNG, report.
+//! `lumis render`: load, render in passes with checkpoints, write the PNG
+//! and the EXR (with its metadata in the header), report.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
-use lumis_render::{render, RenderSettings};
+use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, RenderProgress};
 use lumis_scene::LoadedScene;
+
+use crate::checkpoint::{checkpoint_path, Checkpoint};
+use crate::metadata::{lumis_version, ImageMetadata};
+use crate::outputs::Outputs;
 
 /// What `lumis render` was asked to do; also its command-line flags.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -42,7 +49,31 @@ pub struct RenderArgs {
     /// slower).
     #[arg(long)]
     pub stats: bool,
+    /// Save the render's state (NAME.checkpoint beside the EXR, and the
+    /// image so far) every SECONDS, or after every pass without a value.
+    /// Without this flag a render checkpoints every 60 s.
+    #[arg(long, value_name = "SECONDS", num_args = 0..=1, conflicts_with = "no_checkpoint")]
+    pub checkpoint: Option<Option<f64>>,
+    /// Never write a checkpoint while rendering (Ctrl-C still saves the
+    /// passes done).
+    #[arg(long)]
+    pub no_checkpoint: bool,
+    /// Continue the render its checkpoint saved (same scene, overrides and
+    /// seed); the image is the one an uninterrupted render makes.
+    #[arg(long)]
+    pub resume: bool,
+    /// Samples per pixel per pass [default: passes of about two seconds].
+    /// The image does not depend on it.
+    #[arg(long, value_name = "N")]
+    pub pass_spp: Option<u32>,
 }
+
+/// Seconds between checkpoints when `--checkpoint` does not say.
+pub const DEFAULT_CHECKPOINT_SECONDS: f64 = 60.0;
+
+/// How long a pass should take when `--pass-spp` does not say: short enough
+/// that the first Ctrl-C, which abandons the pass in flight, loses little.
+const PASS_SECONDS: f64 = 2.0;
 
 /// The outcome of a render, for the summary line and for tests.
 pub struct RenderReport {
@@ -50,6 +81,8 @@ pub struct RenderReport {
     pub exr: PathBuf,
     pub png: PathBuf,
     pub spp: u32,
+    /// Stopped by a signal: the image holds the passes finished before it.
+    pub interrupted: bool,
     pub seconds: f64,
     pub stats: RenderStats,
     /// Time by stage, with `--stats`.
@@ -60,8 +93,13 @@ impl RenderReport {
     /// The one-line summary printed at the end of a render.
     pub fn summary(&self) -> String {
         let secs = self.seconds.max(1e-9);
+        let interrupted = if self.interrupted {
+            "interrupted, "
+        } else {
+            ""
+        };
         format!(
-            "{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} closest-hit and {} shadow rays), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
+            "{interrupted}{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} closest-hit and {} shadow rays), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
             self.image.width,
             self.image.height,
             self.spp,
@@ -144,10 +182,127 @@ fn describe(loaded: &LoadedScene) -> String {
     )
 }
 
-/// Renders a scene file and writes `PATH.exr` and `PATH.png`.
+/// When a render saves its state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum CheckpointEvery {
+    Pass,
+    Seconds(f64),
+    Never,
+}
+
+impl CheckpointEvery {
+    fn of(args: &RenderArgs) -> Result<Self> {
+        match args.checkpoint {
+            _ if args.no_checkpoint => Ok(Self::Never),
+            None => Ok(Self::Seconds(DEFAULT_CHECKPOINT_SECONDS)),
+            Some(None) => Ok(Self::Pass),
+            Some(Some(s)) if s.is_finite() && s >= 0.0 => Ok(Self::Seconds(s)),
+            Some(Some(s)) => Err(Error::msg(format!(
+                "--checkpoint {s}: expected a number of seconds, 0 or more"
+            ))),
+        }
+    }
+}
+
+/// The film to render into: the checkpoint's with `--resume` (checked to
+/// belong to this render), else an empty one.
+fn starting_state(
+    args: &RenderArgs,
+    checkpoint: &Path,
+    scene_hash: u64,
+    seed: u64,
+    spp: u32,
+    resolution: lumis_core::UVec2,
+) -> Result<Checkpoint> {
+    let saved = Checkpoint::read(checkpoint)
+        .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
+    let fresh = || -> Result<Checkpoint> {
+        Ok(Checkpoint {
+            film: Film::try_new(resolution)?,
+            spp,
+            passes: 0,
+            seed,
+            scene_hash,
+            seconds: 0.0,
+        })
+    };
+    let Some(saved) = saved else {
+        if args.resume {
+            eprintln!(
+                "no checkpoint '{}' to resume: rendering from the first sample",
+                checkpoint.display()
+            );
+        }
+        return fresh();
+    };
+    let refuse = |why: String| {
+        Err(Error::msg(format!(
+            "cannot resume '{}': {why}",
+            checkpoint.display()
+        )))
+    };
+    if !args.resume {
+        return Err(Error::msg(format!(
+            "'{}' holds an unfinished render ({} spp): --resume continues it; remove the file to start over",
+            checkpoint.display(),
+            saved.film.samples
+        )));
+    }
+    if saved.scene_hash != scene_hash {
+        return refuse(format!(
+            "it was rendered from a different scene (scene hash {:016x}, this scene {scene_hash:016x}: the scene, a file it names or a --set differs)",
+            saved.scene_hash
+        ));
+    }
+    if saved.seed != seed {
+        return refuse(format!(
+            "it was rendered with seed {}, not {seed}",
+            saved.seed
+        ));
+    }
+    if (saved.film.width as u32, saved.film.height as u32) != (resolution.x, resolution.y) {
+        return refuse(format!(
+            "its film is {}x{}, not {}x{}",
+            saved.film.width, saved.film.height, resolution.x, resolution.y
+        ));
+    }
+    if saved.spp != spp {
+        return refuse(format!(
+            "it is a render of {} spp, not {spp} (a sampler may place each sample by the total count)",
+            saved.spp
+        ));
+    }
+    eprintln!(
+        "resuming '{}' at {} of {spp} spp",
+        checkpoint.display(),
+        saved.film.samples
+    );
+    Ok(saved)
+}
+
+/// Samples for the next pass: `--pass-spp`, else as many as fit in
+/// [`PASS_SECONDS`] at the pace so far (starting from one, at most
+/// doubling). The image does not depend on the split.
+fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) -> u32 {
+    let spp = match (args.pass_spp, last) {
+        (Some(n), _) => n,
+        (None, None) => 1,
+        (None, Some((spp, seconds))) => {
+            let fit = (PASS_SECONDS * spp as f64 / seconds.max(1e-6)).floor();
+            (fit.min(2.0 * spp as f64) as u32).max(1)
+        }
+    };
+    spp.clamp(1, remaining)
+}
+
+/// Renders a scene file and writes `PATH.exr` and `PATH.png`, in passes,
+/// saving a checkpoint as [`RenderArgs::checkpoint`] asks. Once `stop` is
+/// set (by the first Ctrl-C) the pass in flight is abandoned and the
+/// passes done are written, with their true sample count.
 pub fn render_scene_file(
     args: &RenderArgs,
     registry: &lumis_core::Registry,
+    stop: &AtomicBool,
 ) -> Result<RenderReport> {
     let mut loaded = load(args, registry)?;
     if !args.quiet {
@@ -158,6 +313,10 @@ pub fn render_scene_file(
     if args.verbose {
         eprintln!("{}", describe(&loaded));
     }
+    if args.pass_spp == Some(0) {
+        return Err(Error::msg("--pass-spp must be at least 1"));
+    }
+    let every = CheckpointEvery::of(args)?;
     let output = match (&args.output, &loaded.output) {
         (Some(o), _) => o.clone(),
         (None, Some(o)) => o.clone(),
@@ -174,13 +333,23 @@ pub fn render_scene_file(
             )));
         }
     }
+    let outputs = Outputs::claim(&exr, Some(&png))?;
     crate::warn_if_threads_capped(args.threads);
-    let settings = RenderSettings {
-        spp: loaded.sampler.samples_per_pixel(),
-        seed: loaded.seed,
-        threads: args.threads,
-        progress: !args.quiet,
-    };
+    let spp = loaded.sampler.samples_per_pixel();
+    if spp == 0 {
+        return Err(Error::msg("spp must be at least 1"));
+    }
+    let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
+    let checkpoint_file = checkpoint_path(&exr);
+    let resolution = loaded.camera.resolution();
+    let mut state = starting_state(
+        args,
+        &checkpoint_file,
+        scene_hash,
+        loaded.seed,
+        spp,
+        resolution,
+    )?;
     // With --stats the scene, its plugins and the sampler run inside the
     // profiling wrappers; the render itself is the same call.
     if args.stats {
@@ -194,28 +363,109 @@ pub fn render_scene_file(
         Some(sampler) => (&profiled_scene, sampler),
         None => (&loaded.scene, loaded.sampler.as_ref()),
     };
-    let profile = args.stats.then(Profile::start);
-    let out = render(
-        &loaded.camera,
-        scene,
-        loaded.integrator.as_ref(),
-        sampler,
-        &settings,
+    let pool = RenderPool::new(args.threads)?;
+    let progress = RenderProgress::new(
+        !args.quiet,
+        progress_units(resolution, spp - state.film.samples),
     );
+    let ctx = PassContext {
+        camera: &loaded.camera,
+        scene,
+        integrator: loaded.integrator.as_ref(),
+        sampler,
+        seed: loaded.seed,
+        pool: &pool,
+        progress: &progress,
+        stop,
+    };
+    let scene_file_hash = lumis_scene::scene_hash(&args.scene, &[])?;
+    let metadata = |state: &Checkpoint| ImageMetadata {
+        command: "render".into(),
+        spp: state.film.samples,
+        passes: state.passes,
+        seed: state.seed,
+        scene_hash,
+        scene_file_hash,
+        seconds: state.seconds,
+        version: lumis_version(),
+    };
+    let save = |state: &Checkpoint| -> Result<()> {
+        state.write(&checkpoint_file)?;
+        outputs.write(&state.film.image(), &metadata(state))
+    };
+    let profile = args.stats.then(Profile::start);
+    let mut stats = RenderStats::default();
+    let mut seconds = 0.0;
+    let mut last_pass = None;
+    let mut last_save = Instant::now();
+    let mut interrupted = false;
+    while state.film.samples < spp {
+        let pass_spp = next_pass_spp(args, last_pass, spp - state.film.samples);
+        let Some(pass) = render_pass(&ctx, &mut state.film, pass_spp)? else {
+            interrupted = true;
+            break;
+        };
+        stats += pass.stats;
+        seconds += pass.seconds;
+        state.passes += 1;
+        state.seconds += pass.seconds;
+        last_pass = Some((pass_spp, pass.seconds));
+        let due = match every {
+            CheckpointEvery::Pass => true,
+            CheckpointEvery::Seconds(s) => last_save.elapsed().as_secs_f64() >= s,
+            CheckpointEvery::Never => false,
+        };
+        if due && state.film.samples < spp {
+            save(&state)?;
+            last_save = Instant::now();
+        }
+        interrupted = stop.load(Ordering::Relaxed);
+        if interrupted {
+            break;
+        }
+    }
+    progress.finish();
     let profile = profile.map(Profile::finish);
-    let out = out?;
-    // A loaded plugin that panicked answered with neutral values: the image
-    // is not the scene's, and the panic is the error.
-    registry.faults().check()?;
-    lumis_image::write_exr(&exr, &out.image).map_err(|e| Error::msg(e.to_string()))?;
-    lumis_image::write_png(&png, &out.image).map_err(|e| Error::msg(e.to_string()))?;
+    if interrupted && state.film.samples == 0 {
+        return Err(Error::msg(format!(
+            "interrupted before the first pass ended: nothing written to {}",
+            exr.display()
+        )));
+    }
+    if interrupted && state.film.samples < spp {
+        save(&state)?;
+        eprintln!(
+            "interrupted at {} of {spp} spp: {} holds the image so far; --resume continues it",
+            state.film.samples,
+            exr.display()
+        );
+    } else {
+        // A loaded plugin that panicked answered with neutral values: the
+        // image is not the scene's, and the panic is the error.
+        registry.faults().check()?;
+        outputs.write(&state.film.image(), &metadata(&state))?;
+        // Last: a kill before this line leaves a checkpoint that resumes
+        // to the same, finished image.
+        match std::fs::remove_file(&checkpoint_file) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => {
+                return Err(Error::msg(format!(
+                    "{}: cannot remove the finished render's checkpoint: {e}",
+                    checkpoint_file.display()
+                )))
+            }
+        }
+        interrupted = false;
+    }
     Ok(RenderReport {
-        image: out.image,
+        image: state.film.image(),
         exr,
         png,
-        spp: settings.spp,
-        seconds: out.seconds,
-        stats: out.stats,
+        spp: state.film.samples,
+        interrupted,
+        seconds,
+        stats,
         profile,
     })
 }

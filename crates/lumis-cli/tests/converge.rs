@@ -40,6 +40,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
             ..Default::default()
         },
         &registry,
+        &std::sync::atomic::AtomicBool::new(false),
     )
     .unwrap();
     let variants = dir.join("variants.toml");
@@ -137,7 +138,8 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
 
 /// A reference rendered in two runs (interrupted at 64 spp, then resumed to
 /// 128) is bit-identical to one rendered in a single run: passes keep their
-/// seeds. A changed scene starts over instead of mixing images.
+/// seeds. A changed scene is refused, and with `--force` starts over
+/// instead of mixing images.
 #[test]
 fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
     use lumis_cli::{render_reference, ReferenceArgs};
@@ -150,8 +152,13 @@ fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
         spp,
         pass_spp: 32,
         output: Some(dir.join(output)),
-        set: [TINY].iter().chain(extra).map(|s| s.to_string()).collect(),
+        set: [TINY]
+            .iter()
+            .chain(extra.iter().filter(|s| **s != "--force"))
+            .map(|s| s.to_string())
+            .collect(),
         threads: 0,
+        force: extra.contains(&"--force"),
     };
     let (path, meta) = render_reference(&args(64, "resumed.exr", &[]), &registry, &stop).unwrap();
     assert_eq!((meta.spp, meta.passes), (64, 2));
@@ -161,8 +168,13 @@ fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
     let read = |p: &Path| lumis_image::read_exr(p).unwrap();
     assert_eq!(read(&path), read(&whole));
     let changed = ["integrator.max_depth=2"];
-    let (_, meta) =
-        render_reference(&args(128, "resumed.exr", &changed), &registry, &stop).unwrap();
+    let refused = render_reference(&args(128, "resumed.exr", &changed), &registry, &stop)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(refused.contains("different scene"), "{refused}");
+    let forced = ["integrator.max_depth=2", "--force"];
+    let (_, meta) = render_reference(&args(128, "resumed.exr", &forced), &registry, &stop).unwrap();
     assert_eq!((meta.spp, meta.passes), (128, 4), "restarted from zero");
     assert_ne!(read(&path), read(&whole));
 }

@@ -36,30 +36,38 @@ impl FileKind {
 /// size the system reports is not the size that reads return (`/proc`).
 /// Opening does not block on a FIFO: its type is checked first.
 pub fn read_bounded(path: &Path, kind: FileKind) -> Result<Vec<u8>, String> {
-    let shown = path.display();
-    let what = kind.name;
-    let file = open_regular(path, kind)?;
-    let size = file
-        .metadata()
-        .map_err(|e| format!("cannot read {what} '{shown}': {e}"))?
-        .len();
-    let too_large = |size: u64| {
-        format!(
-            "'{shown}' is {} bytes, more than the {} bytes lumis reads as a {what}",
-            size, kind.max_bytes
-        )
-    };
-    if size > kind.max_bytes {
-        return Err(too_large(size));
-    }
+    let (file, size) = open_bounded(path, kind)?;
     let mut bytes = Vec::with_capacity(size as usize);
     file.take(kind.max_bytes + 1)
         .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read {what} '{shown}': {e}"))?;
+        .map_err(|e| format!("cannot read {} '{}': {e}", kind.name, path.display()))?;
     if bytes.len() as u64 > kind.max_bytes {
-        return Err(too_large(bytes.len() as u64));
+        return Err(too_large(path, bytes.len() as u64, kind));
     }
     Ok(bytes)
+}
+
+/// Opens `path`, a regular file of at most `kind.max_bytes`, for reading
+/// it in pieces; with its size. A reader should still stop at the bound.
+pub fn open_bounded(path: &Path, kind: FileKind) -> Result<(File, u64), String> {
+    let file = open_regular(path, kind)?;
+    let size = file
+        .metadata()
+        .map_err(|e| format!("cannot read {} '{}': {e}", kind.name, path.display()))?
+        .len();
+    if size > kind.max_bytes {
+        return Err(too_large(path, size, kind));
+    }
+    Ok((file, size))
+}
+
+fn too_large(path: &Path, size: u64, kind: FileKind) -> String {
+    format!(
+        "'{}' is {size} bytes, more than the {} bytes lumis reads as a {}",
+        path.display(),
+        kind.max_bytes,
+        kind.name
+    )
 }
 
 /// The first `len` bytes of `path` (fewer if the file is shorter), for

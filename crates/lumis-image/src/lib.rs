@@ -1,13 +1,20 @@
-//! Images: a linear RGB float buffer, EXR and PNG files, and writes that
-//! never leave a half-written file behind.
+//! Images: a linear RGB float buffer, EXR and PNG files with metadata in
+//! the EXR header, writes that never leave a half-written file behind, and
+//! a lock that keeps two processes from writing one output.
 
 mod atomic;
 mod exr_io;
+mod output_lock;
 mod png_io;
+mod process;
 
-pub use atomic::write_atomically;
-pub use exr_io::{read_exr, write_exr};
-pub use png_io::{linear_to_srgb8, write_png, write_rgb8_png};
+pub use atomic::{remove_stale_temporaries, stage, write_atomically, StagedFile};
+pub use exr_io::{
+    read_exr, read_exr_metadata, stage_exr, write_exr, write_exr_with_metadata, ExrMetadata,
+};
+pub use output_lock::{lock_path, OutputLock};
+pub use png_io::{linear_to_srgb8, stage_png, write_png, write_rgb8_png};
+pub use process::process_is_running;
 
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::atomic::{flush, write_atomically};
+use crate::atomic::{flush, stage, StagedFile};
 use crate::{Image, ImageError};
 
 /// Clamps linear `v` to [0, 1] and applies the sRGB transfer function
@@ -20,12 +20,18 @@ pub fn linear_to_srgb8(v: f32) -> u8 {
 
 /// Writes `image` tone-mapped (clamped, sRGB-encoded) to an 8-bit PNG, atomically.
 pub fn write_png(path: &Path, image: &Image) -> Result<(), ImageError> {
+    stage_png(path, image)?.commit()
+}
+
+/// Writes the PNG of [`write_png`] under a temporary name, to be renamed
+/// into place with [`StagedFile::commit`].
+pub fn stage_png(path: &Path, image: &Image) -> Result<StagedFile, ImageError> {
     let data: Vec<u8> = image
         .pixels
         .iter()
         .flat_map(|p| p.map(linear_to_srgb8))
         .collect();
-    write_rgb8_png(path, image.width, image.height, &data)
+    stage_rgb8_png(path, image.width, image.height, &data)
 }
 
 /// Writes 8-bit sRGB RGB rows (e.g. a drawn plot) to a PNG, atomically.
@@ -35,7 +41,16 @@ pub fn write_rgb8_png(
     height: usize,
     data: &[u8],
 ) -> Result<(), ImageError> {
-    write_atomically(path, |w| {
+    stage_rgb8_png(path, width, height, data)?.commit()
+}
+
+fn stage_rgb8_png(
+    path: &Path,
+    width: usize,
+    height: usize,
+    data: &[u8],
+) -> Result<StagedFile, ImageError> {
+    stage(path, |w| {
         let mut encoder = png::Encoder::new(&mut *w, width as u32, height as u32);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);

@@ -1,6 +1,8 @@
-//! The render loop: tiles on a rayon pool, a box-filtered film, a progress
-//! bar, and counters.
+//! The render loop: passes of samples over tiles on a rayon pool, added to
+//! a box-filtered film, with a progress bar and counters.
 
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use lumis_core::{
@@ -10,8 +12,9 @@ use lumis_image::Image;
 use rayon::prelude::*;
 
 use crate::camera::PerspectiveCamera;
+use crate::film::Film;
 use crate::profile::{self, Stage};
-use crate::progress::Progress;
+use crate::progress::RenderProgress;
 
 /// Tile edge in pixels: small enough to balance load, large enough that
 /// per-tile overhead (sampler clone, progress update) does not show.
@@ -115,27 +118,32 @@ impl Batch {
     }
 }
 
-/// Renders one tile. The tile's samples go to the integrator in batches of
-/// at most its [`Integrator::batch_size`], one sampler per batch lane: a
-/// run of the tile's pixels, several samples of each. Lane `l` holds pixel
-/// `l % run` of the run throughout, so that a lane keeps one pixel for all
-/// its samples and its sampler reuses per-pixel work (the Sobol' sampler's
-/// scramble seeds), as `path`'s single sampler does. Each pixel's samples
-/// are summed in index order, so the result does not depend on the thread
-/// count or the batch size.
+/// Renders sample indices `samples` of one tile, adding them to `sums`
+/// (the tile's pixels, row-major). The tile's samples go to the integrator
+/// in batches of at most its [`Integrator::batch_size`], one sampler per
+/// batch lane: a run of the tile's pixels, several samples of each. Lane
+/// `l` holds pixel `l % run` of the run throughout, so that a lane keeps
+/// one pixel for all its samples and its sampler reuses per-pixel work (the
+/// Sobol' sampler's scramble seeds), as `path`'s single sampler does. Each
+/// pixel's samples are added in index order, so the result depends neither
+/// on the thread count, the batch size nor how the samples were split into
+/// passes. Returns `None`, abandoning the tile, once `stop` is set.
+#[allow(clippy::too_many_arguments)]
 fn render_tile(
     tile: &Tile,
     camera: &PerspectiveCamera,
     scene: &dyn Scene,
     integrator: &dyn Integrator,
     lanes: &mut dyn SamplerLanes,
-    settings: &RenderSettings,
-) -> (Vec<[f32; 3]>, RenderStats) {
+    seed: u64,
+    samples: Range<u32>,
+    mut sums: Vec<[f64; 3]>,
+    stop: &AtomicBool,
+) -> Option<(Vec<[f64; 3]>, RenderStats)> {
     profile::enter_worker();
     let mut stats = RenderStats::default();
     let width = tile.max.x - tile.min.x;
-    let count = (width * (tile.max.y - tile.min.y)) as usize;
-    let mut sums = vec![[0.0f64; 3]; count];
+    let count = sums.len();
     let mut batch = Batch {
         rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
         pixel_of_lane: vec![0; lanes.len()],
@@ -146,13 +154,16 @@ fn render_tile(
     let samples_per_batch = (lanes.len() / run) as u32;
     for first in (0..count).step_by(run) {
         let pixels = first..(first + run).min(count);
-        for base in (0..settings.spp).step_by(samples_per_batch as usize) {
-            for index in base..(base + samples_per_batch).min(settings.spp) {
+        for base in samples.clone().step_by(samples_per_batch as usize) {
+            if stop.load(Ordering::Relaxed) {
+                return None;
+            }
+            for index in base..(base + samples_per_batch).min(samples.end) {
                 for i in pixels.clone() {
                     let pixel =
                         UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
                     let lane = lanes.lane(batch.filled);
-                    lane.start_pixel_sample(pixel, index, settings.seed);
+                    lane.start_pixel_sample(pixel, index, seed);
                     // Box filter of radius 1/2: uniform over the pixel, weight 1.
                     batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
                         camera.generate_ray(pixel, lane.get_pixel_2d())
@@ -164,16 +175,121 @@ fn render_tile(
             batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
         }
     }
-    let inv = 1.0 / settings.spp as f64;
-    let pixels = sums
-        .into_iter()
-        .map(|sum| sum.map(|s| (s * inv) as f32))
-        .collect();
-    (pixels, stats)
+    Some((sums, stats))
 }
 
-/// Renders the image seen by `camera`. Samples whose radiance is NaN or
-/// infinite are counted in the stats and contribute zero.
+/// What one pass of a render did.
+pub struct PassOutput {
+    pub stats: RenderStats,
+    pub seconds: f64,
+}
+
+/// A render's worker threads, started once for all its passes.
+pub struct RenderPool {
+    pool: rayon::ThreadPool,
+}
+
+impl RenderPool {
+    /// Starts [`worker_threads`]`(requested)` threads.
+    pub fn new(requested: usize) -> Result<Self> {
+        let threads = worker_threads(requested);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| Error::msg(format!("cannot start {threads} render threads: {e}")))?;
+        Ok(Self { pool })
+    }
+}
+
+/// Everything a pass renders with, beside the film it adds to.
+pub struct PassContext<'a> {
+    pub camera: &'a PerspectiveCamera,
+    pub scene: &'a dyn Scene,
+    pub integrator: &'a dyn Integrator,
+    pub sampler: &'a dyn Sampler,
+    pub seed: u64,
+    pub pool: &'a RenderPool,
+    pub progress: &'a RenderProgress,
+    /// Set (by a signal handler) to abandon the pass in flight.
+    pub stop: &'a AtomicBool,
+}
+
+/// Adds sample indices `film.samples..film.samples + spp` of every pixel to
+/// `film`. Returns `None`, with `film` as it was, where `stop` was set
+/// before the pass finished: a film holds whole passes only, so every
+/// pixel has taken the same samples.
+pub fn render_pass(ctx: &PassContext, film: &mut Film, spp: u32) -> Result<Option<PassOutput>> {
+    let end = film
+        .samples
+        .checked_add(spp)
+        .ok_or_else(|| Error::msg("more than 2^32 samples per pixel"))?;
+    let samples = film.samples..end;
+    let resolution = UVec2::new(film.width as u32, film.height as u32);
+    let tiles = tiles(resolution);
+    let tile_sums = |tile: &Tile| -> Vec<[f64; 3]> {
+        (tile.min.y..tile.max.y)
+            .flat_map(|y| {
+                let row = y as usize * film.width;
+                film.sums[row + tile.min.x as usize..row + tile.max.x as usize]
+                    .iter()
+                    .copied()
+            })
+            .collect()
+    };
+    let start = Instant::now();
+    let rendered: Vec<Option<(Vec<[f64; 3]>, RenderStats)>> = ctx.pool.pool.install(|| {
+        tiles
+            .par_iter()
+            .map_init(
+                || ctx.sampler.lanes(ctx.integrator.batch_size().max(1)),
+                |lanes, tile| {
+                    let out = render_tile(
+                        tile,
+                        ctx.camera,
+                        ctx.scene,
+                        ctx.integrator,
+                        lanes.as_mut(),
+                        ctx.seed,
+                        samples.clone(),
+                        tile_sums(tile),
+                        ctx.stop,
+                    );
+                    if out.is_some() {
+                        ctx.progress.advance(spp as u64);
+                    }
+                    out
+                },
+            )
+            .collect()
+    });
+    let seconds = start.elapsed().as_secs_f64();
+    if rendered.iter().any(Option::is_none) {
+        return Ok(None);
+    }
+    let mut stats = RenderStats::default();
+    for (tile, (sums, tile_stats)) in tiles.iter().zip(rendered.into_iter().flatten()) {
+        stats += tile_stats;
+        let width = (tile.max.x - tile.min.x) as usize;
+        for (i, sum) in sums.into_iter().enumerate() {
+            let (x, y) = (
+                tile.min.x as usize + i % width,
+                tile.min.y as usize + i / width,
+            );
+            film.sums[y * film.width + x] = sum;
+        }
+    }
+    film.samples = end;
+    Ok(Some(PassOutput { stats, seconds }))
+}
+
+/// The progress units of a render of `spp` samples per pixel at
+/// `resolution`, for [`RenderProgress::new`]: one per tile and sample.
+pub fn progress_units(resolution: UVec2, spp: u32) -> u64 {
+    tiles(resolution).len() as u64 * spp as u64
+}
+
+/// Renders the image seen by `camera` in one pass. Samples whose radiance
+/// is NaN or infinite are counted in the stats and contribute zero.
 pub fn render(
     camera: &PerspectiveCamera,
     scene: &dyn Scene,
@@ -187,55 +303,27 @@ pub fn render(
     let resolution = camera.resolution();
     // The film first: a resolution beyond memory fails now, with a message,
     // not after the render with an aborted allocation.
-    let mut image = Image::try_new(resolution.x as usize, resolution.y as usize).map_err(|e| {
-        Error::msg(format!(
-            "film resolution {}x{}: {e}",
-            resolution.x, resolution.y
-        ))
-    })?;
-    let tiles = tiles(resolution);
-    let threads = worker_threads(settings.threads);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| Error::msg(format!("cannot start {threads} render threads: {e}")))?;
-
-    let progress = Progress::new(settings.progress, tiles.len() as u64);
-
-    let start = Instant::now();
-    let rendered: Vec<(Vec<[f32; 3]>, RenderStats)> = pool.install(|| {
-        tiles
-            .par_iter()
-            .map_init(
-                || sampler.lanes(integrator.batch_size().max(1)),
-                |lanes, tile| {
-                    let out =
-                        render_tile(tile, camera, scene, integrator, lanes.as_mut(), settings);
-                    progress.tile_done();
-                    out
-                },
-            )
-            .collect()
-    });
-    let seconds = start.elapsed().as_secs_f64();
+    let mut film = Film::try_new(resolution)?;
+    let pool = RenderPool::new(settings.threads)?;
+    let progress = RenderProgress::new(settings.progress, progress_units(resolution, settings.spp));
+    let never = AtomicBool::new(false);
+    let ctx = PassContext {
+        camera,
+        scene,
+        integrator,
+        sampler,
+        seed: settings.seed,
+        pool: &pool,
+        progress: &progress,
+        stop: &never,
+    };
+    let pass = render_pass(&ctx, &mut film, settings.spp)?;
     progress.finish();
-
-    let mut stats = RenderStats::default();
-    for (tile, (pixels, tile_stats)) in tiles.iter().zip(rendered) {
-        stats += tile_stats;
-        let width = (tile.max.x - tile.min.x) as usize;
-        for (i, p) in pixels.into_iter().enumerate() {
-            image.set(
-                tile.min.x as usize + i % width,
-                tile.min.y as usize + i / width,
-                p,
-            );
-        }
-    }
+    let pass = pass.ok_or_else(|| Error::msg("render stopped"))?;
     Ok(RenderOutput {
-        image,
-        stats,
-        seconds,
+        image: film.image(),
+        stats: pass.stats,
+        seconds: pass.seconds,
     })
 }
 

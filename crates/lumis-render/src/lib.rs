@@ -3,10 +3,14 @@
 
 mod camera;
 mod driver;
+mod film;
 pub mod profile;
 mod progress;
 
 pub use camera::PerspectiveCamera;
 pub use driver::{
-    render, worker_threads, RenderOutput, RenderSettings, MAX_THREADS_PER_CORE, TILE_SIZE,
+    progress_units, render, render_pass, worker_threads, PassContext, PassOutput, RenderOutput,
+    RenderPool, RenderSettings, MAX_THREADS_PER_CORE, TILE_SIZE,
 };
+pub use film::Film;
+pub use progress::RenderProgress;

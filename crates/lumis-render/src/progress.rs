@@ -1,4 +1,4 @@
-//! A render's progress: a bar on a terminal; a plain line every few
+//! A render's progress, over all its passes: a bar on a terminal; a plain line every few
 //! seconds where stderr is a log, a pipe or a CI job, which a bar would
 //! leave silent; or nothing.
 
@@ -12,36 +12,39 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 /// Seconds between two plain progress lines.
 const LINE_PERIOD: f64 = 5.0;
 
-pub(crate) enum Progress {
+/// Progress over units of work (a tile's samples of one pass), shown as a
+/// bar, as lines or not at all.
+pub enum RenderProgress {
     Bar(ProgressBar),
     Lines(Lines),
     Hidden,
 }
 
-impl Progress {
-    /// Progress over `tiles` tiles, shown if `enabled`.
-    pub(crate) fn new(enabled: bool, tiles: u64) -> Self {
+impl RenderProgress {
+    /// Progress over `total` units, shown if `enabled`.
+    pub fn new(enabled: bool, total: u64) -> Self {
         if !enabled {
             return Self::Hidden;
         }
         if !std::io::stderr().is_terminal() {
-            return Self::Lines(Lines::new(tiles));
+            return Self::Lines(Lines::new(total));
         }
-        let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
+        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
         bar.set_style(
             ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} tiles, eta {eta}",
+                "{spinner} [{elapsed_precise}] {wide_bar} {percent}%, eta {eta}",
             )
             .expect("static template is valid"),
         );
         Self::Bar(bar)
     }
 
-    pub(crate) fn tile_done(&self) {
+    /// Counts `units` more done.
+    pub fn advance(&self, units: u64) {
         match self {
-            Self::Bar(bar) => bar.inc(1),
+            Self::Bar(bar) => bar.inc(units),
             Self::Lines(lines) => {
-                if let Some(line) = lines.tile_done() {
+                if let Some(line) = lines.advance(units) {
                     eprintln!("{line}");
                 }
             }
@@ -49,16 +52,17 @@ impl Progress {
         }
     }
 
-    pub(crate) fn finish(&self) {
+    /// Clears the bar.
+    pub fn finish(&self) {
         if let Self::Bar(bar) = self {
             bar.finish_and_clear();
         }
     }
 }
 
-/// The plain-line progress: counts tiles, and says how far the render is
+/// The plain-line progress: counts units, and says how far the render is
 /// when a period has passed since the last line.
-pub(crate) struct Lines {
+pub struct Lines {
     total: u64,
     done: AtomicU64,
     start: Instant,
@@ -76,15 +80,15 @@ impl Lines {
         }
     }
 
-    fn tile_done(&self) -> Option<String> {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+    fn advance(&self, units: u64) -> Option<String> {
+        let done = self.done.fetch_add(units, Ordering::Relaxed) + units;
         let elapsed = self.start.elapsed().as_secs_f64();
         let mut next = self.next_line.lock().unwrap_or_else(|e| e.into_inner());
         line_if_due(done, self.total, elapsed, &mut next)
     }
 }
 
-/// The progress line for `done` of `total` tiles after `elapsed` seconds,
+/// The progress line for `done` of `total` units after `elapsed` seconds,
 /// if `*next_line` has come (and then the time of the one after).
 fn line_if_due(done: u64, total: u64, elapsed: f64, next_line: &mut f64) -> Option<String> {
     if elapsed < *next_line || done >= total {
@@ -93,7 +97,7 @@ fn line_if_due(done: u64, total: u64, elapsed: f64, next_line: &mut f64) -> Opti
     *next_line = elapsed + LINE_PERIOD;
     let eta = elapsed * (total - done) as f64 / done as f64;
     Some(format!(
-        "rendering: {done}/{total} tiles ({:.0}%), {elapsed:.0} s, eta {eta:.0} s",
+        "rendering: {:.0}%, {elapsed:.0} s, eta {eta:.0} s",
         100.0 * done as f64 / total as f64
     ))
 }
@@ -109,7 +113,7 @@ mod tests {
         let mut next = LINE_PERIOD;
         assert_eq!(line_if_due(3, 100, 1.0, &mut next), None);
         let line = line_if_due(25, 100, 5.5, &mut next).unwrap();
-        assert_eq!(line, "rendering: 25/100 tiles (25%), 6 s, eta 16 s");
+        assert_eq!(line, "rendering: 25%, 6 s, eta 16 s");
         assert_eq!(next, 10.5);
         assert_eq!(line_if_due(26, 100, 7.0, &mut next), None);
         assert!(line_if_due(60, 100, 11.0, &mut next).is_some());

@@ -21,8 +21,10 @@ mod load;
 mod obj;
 mod render_scene;
 mod report;
+mod scene_hash;
 mod triangle_mesh;
 
 pub use description::{Compaction, AUTO_COMPACT_TRIANGLES};
 pub use load::{load_file, load_str, LoadedScene};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
+pub use scene_hash::{scene_hash, Fnv1a};

@@ -1,0 +1,60 @@
+//! A render's output files, written so that they stay consistent: the EXR
+//! (whose header says what the image is) is the one truth, written last.
+
+use std::path::{Path, PathBuf};
+
+use lumis_core::{Error, Result};
+use lumis_image::{Image, OutputLock};
+
+use crate::checkpoint::checkpoint_path;
+use crate::metadata::ImageMetadata;
+
+/// The EXR and PNG of one render, locked against other writers for as long
+/// as this value lives.
+pub struct Outputs {
+    pub exr: PathBuf,
+    pub png: Option<PathBuf>,
+    _lock: OutputLock,
+}
+
+fn image_error(e: lumis_image::ImageError) -> Error {
+    Error::msg(e.to_string())
+}
+
+impl Outputs {
+    /// Locks the outputs (the lock is on the EXR: `PATH.exr.lock`) and
+    /// removes the temporary files that killed runs left beside them.
+    pub fn claim(exr: &Path, png: Option<&Path>) -> Result<Self> {
+        let lock = OutputLock::acquire(exr).map_err(image_error)?;
+        let checkpoint = checkpoint_path(exr);
+        for path in [Some(exr), png, Some(checkpoint.as_path())]
+            .into_iter()
+            .flatten()
+        {
+            lumis_image::remove_stale_temporaries(path);
+        }
+        Ok(Self {
+            exr: exr.to_path_buf(),
+            png: png.map(Path::to_path_buf),
+            _lock: lock,
+        })
+    }
+
+    /// Writes the image: both files are written in full under temporary
+    /// names first, then the PNG renamed into place and the EXR last. A
+    /// failure before the renames (a full disk) leaves both old files; a
+    /// kill between them leaves a new PNG beside the old EXR, whose header
+    /// still tells the truth about itself.
+    pub fn write(&self, image: &Image, metadata: &ImageMetadata) -> Result<()> {
+        let png = match &self.png {
+            Some(path) => Some(lumis_image::stage_png(path, image).map_err(image_error)?),
+            None => None,
+        };
+        let exr = lumis_image::stage_exr(&self.exr, image, &metadata.attributes())
+            .map_err(image_error)?;
+        if let Some(png) = png {
+            png.commit().map_err(image_error)?;
+        }
+        exr.commit().map_err(image_error)
+    }
+}

@@ -1,0 +1,87 @@
+//! A render's files stay consistent: metadata in the EXR header, the EXR
+//! written last, no temporary files left by killed runs, one writer at a
+//! time.
+
+mod common;
+
+use common::*;
+
+#[test]
+fn the_exr_header_says_what_the_image_is() {
+    let tmp = scratch("header");
+    let out = path_in(tmp.path(), "plates.exr");
+    let result = lumis(&small_render(&out, "3"));
+    assert!(result.status.success(), "{result:?}");
+    let exr = tmp.path().join("plates.exr");
+    assert_eq!(header(&exr, "command"), "render");
+    assert_eq!(header(&exr, "spp"), "3");
+    assert_eq!(header(&exr, "seed"), "0");
+    assert_eq!(header(&exr, "version"), env!("CARGO_PKG_VERSION"));
+    assert_eq!(header(&exr, "scene_hash").len(), 16);
+    assert!(header(&exr, "passes").parse::<u64>().unwrap() >= 1);
+    // No lock, checkpoint or temporary file stays behind.
+    assert_eq!(files_in(tmp.path()), ["plates.exr", "plates.png"]);
+}
+
+/// The PNG is renamed into place before the EXR: where it cannot be (its
+/// path is a directory here, as a full disk would fail it), the EXR is
+/// the previous one, and no temporary file is left.
+#[test]
+fn a_failed_png_leaves_the_previous_exr() {
+    let tmp = scratch("png-fails");
+    let out = path_in(tmp.path(), "plates.exr");
+    assert!(lumis(&small_render(&out, "1")).status.success());
+    let exr = tmp.path().join("plates.exr");
+    let before = std::fs::read(&exr).unwrap();
+    std::fs::remove_file(tmp.path().join("plates.png")).unwrap();
+    std::fs::create_dir_all(tmp.path().join("plates.png/in-the-way")).unwrap();
+    let result = lumis(&small_render(&out, "2"));
+    assert!(!result.status.success(), "{result:?}");
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(stderr.contains("plates.png"), "{stderr}");
+    assert_eq!(std::fs::read(&exr).unwrap(), before, "the EXR was replaced");
+    assert_eq!(files_in(tmp.path()), ["plates.exr", "plates.png"]);
+}
+
+#[test]
+fn temporary_files_of_dead_processes_are_removed() {
+    let tmp = scratch("stale-tmp");
+    let dead = dead_pid();
+    for name in [
+        "plates.exr",
+        "plates.png",
+        "plates.checkpoint",
+        "plates.exr.lock",
+    ] {
+        std::fs::write(tmp.path().join(format!(".{name}.tmp-{dead}")), b"partial").unwrap();
+    }
+    let out = path_in(tmp.path(), "plates.exr");
+    assert!(lumis(&small_render(&out, "1")).status.success());
+    assert_eq!(files_in(tmp.path()), ["plates.exr", "plates.png"]);
+}
+
+/// A second render to the same output while the first runs is refused,
+/// naming the first; the lock of a killed render is taken over.
+#[test]
+fn a_second_writer_is_refused_and_a_dead_ones_lock_taken_over() {
+    let tmp = scratch("lock");
+    let out = path_in(tmp.path(), "plates.exr");
+    let lock = tmp.path().join("plates.exr.lock");
+    let mut first = spawn(&small_render(&out, "1000000"));
+    wait_for(&mut first, &lock);
+    let second = lumis(&small_render(&out, "1"));
+    assert!(!second.status.success());
+    let stderr = String::from_utf8(second.stderr).unwrap();
+    assert!(
+        stderr.contains(&format!("another lumis (process {})", first.id()))
+            && stderr.contains("plates.exr.lock"),
+        "{stderr}"
+    );
+    signal(first.id(), "KILL");
+    first.wait().unwrap();
+    assert!(lock.exists(), "a killed process cannot remove its lock");
+    let third = lumis(&small_render(&out, "1"));
+    assert!(third.status.success(), "{third:?}");
+    assert!(!lock.exists());
+    assert_eq!(header(&tmp.path().join("plates.exr"), "spp"), "1");
+}

@@ -1,0 +1,159 @@
+//! `lumis reference` never silently replaces a more converged or a
+//! different reference, keeps its resume state in the EXR header, and
+//! stops on Ctrl-C with a nonzero status.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+
+/// `lumis reference` of `scene` to `out` with extra arguments.
+fn reference(scene: &Path, out: &str, spp: &str, extra: &[&str]) -> std::process::Output {
+    let scene = scene.display().to_string();
+    let mut args = vec![
+        "reference",
+        &scene,
+        "--set",
+        "film.resolution=[16, 16]",
+        "--threads",
+        "2",
+        "--spp",
+        spp,
+        "--pass-spp",
+        "4",
+        "-o",
+        out,
+    ];
+    args.extend(extra);
+    lumis(&args)
+}
+
+fn stderr_of(output: &std::process::Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+#[test]
+fn a_rerun_refuses_to_replace_a_more_converged_or_different_reference() {
+    let tmp = scratch("reference");
+    // A copy of a scene that names no files, to edit.
+    let text = std::fs::read_to_string(scene("glossy-plates.toml")).unwrap();
+    let scene_file = tmp.path().join("plates.toml");
+    std::fs::write(&scene_file, &text).unwrap();
+    let out = path_in(tmp.path(), "ref.exr");
+    let exr = tmp.path().join("ref.exr");
+
+    let first = reference(&scene_file, &out, "8", &[]);
+    assert!(first.status.success(), "{}", stderr_of(&first));
+    assert_eq!(header(&exr, "command"), "reference");
+    assert_eq!(header(&exr, "spp"), "8");
+    assert_eq!(header(&exr, "passes"), "2");
+    // The header is the only metadata: no JSON beside it.
+    assert_eq!(files_in(tmp.path()), ["plates.toml", "ref.exr"]);
+    let eight = std::fs::read(&exr).unwrap();
+
+    // Fewer spp: refused, the reference kept.
+    let fewer = reference(&scene_file, &out, "4", &[]);
+    let stderr = stderr_of(&fewer);
+    assert!(!fewer.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("refusing to replace") && stderr.contains("has 8 spp, more than the 4"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&exr).unwrap(), eight);
+
+    // Another scene: refused.
+    let other = reference(
+        &scene_file,
+        &out,
+        "12",
+        &["--set", "integrator.max_depth=2"],
+    );
+    let stderr = stderr_of(&other);
+    assert!(
+        !other.status.success() && stderr.contains("different scene"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&exr).unwrap(), eight);
+
+    // An edited comment is the same scene: resumed, not restarted.
+    std::fs::write(&scene_file, format!("# edited\n{text}")).unwrap();
+    let more = reference(&scene_file, &out, "12", &[]);
+    let stderr = stderr_of(&more);
+    assert!(
+        more.status.success() && stderr.contains("resuming") && stderr.contains("at 8 of 12"),
+        "{stderr}"
+    );
+    assert_eq!(header(&exr, "spp"), "12");
+    assert_eq!(header(&exr, "passes"), "3");
+
+    // A render's image is not a reference to continue.
+    let render_out = path_in(tmp.path(), "render.exr");
+    let render = lumis(&[
+        "render",
+        &scene_file.display().to_string(),
+        "--set",
+        "film.resolution=[16, 16]",
+        "--spp",
+        "1",
+        "-q",
+        "-o",
+        &render_out,
+    ]);
+    assert!(render.status.success());
+    let stderr = stderr_of(&reference(&scene_file, &render_out, "8", &[]));
+    assert!(stderr.contains("written by `lumis render`"), "{stderr}");
+
+    // --force replaces.
+    let forced = reference(&scene_file, &out, "4", &["--force"]);
+    assert!(forced.status.success(), "{}", stderr_of(&forced));
+    assert_eq!(header(&exr, "spp"), "4");
+}
+
+/// Ctrl-C abandons the pass in flight and exits 130; the EXR holds the
+/// passes done and a rerun resumes from them.
+#[test]
+fn an_interrupted_reference_exits_nonzero_and_resumes() {
+    let tmp = scratch("reference-int");
+    let out = path_in(tmp.path(), "ref.exr");
+    let exr = tmp.path().join("ref.exr");
+    let mut child = spawn(&[
+        "reference",
+        &scene("glossy-plates.toml"),
+        "--set",
+        "film.resolution=[16, 16]",
+        "--threads",
+        "2",
+        "--spp",
+        "100000000",
+        "--pass-spp",
+        "2",
+        "-o",
+        &out,
+    ]);
+    wait_for(&mut child, &exr);
+    signal(child.id(), "INT");
+    let result = child.wait_with_output().unwrap();
+    let stderr = stderr_of(&result);
+    assert_eq!(result.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted at"), "{stderr}");
+    let spp: u32 = header(&exr, "spp").parse().unwrap();
+    let passes: u32 = header(&exr, "passes").parse().unwrap();
+    assert!(spp > 0 && spp == 2 * passes, "{spp} spp in {passes} passes");
+    let more = (spp + 2).to_string();
+    let resumed = lumis(&[
+        "reference",
+        &scene("glossy-plates.toml"),
+        "--set",
+        "film.resolution=[16, 16]",
+        "--spp",
+        &more,
+        "--pass-spp",
+        "2",
+        "-o",
+        &out,
+    ]);
+    assert!(resumed.status.success(), "{}", stderr_of(&resumed));
+    assert!(stderr_of(&resumed).contains(&format!("at {spp} of {more}")));
+    assert_eq!(header(&exr, "passes"), (passes + 1).to_string());
+}

@@ -1,0 +1,167 @@
+//! `lumis render --resume` continues a killed render to the image an
+//! uninterrupted render makes, bit for bit.
+
+mod common;
+
+use std::time::Duration;
+
+use common::*;
+
+const SPP: &str = "96";
+
+/// Moments to kill at, in milliseconds after a start: a small linear
+/// congruential generator seeded from the clock, printed so a failure can
+/// be replayed by its seed (`LUMIS_KILL_SEED`).
+fn kill_moments(count: usize, max_ms: u64) -> Vec<u64> {
+    let seed = std::env::var("LUMIS_KILL_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| {
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .unwrap()
+                .as_nanos() as u64
+        });
+    eprintln!("kill moments from LUMIS_KILL_SEED={seed}");
+    let mut state = seed;
+    (0..count)
+        .map(|_| {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) % max_ms
+        })
+        .collect()
+}
+
+/// Starts the render (resuming from the second start on), SIGKILLs it at
+/// each moment, then lets it finish, and compares with an uninterrupted
+/// render.
+fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
+    let tmp = scratch(name);
+    let whole = path_in(tmp.path(), "whole.exr");
+    let result = lumis(&small_render(&whole, SPP));
+    assert!(result.status.success(), "{result:?}");
+
+    let out = path_in(tmp.path(), "plates.exr");
+    let mut args = small_render(&out, SPP);
+    args.extend(["--checkpoint", "--pass-spp", "1", "--resume"]);
+    // One uninterrupted run with the same flags: the kill moments spread
+    // over its duration (which only chooses them; nothing is asserted on it).
+    let start = std::time::Instant::now();
+    let result = lumis(&args);
+    let duration_ms = start.elapsed().as_millis() as u64;
+    assert!(result.status.success(), "{result:?}");
+    let exr = tmp.path().join("plates.exr");
+    assert_eq!(
+        exr_pixels(&exr),
+        exr_pixels(&whole),
+        "checkpoints changed the image"
+    );
+    for name in ["plates.exr", "plates.png"] {
+        std::fs::remove_file(tmp.path().join(name)).unwrap();
+    }
+    let checkpoint = tmp.path().join("plates.checkpoint");
+    let mut killed_mid_render = 0;
+    for ms in kill_moments(kills, duration_ms.max(1)) {
+        let mut child = spawn(&args);
+        // After its first checkpoint (or the one it resumed from): then at
+        // a random moment.
+        wait_for(&mut child, &checkpoint);
+        std::thread::sleep(Duration::from_millis(ms / 2));
+        // It may have finished already: then there is nothing to kill.
+        if child.try_wait().unwrap().is_none() {
+            signal(child.id(), "KILL");
+            killed_mid_render += 1;
+        }
+        child.wait().unwrap();
+    }
+    assert!(killed_mid_render > 0, "every run finished before its kill");
+    let resumes = checkpoint.exists();
+    let result = lumis(&args);
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(result.status.success(), "{stderr}");
+    assert!(!resumes || stderr.contains("resuming"), "{stderr}");
+    assert_eq!(header(&exr, "spp"), SPP);
+    assert_eq!(
+        exr_pixels(&exr),
+        exr_pixels(&whole),
+        "resumed image differs"
+    );
+    assert_eq!(
+        files_in(tmp.path()),
+        ["plates.exr", "plates.png", "whole.exr", "whole.png"],
+        "checkpoint, lock and temporary files are gone"
+    );
+}
+
+#[test]
+fn a_render_killed_at_random_moments_resumes_bit_for_bit() {
+    killed_and_resumed_equals_uninterrupted("kill", 3);
+}
+
+/// The same with many more kills (a few minutes):
+/// `cargo test -p lumis-cli --test resume -- --ignored`.
+#[test]
+#[ignore]
+fn a_render_killed_many_times_resumes_bit_for_bit() {
+    killed_and_resumed_equals_uninterrupted("kill-many", 40);
+}
+
+/// A checkpoint is continued only with `--resume`, and only by the render
+/// it belongs to.
+#[test]
+fn a_checkpoint_is_resumed_only_on_request_and_by_its_own_scene() {
+    let tmp = scratch("resume-refuses");
+    let out = path_in(tmp.path(), "plates.exr");
+    let mut args = small_render(&out, "1000000");
+    args.extend(["--checkpoint", "--pass-spp", "2"]);
+    let mut child = spawn(&args);
+    wait_for(&mut child, &tmp.path().join("plates.checkpoint"));
+    signal(child.id(), "KILL");
+    child.wait().unwrap();
+
+    let plain = lumis(&small_render(&out, "8"));
+    let stderr = String::from_utf8(plain.stderr).unwrap();
+    assert!(
+        !plain.status.success()
+            && stderr.contains("plates.checkpoint")
+            && stderr.contains("--resume continues it"),
+        "{stderr}"
+    );
+
+    let mut other = small_render(&out, "8");
+    other.extend(["--resume", "--set", "integrator.max_depth=2"]);
+    let result = lumis(&other);
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(
+        !result.status.success() && stderr.contains("different scene"),
+        "{stderr}"
+    );
+
+    let mut reseeded = small_render(&out, "8");
+    reseeded.extend(["--resume", "--seed", "5"]);
+    let stderr = String::from_utf8(lumis(&reseeded).stderr).unwrap();
+    assert!(stderr.contains("seed 0, not 5"), "{stderr}");
+
+    let mut fewer = small_render(&out, "1");
+    fewer.push("--resume");
+    let stderr = String::from_utf8(lumis(&fewer).stderr).unwrap();
+    assert!(
+        stderr.contains("a render of 1000000 spp, not 1"),
+        "{stderr}"
+    );
+
+    let mut damaged = std::fs::read(tmp.path().join("plates.checkpoint")).unwrap();
+    damaged[60] ^= 0xff;
+    std::fs::write(tmp.path().join("plates.checkpoint"), damaged).unwrap();
+    let mut resume = small_render(&out, "1000000");
+    resume.push("--resume");
+    let stderr = String::from_utf8(lumis(&resume).stderr).unwrap();
+    assert!(
+        stderr.contains("plates.checkpoint: not a lumis checkpoint")
+            && stderr.contains("checksum")
+            && stderr.contains("remove it to start over"),
+        "{stderr}"
+    );
+}

@@ -1,0 +1,221 @@
+//! A fingerprint of what a scene renders, so that a saved render (a
+//! checkpoint, a reference) is continued only with the scene it came from.
+//!
+//! It hashes the scene's meaning, not its text: the parsed document after
+//! `--set` overrides, tables with their keys in sorted order, so comments,
+//! whitespace, key order and number spelling (`1e3` or `1000.0`) do not
+//! count; and the bytes of every file the document names with a `file` key
+//! (meshes, glTF files, measured BRDF tables). It leaves out what a render
+//! records on its own or what does not change the image: `seed`,
+//! `sampler.spp` and `film.output`. Not covered: files that a named file
+//! itself refers to (a glTF's external buffers), and the code of plugin
+//! libraries in `[plugins] load`, which count by their path only (a
+//! rebuild, whose bytes differ, is not another scene).
+
+use std::io::{BufRead, Read};
+use std::path::Path;
+
+use lumis_core::doc::{self, Table, Value};
+use lumis_core::files::{open_bounded, read_text_bounded, FileKind, GIB};
+use lumis_core::{Error, Result};
+
+use crate::load::SCENE_FILE;
+
+/// FNV-1a 64 (Fowler, Noll, Vo): stable across Rust versions and
+/// platforms, unlike `DefaultHasher`, so a hash written today still matches
+/// tomorrow.
+#[derive(Debug, Clone, Copy)]
+pub struct Fnv1a(u64);
+
+impl Default for Fnv1a {
+    fn default() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv1a {
+    pub fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+
+    /// Writes the length first, so that consecutive fields cannot run into
+    /// each other ("ab" + "c" differs from "a" + "bc").
+    fn write_field(&mut self, bytes: &[u8]) {
+        self.write(&(bytes.len() as u64).to_le_bytes());
+        self.write(bytes);
+    }
+
+    /// Writes a file's size, then its bytes, read in pieces: a mesh can be
+    /// larger than is worth holding twice.
+    fn write_file(&mut self, path: &Path) -> std::result::Result<(), String> {
+        let (file, size) = open_bounded(path, HASHED_FILE)?;
+        self.write(&size.to_le_bytes());
+        let mut reader = std::io::BufReader::new(file.take(HASHED_FILE.max_bytes));
+        loop {
+            let chunk = reader
+                .fill_buf()
+                .map_err(|e| format!("cannot read '{}': {e}", path.display()))?;
+            if chunk.is_empty() {
+                return Ok(());
+            }
+            let n = chunk.len();
+            self.write(chunk);
+            reader.consume(n);
+        }
+    }
+
+    pub fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// The hash of the scene file at `path` with `overrides` applied, as the
+/// module documentation describes.
+pub fn scene_hash(path: &Path, overrides: &[String]) -> Result<u64> {
+    let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
+    let mut root = doc::parse(&text, &path.display().to_string())?;
+    for assignment in overrides {
+        doc::apply_override(&mut root, assignment)?;
+    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut hash = Fnv1a::default();
+    hash_table(&mut hash, &root, &[], dir)?;
+    Ok(hash.finish())
+}
+
+/// A file a scene names: a mesh, an asset, a measured table.
+const HASHED_FILE: FileKind = FileKind::new("scene file's asset", 16 * GIB);
+
+/// Keys left out of the hash, by their path from the root.
+const NOT_HASHED: &[&[&str]] = &[&["seed"], &["sampler", "spp"], &["film", "output"]];
+
+fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str], dir: &Path) -> Result<()> {
+    let mut entries: Vec<_> = table.entries.iter().collect();
+    entries.sort_by(|a, b| a.key.cmp(&b.key));
+    let mut path = at.to_vec();
+    for entry in entries {
+        path.push(&entry.key);
+        if !NOT_HASHED.contains(&path.as_slice()) {
+            hash.write(b"k");
+            hash.write_field(entry.key.as_bytes());
+            hash_value(hash, &entry.node.value, &path, dir)?;
+        }
+        path.pop();
+    }
+    hash.write(b"}");
+    Ok(())
+}
+
+fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Result<()> {
+    match value {
+        Value::Bool(b) => hash.write(&[b'b', *b as u8]),
+        Value::Int(i) => {
+            hash.write(b"i");
+            hash.write(&i.to_le_bytes());
+        }
+        Value::Float(f) => {
+            hash.write(b"f");
+            hash.write(&f.to_bits().to_le_bytes());
+        }
+        Value::String(s) => {
+            hash.write(b"s");
+            hash.write_field(s.as_bytes());
+            if names_a_file(at) {
+                let file = dir.join(s);
+                hash.write_file(&file).map_err(|e| {
+                    Error::msg(format!(
+                        "{e} (named by {} in the scene, to hash it)",
+                        at.join(".")
+                    ))
+                })?;
+            }
+        }
+        Value::Array(items) => {
+            hash.write(b"a");
+            hash.write(&(items.len() as u64).to_le_bytes());
+            for item in items {
+                hash_value(hash, &item.value, at, dir)?;
+            }
+        }
+        Value::Table(table) => {
+            hash.write(b"{");
+            hash_table(hash, table, at, dir)?;
+        }
+        Value::Datetime(d) => {
+            hash.write(b"d");
+            hash.write_field(d.as_bytes());
+        }
+    }
+    Ok(())
+}
+
+/// Whether a string at this key path names a file whose bytes count.
+fn names_a_file(at: &[&str]) -> bool {
+    at.last() == Some(&"file")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hash_of(text: &str, overrides: &[&str]) -> u64 {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("mesh.obj"), b"v 0 0 0\n").unwrap();
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, text).unwrap();
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        scene_hash(&path, &overrides).unwrap()
+    }
+
+    #[test]
+    fn meaning_counts_and_spelling_does_not() {
+        let base = hash_of(
+            "seed = 1\n[sampler]\ntype = \"sobol\"\nspp = 4\n[film]\nresolution = [8, 8]\n",
+            &[],
+        );
+        // Comments, whitespace, key order, number spelling, the seed, the
+        // spp and the output path do not count.
+        assert_eq!(
+            base,
+            hash_of("# a comment\n[film]\nresolution = [ 8, 8 ]\noutput = \"x.exr\"\n[sampler]\nspp = 64 # more\ntype = \"sobol\"\n", &[])
+        );
+        // Values do, also when set on the command line.
+        assert_ne!(
+            base,
+            hash_of(
+                "[sampler]\ntype = \"sobol\"\n[film]\nresolution = [8, 9]\n",
+                &[]
+            )
+        );
+        assert_ne!(
+            base,
+            hash_of(
+                "[sampler]\ntype = \"sobol\"\n[film]\nresolution = [8, 8]\n",
+                &["sampler.type=independent"]
+            )
+        );
+        // Integer and float are different parameters.
+        assert_ne!(hash_of("a = 1\n", &[]), hash_of("a = 1.0\n", &[]));
+        assert_eq!(hash_of("a = 1000.0\n", &[]), hash_of("a = 1e3\n", &[]));
+    }
+
+    #[test]
+    fn the_bytes_of_named_files_count() {
+        let scene = "[[shape]]\ntype = \"obj\"\nfile = \"mesh.obj\"\n";
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, scene).unwrap();
+        std::fs::write(dir.path().join("mesh.obj"), b"v 0 0 0\n").unwrap();
+        let before = scene_hash(&path, &[]).unwrap();
+        std::fs::write(dir.path().join("mesh.obj"), b"v 0 0 1\n").unwrap();
+        assert_ne!(before, scene_hash(&path, &[]).unwrap());
+        std::fs::remove_file(dir.path().join("mesh.obj")).unwrap();
+        let err = scene_hash(&path, &[]).unwrap_err().to_string();
+        assert!(
+            err.contains("mesh.obj") && err.contains("shape.file"),
+            "{err}"
+        );
+    }
+}
