@@ -157,3 +157,64 @@ fn an_interrupted_reference_exits_nonzero_and_resumes() {
     assert!(stderr_of(&resumed).contains(&format!("at {spp} of {more}")));
     assert_eq!(header(&exr, "passes"), (passes + 1).to_string());
 }
+
+/// SIGKILLed at random moments and rerun, a reference reaches the image
+/// and the header of an uninterrupted one, bit for bit: its resume state is
+/// the EXR it renames into place whole, so no kill can leave a pass counted
+/// twice or an image and a count that disagree.
+#[test]
+fn a_reference_killed_at_random_moments_resumes_bit_for_bit() {
+    let tmp = scratch("reference-kill");
+    let plates = scene("glossy-plates.toml");
+    let args = |out: &str| {
+        [
+            "reference",
+            &plates,
+            "--set",
+            "film.resolution=[16, 16]",
+            "--threads",
+            "2",
+            "--spp",
+            "240",
+            "--pass-spp",
+            "2",
+            "-o",
+            out,
+        ]
+        .map(str::to_string)
+    };
+    let run = |out: &str| {
+        let args = args(out);
+        lumis(&args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let whole = path_in(tmp.path(), "whole.exr");
+    let start = std::time::Instant::now();
+    assert!(run(&whole).status.success());
+    let duration_ms = start.elapsed().as_millis() as u64;
+
+    let out = path_in(tmp.path(), "ref.exr");
+    let exr = tmp.path().join("ref.exr");
+    let mut killed = 0;
+    for ms in kill_moments(3, duration_ms.max(1)) {
+        let args = args(&out);
+        let mut child = spawn(&args.iter().map(String::as_str).collect::<Vec<_>>());
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        if child.try_wait().unwrap().is_none() {
+            signal(child.id(), "KILL");
+            killed += 1;
+        }
+        child.wait().unwrap();
+    }
+    assert!(killed > 0, "every run finished before its kill");
+    let last = run(&out);
+    assert!(last.status.success(), "{}", stderr_of(&last));
+    let whole = tmp.path().join("whole.exr");
+    assert_eq!(
+        exr_pixels(&exr),
+        exr_pixels(&whole),
+        "resumed reference differs"
+    );
+    for key in ["spp", "passes", "seed", "scene_hash"] {
+        assert_eq!(header(&exr, key), header(&whole, key), "{key}");
+    }
+}

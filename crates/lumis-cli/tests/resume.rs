@@ -9,31 +9,6 @@ use common::*;
 
 const SPP: &str = "96";
 
-/// Moments to kill at, in milliseconds after a start: a small linear
-/// congruential generator seeded from the clock, printed so a failure can
-/// be replayed by its seed (`LUMIS_KILL_SEED`).
-fn kill_moments(count: usize, max_ms: u64) -> Vec<u64> {
-    let seed = std::env::var("LUMIS_KILL_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| {
-            std::time::SystemTime::now()
-                .duration_since(std::time::UNIX_EPOCH)
-                .unwrap()
-                .as_nanos() as u64
-        });
-    eprintln!("kill moments from LUMIS_KILL_SEED={seed}");
-    let mut state = seed;
-    (0..count)
-        .map(|_| {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 33) % max_ms
-        })
-        .collect()
-}
-
 /// Starts the render (resuming from the second start on), SIGKILLs it at
 /// each moment, then lets it finish, and compares with an uninterrupted
 /// render.
