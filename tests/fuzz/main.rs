@@ -1,5 +1,6 @@
 //! Mutation fuzzing of every parser that reads a user's file: TOML scenes,
-//! OBJ meshes, glTF/GLB assets (JSON and binary) and MERL tables.
+//! OBJ meshes, glTF/GLB assets (JSON and binary), their PNG and JPEG
+//! textures, and MERL tables.
 //!
 //! Each target mutates files of its seed corpus (the repository's own
 //! scenes and assets, plus `tests/fuzz/corpus/`) with a seeded stream and
@@ -22,6 +23,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, Once};
 
+use base64::Engine;
 use lumis_tests::scenes_dir;
 use mutate::Rng;
 use serde_json::Value;
@@ -254,6 +256,59 @@ fn gltf_assets() {
             let camera = format!("[camera]\ntype = \"gltf\"\nfile = \"{file}\"");
             let as_camera = scene_with_shape("gltf", file, &camera);
             located(load_scene(&as_camera, dir), file)
+        },
+    );
+}
+
+/// The PNG and JPEG decoders, reached as a glTF material's base-colour
+/// texture: the image's bytes are mutated, the asset around them is valid.
+#[test]
+fn gltf_texture_images() {
+    let (w, h) = (8u32, 8u32);
+    let pixels: Vec<u8> = (0..w * h * 3).map(|i| (i * 37 % 251) as u8).collect();
+    let mut jpeg = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, 90)
+        .encode(&pixels, w, h, image::ColorType::Rgb8)
+        .unwrap();
+    let asset: Value =
+        serde_json::from_slice(&seed(corpus_dir().join("sparse-ortho.gltf")).bytes).unwrap();
+    let png = asset["images"][0]["uri"]
+        .as_str()
+        .and_then(|uri| uri.split_once(";base64,"))
+        .map(|(_, data)| {
+            base64::engine::general_purpose::STANDARD
+                .decode(data)
+                .unwrap()
+        })
+        .unwrap();
+    let seeds = [
+        Seed {
+            name: "texture.png".into(),
+            bytes: png,
+        },
+        Seed {
+            name: "texture.jpg".into(),
+            bytes: jpeg,
+        },
+    ];
+    fuzz(
+        "image",
+        &seeds,
+        iterations(300),
+        |rng, seed| mutate::binary(rng, &seed.bytes),
+        |dir, seed, mutant| {
+            let mime = if seed.name.ends_with(".png") {
+                "image/png"
+            } else {
+                "image/jpeg"
+            };
+            let mut doc = asset.clone();
+            doc["images"][0] = serde_json::json!({
+                "uri": format!("data:{mime};base64,{}", base64::engine::general_purpose::STANDARD.encode(mutant)),
+            });
+            std::fs::write(dir.join("mutant.gltf"), serde_json::to_vec(&doc).unwrap()).unwrap();
+            let scene = scene_with_shape("gltf", "mutant.gltf", PERSPECTIVE);
+            located(load_scene(&scene, dir), "mutant.gltf")
         },
     );
 }
