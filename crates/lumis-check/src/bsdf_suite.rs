@@ -322,7 +322,10 @@ fn check_values(bsdf: &dyn Bsdf, wo: Vec3, samples: usize, seed: u64) -> (f64, f
             lanes.u.push((u1, u2));
             lanes.wi.push(wi);
         }
-        if eval_f != f || eval_pdf.to_bits() != pdf.to_bits() {
+        // Compared bit for bit, so that a NaN in both is reported once,
+        // as a NaN below, not as a mismatch.
+        let bits = |c: Rgb| [c.r, c.g, c.b].map(f32::to_bits);
+        if bits(eval_f) != bits(f) || eval_pdf.to_bits() != pdf.to_bits() {
             note(format!(
                 "eval() = ({eval_f:?}, {eval_pdf}) but (f(), pdf()) = ({f:?}, {pdf}) at wi = {wi:?}"
             ));
@@ -599,16 +602,18 @@ fn hemispheres(bsdf: &dyn Bsdf) -> &'static [Hemisphere] {
 /// A readable table of results, one line per case, failures explained.
 pub fn format_results(results: &[CaseResult]) -> String {
     let mut out = String::new();
+    // The case number is the one failure pictures carry
+    // (`check-NAME-CASE.png`).
     let _ = writeln!(
         out,
-        "{:<11} {:<44} {:>8} {:>7} {:>10} {:>9} {:>9} {:>8}  result",
-        "bsdf", "parameters", "cos_o", "zoom", "p-value", "pdf int", "sampled", "albedo"
+        "{:>4} {:<11} {:<44} {:>8} {:>7} {:>10} {:>9} {:>9} {:>8}  result",
+        "case", "bsdf", "parameters", "cos_o", "zoom", "p-value", "pdf int", "sampled", "albedo"
     );
-    for r in results {
+    for (case, r) in results.iter().enumerate() {
         let c = &r.chi_square;
         let _ = writeln!(
             out,
-            "{:<11} {:<44} {:>8} {:>7.0} {:>10.3e} {:>9.5} {:>9.5} {:>8.4}  {}",
+            "{case:>4} {:<11} {:<44} {:>8} {:>7.0} {:>10.3e} {:>9.5} {:>9.5} {:>8.4}  {}",
             r.bsdf,
             r.variant,
             r.cos_theta_o,
@@ -747,6 +752,8 @@ mod tests {
         wrong_sample_batch: bool,
         /// `eval_batch` reads the first lane's `wo` for every lane.
         first_wo: bool,
+        /// `f` is NaN below the horizon.
+        nan_below: bool,
     }
 
     impl Bsdf for Lambert {
@@ -756,6 +763,8 @@ mod tests {
         fn f(&self, _: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
             if wo.z > 0.0 && wi.z > 0.0 {
                 Rgb::splat(std::f32::consts::FRAC_1_PI)
+            } else if self.nan_below && wi.z < 0.0 {
+                Rgb::splat(f32::NAN)
             } else {
                 Rgb::BLACK
             }
@@ -845,6 +854,32 @@ mod tests {
         assert!(
             first.iter().any(|p| p.starts_with("eval_batch lane 2 ")),
             "{first:?}"
+        );
+    }
+
+    /// A NaN is reported as a NaN, not as `eval` disagreeing with `f`.
+    #[test]
+    fn a_nan_is_reported_as_a_nan() {
+        let wo = direction(0.6, 0.3);
+        let problems = check_values(
+            &Lambert {
+                nan_below: true,
+                ..Default::default()
+            },
+            wo,
+            400,
+            7,
+        )
+        .2;
+        assert!(
+            problems
+                .iter()
+                .any(|p| p.starts_with("f() = Rgb") && p.contains("NaN")),
+            "{problems:?}"
+        );
+        assert!(
+            !problems.iter().any(|p| p.starts_with("eval()")),
+            "{problems:?}"
         );
     }
 }
