@@ -405,6 +405,10 @@ pub fn render_scene_file(
             interrupted = true;
             break;
         };
+        // A loaded plugin that panicked answered with neutral values: the
+        // pass is not the scene's, so nothing is saved, and the panic is the
+        // error.
+        registry.faults().check()?;
         stats += pass.stats;
         seconds += pass.seconds;
         state.passes += 1;
@@ -440,9 +444,6 @@ pub fn render_scene_file(
             exr.display()
         );
     } else {
-        // A loaded plugin that panicked answered with neutral values: the
-        // image is not the scene's, and the panic is the error.
-        registry.faults().check()?;
         outputs.write(&state.film.image(), &metadata(&state))?;
         // Last: a kill before this line leaves a checkpoint that resumes
         // to the same, finished image.
