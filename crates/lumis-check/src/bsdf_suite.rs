@@ -84,11 +84,15 @@ pub struct CaseResult {
     pub albedo_se: f64,
     /// Everything that failed besides the chi-square statistic itself.
     pub problems: Vec<String>,
+    /// Why the plugin refused this parameter setting (its factory's
+    /// error): a combination it declares invalid, such as two albedos
+    /// summing past 1, is not tested and not a failure.
+    pub refused: Option<String>,
 }
 
 impl CaseResult {
     pub fn passed(&self) -> bool {
-        self.chi_square.passed && self.problems.is_empty()
+        self.refused.is_some() || self.chi_square.passed && self.problems.is_empty()
     }
 }
 
@@ -114,6 +118,28 @@ fn stand_in(
     })
 }
 
+/// A value inside `(a, b)` at fraction `t` of it: log-uniform over a range
+/// spanning decades (roughness from 1e-4, exponents to 1e6), where the
+/// interesting values are small, else uniform.
+fn interior(a: f64, b: f64, t: f64) -> f64 {
+    if a > 0.0 && b / a > 100.0 {
+        (a.ln() + t * (b.ln() - a.ln())).exp()
+    } else {
+        a + t * (b - a)
+    }
+}
+
+/// FNV-1a of the two names.
+fn name_seed(plugin: &str, parameter: &str) -> u64 {
+    plugin
+        .bytes()
+        .chain([0])
+        .chain(parameter.bytes())
+        .fold(0xcbf2_9ce4_8422_2325, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+        })
+}
+
 /// A named parameter setting, from TOML text (`"roughness = 0.01\n..."`).
 pub fn variant(label: impl Into<String>, toml: &str) -> Result<Variant> {
     Ok(Variant {
@@ -122,9 +148,17 @@ pub fn variant(label: impl Into<String>, toml: &str) -> Result<Variant> {
     })
 }
 
+/// Seeded values between the ends of each ranged parameter: a defect at an
+/// interior value (a panic for 0.6 < sigma < 0.7) that the ends and the
+/// default miss. Seeded by the plugin's and the parameter's names, so a
+/// check is repeatable.
+pub const INTERIOR_VALUES: usize = 2;
+
 /// The parameter settings to check: the defaults (with stand-ins for
 /// required parameters), then one parameter at a time at each end of its
-/// range, at each declared choice and at each boolean value.
+/// range and at [`INTERIOR_VALUES`] seeded values inside it, at each
+/// declared choice, at each boolean value, and each colour at its maximum
+/// (where a BSDF that creates energy shows it most).
 pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
     parameter_sweep_with(spec, &[])
 }
@@ -177,7 +211,40 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
                         }
                     };
                     values.extend([fmt(a), fmt(b)]);
+                    let mut rng = Pcg32::new(name_seed(spec.name, p.name), 0x5eed);
+                    for _ in 0..INTERIOR_VALUES {
+                        values.push(fmt(interior(a, b, rng.next_f32() as f64)));
+                    }
                 }
+            }
+            ParamType::Rgb => {
+                // A colour at its maximum and the other colours (those
+                // with defaults) at zero: each lobe at full strength alone,
+                // where a BSDF that creates energy shows it most.
+                let max = p.range.map_or("1.0".into(), |(_, b)| format!("{b:?}"));
+                let others = spec.params.iter().filter(|q| {
+                    q.ty == ParamType::Rgb
+                        && q.name != p.name
+                        && matches!(q.default, ParamDefault::Value(_))
+                        && !fixed.iter().any(|(k, _)| k == q.name)
+                });
+                let mut s: Vec<(String, String)> = base
+                    .iter()
+                    .filter(|(k, _)| k != p.name && !others.clone().any(|q| q.name == k))
+                    .cloned()
+                    .collect();
+                s.extend(
+                    others
+                        .clone()
+                        .map(|q| (q.name.to_string(), "0.0".to_string())),
+                );
+                s.push((p.name.to_string(), max.clone()));
+                let zeroed = if others.clone().next().is_some() {
+                    ", other colours 0"
+                } else {
+                    ""
+                };
+                settings.push((format!("{} = {max}{zeroed}", p.name), s));
             }
             ParamType::Bool => values.extend(["true".to_string(), "false".to_string()]),
             ParamType::String => values.extend(p.choices.iter().map(|c| format!("\"{c}\""))),
@@ -213,8 +280,21 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
     registry.create::<dyn Bsdf>(&entity, ())
 }
 
-/// The failed case of a variant the plugin could not make.
-fn unmade(name: &str, variant: &Variant, cos_theta_o: f32, error: &Error) -> CaseResult {
+/// The case of a variant the plugin did not make: refused (its factory
+/// returned an error, untested) or failed (its factory panicked).
+fn unmade(
+    name: &str,
+    variant: &Variant,
+    cos_theta_o: f32,
+    error: &Error,
+    panicked: bool,
+) -> CaseResult {
+    let why = error.to_string();
+    let (problems, refused) = if panicked {
+        (vec![why], None)
+    } else {
+        (Vec::new(), Some(why))
+    };
     CaseResult {
         bsdf: name.to_string(),
         variant: variant.label.clone(),
@@ -233,7 +313,8 @@ fn unmade(name: &str, variant: &Variant, cos_theta_o: f32, error: &Error) -> Cas
         zoom: f64::NAN,
         albedo: f64::NAN,
         albedo_se: f64::NAN,
-        problems: vec![error.to_string()],
+        problems,
+        refused,
     }
 }
 
@@ -512,7 +593,13 @@ pub fn check_bsdf_variants(
         .map(|(case, variant, bsdf, i, c)| {
             let bsdf = match bsdf {
                 Ok(bsdf) => bsdf,
-                Err(e) => return unmade(name, variant, c, e),
+                Err(e) => {
+                    let panicked = !registry
+                        .faults()
+                        .faults_of(&owner(name, variant))
+                        .is_empty();
+                    return unmade(name, variant, c, e, panicked);
+                }
             };
             let wo = direction(c, 0.3 + i as f32);
             // Each case (and hemisphere) draws its own samples, so the
@@ -545,6 +632,7 @@ pub fn check_bsdf_variants(
                 albedo,
                 albedo_se,
                 problems,
+                refused: None,
             }
         })
         .collect();
@@ -622,8 +710,19 @@ pub fn format_results(results: &[CaseResult]) -> String {
             c.pdf_integral,
             c.sampled_fraction,
             r.albedo,
-            if r.passed() { "ok" } else { "FAILED" }
+            match (&r.refused, r.passed()) {
+                (Some(_), _) => "refused",
+                (None, true) => "ok",
+                (None, false) => "FAILED",
+            }
         );
+        if let Some(why) = &r.refused {
+            let _ = writeln!(
+                out,
+                "    not tested: the plugin refuses these parameters: {why}"
+            );
+            continue;
+        }
         if let Some(d) = &c.defect {
             let _ = writeln!(out, "    chi-square: {d}");
         }
@@ -639,7 +738,12 @@ pub fn format_results(results: &[CaseResult]) -> String {
         }
     }
     let failed = results.iter().filter(|r| !r.passed()).count();
-    let _ = writeln!(out, "{} passed, {} failed", results.len() - failed, failed);
+    let refused = results.iter().filter(|r| r.refused.is_some()).count();
+    let _ = writeln!(
+        out,
+        "{} passed, {failed} failed, {refused} refused by the plugin",
+        results.len() - failed - refused
+    );
     out
 }
 
@@ -743,6 +847,39 @@ mod tests {
                 "missing {want} in {labels:?}"
             );
         }
+    }
+
+    /// Seeded interior values lie inside the range, log-uniform over a
+    /// range of decades, the same on every run; each colour is swept at its
+    /// maximum with the other colours that have defaults at zero.
+    #[test]
+    fn sweep_adds_interior_values_and_colours_at_their_maximum() {
+        let sweep = parameter_sweep(&SPEC).unwrap();
+        let interior: Vec<f64> = sweep
+            .iter()
+            .filter_map(|v| v.label.strip_prefix("roughness = "))
+            .map(|v| v.parse().unwrap())
+            .filter(|&v| v != 1e-4 && v != 1.0)
+            .collect();
+        assert_eq!(interior.len(), INTERIOR_VALUES, "{interior:?}");
+        assert!(
+            interior.iter().all(|&v| 1e-4 < v && v < 1.0),
+            "{interior:?}"
+        );
+        let again: Vec<String> = parameter_sweep(&SPEC)
+            .unwrap()
+            .into_iter()
+            .map(|v| v.label)
+            .collect();
+        assert_eq!(
+            again,
+            sweep.iter().map(|v| v.label.clone()).collect::<Vec<_>>()
+        );
+        // Half-way is the geometric mean over decades, the mean otherwise.
+        assert!((interior(1e-4, 1.0, 0.5) - 1e-2).abs() < 1e-12);
+        assert_eq!(interior(0.0, 2.0, 0.25), 0.5);
+        let albedo = sweep.iter().find(|v| v.label == "albedo = 1.0").unwrap();
+        assert!(albedo.table.get("albedo").is_some());
     }
 
     /// A Lambertian BSDF whose batched methods can be made wrong.
