@@ -100,8 +100,8 @@ fn stand_in(
     choices: &[&str],
 ) -> Result<String> {
     Ok(match ty {
-        ParamType::Rgb => "0.5".into(),
-        ParamType::Float => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
+        ParamType::Rgb | ParamType::TexturedRgb => "0.5".into(),
+        ParamType::Float | ParamType::TexturedFloat => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
         ParamType::Int => range.map_or("1".into(), |(a, _)| format!("{}", a as i64)),
         ParamType::Bool => "false".into(),
         ParamType::String if !choices.is_empty() => format!("\"{}\"", choices[0]),
@@ -167,7 +167,7 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
     {
         let mut values: Vec<String> = Vec::new();
         match p.ty {
-            ParamType::Float | ParamType::Int => {
+            ParamType::Float | ParamType::TexturedFloat | ParamType::Int => {
                 if let Some((a, b)) = p.range {
                     let fmt = |v: f64| {
                         if p.ty == ParamType::Int {
@@ -210,7 +210,7 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
         variant.table.clone(),
         Location::Builtin,
     );
-    registry.create::<dyn Bsdf>(&entity, ())
+    registry.create::<dyn Bsdf>(&entity, &lumis_core::texture::NO_TEXTURES)
 }
 
 fn direction(cos_theta: f32, phi: f32) -> Vec3 {

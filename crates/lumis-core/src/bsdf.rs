@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::spectrum::Rgb;
+use crate::texture::TextureQuery;
 
 /// Which quantity is transported; refraction scales radiance by 1/eta^2 but
 /// not importance (Veach 1997, section 5.2).
@@ -16,7 +17,9 @@ pub enum TransportMode {
 /// Per-hit information a BSDF may read, so evaluation needs no allocation.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BsdfContext {
-    pub uv: Vec2,
+    /// Where the hit's textured parameters are looked up (its uv and, with
+    /// ray differentials, its footprint).
+    pub texture: TextureQuery,
     pub mode: TransportMode,
     /// A texture's value at this hit that scales the BSDF's diffuse albedo
     /// (pbrt-v4's textured parameters: the material looks the texture up,

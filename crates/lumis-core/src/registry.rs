@@ -16,11 +16,13 @@ use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
 use crate::params::{ParamSpec, Params};
 use crate::sampler::Sampler;
+use crate::texture::{Texture, Textures};
 
 /// The plugin interfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum PluginKind {
     Sampler,
+    Texture,
     Bsdf,
     Light,
     LightSampler,
@@ -28,8 +30,9 @@ pub enum PluginKind {
 }
 
 impl PluginKind {
-    pub const ALL: [PluginKind; 5] = [
+    pub const ALL: [PluginKind; 6] = [
         PluginKind::Sampler,
+        PluginKind::Texture,
         PluginKind::Bsdf,
         PluginKind::Light,
         PluginKind::LightSampler,
@@ -40,6 +43,7 @@ impl PluginKind {
     pub fn table_name(self) -> &'static str {
         match self {
             PluginKind::Sampler => "sampler",
+            PluginKind::Texture => "texture",
             PluginKind::Bsdf => "bsdf",
             PluginKind::Light => "light",
             PluginKind::LightSampler => "light_sampler",
@@ -66,6 +70,9 @@ pub struct PluginSpec {
 }
 
 pub type SamplerFactory = fn(&Params) -> Result<Box<dyn Sampler>>;
+pub type TextureFactory = fn(&Params) -> Result<Arc<dyn Texture>>;
+/// A BSDF's textured parameters ([`crate::params::Textured`]) refer to the
+/// scene's textures through its `Params`.
 pub type BsdfFactory = fn(&Params) -> Result<Arc<dyn Bsdf>>;
 /// Lights get the geometry they are attached to ([`LightShape::None`] for
 /// `[[light]]` tables); a factory refuses shapes it cannot emit from.
@@ -143,6 +150,11 @@ impl Registry {
         self.add(spec, Factory::Sampler(factory))
     }
 
+    pub fn add_texture(&mut self, spec: PluginSpec, factory: TextureFactory) -> Result<()> {
+        Self::check_kind(&spec, PluginKind::Texture)?;
+        self.add(spec, Factory::Texture(factory))
+    }
+
     pub fn add_bsdf(&mut self, spec: PluginSpec, factory: BsdfFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Bsdf)?;
         self.add(spec, Factory::Bsdf(factory))
@@ -184,7 +196,7 @@ impl Registry {
     /// `type`, checks its table against the plugin's declaration, calls the
     /// factory with `input` and rejects keys the plugin did not read. The
     /// one path by which any plugin is made:
-    /// `registry.create::<dyn Bsdf>(&entity, ())`.
+    /// `registry.create::<dyn Bsdf>(&entity, &textures)`.
     pub fn create<P: PluginInterface + ?Sized>(
         &self,
         entity: &PluginEntity,
@@ -211,6 +223,10 @@ impl Registry {
             plugin.spec.params,
             entity.structural,
         )?;
+        let params = match P::textures(&input) {
+            Some(textures) => params.with_textures(textures),
+            None => params,
+        };
         let made = P::call(plugin.factory, &params, input)?;
         params.finish()?;
         Ok(made)
@@ -242,7 +258,7 @@ impl Registry {
 }
 
 /// A plugin interface: its kind, what its factory takes besides the
-/// parameters, and what it makes. Implemented for the five plugin traits
+/// parameters, and what it makes. Implemented for the six plugin traits
 /// (`dyn Sampler`, `dyn Bsdf`, ...), which name the kind in
 /// [`Registry::create`].
 pub trait PluginInterface: sealed::Sealed {
@@ -252,6 +268,10 @@ pub trait PluginInterface: sealed::Sealed {
     /// What the factory takes besides its parameters: the shape an area
     /// light is attached to, the lights a light sampler chooses among.
     type Input<'i>;
+    /// The textures its parameters may refer to, if it takes any.
+    fn textures<'i>(_input: &Self::Input<'i>) -> Option<&'i Textures> {
+        None
+    }
     #[doc(hidden)]
     fn call(
         factory: sealed::Factory,
@@ -269,6 +289,7 @@ mod sealed {
     #[derive(Clone, Copy)]
     pub enum Factory {
         Sampler(SamplerFactory),
+        Texture(TextureFactory),
         Bsdf(BsdfFactory),
         Light(LightFactory),
         LightSampler(LightSamplerFactory),
@@ -276,6 +297,7 @@ mod sealed {
     }
 
     impl Sealed for dyn Sampler {}
+    impl Sealed for dyn Texture {}
     impl Sealed for dyn Bsdf {}
     impl Sealed for dyn Light {}
     impl Sealed for dyn LightSampler {}
@@ -301,11 +323,28 @@ impl PluginInterface for dyn Sampler {
     }
 }
 
+impl PluginInterface for dyn Texture {
+    const KIND: PluginKind = PluginKind::Texture;
+    type Made = Arc<dyn Texture>;
+    type Input<'i> = ();
+    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Texture(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params)
+    }
+}
+
+/// A BSDF is made with the textures its parameters may name
+/// ([`crate::texture::NO_TEXTURES`] outside a scene).
 impl PluginInterface for dyn Bsdf {
     const KIND: PluginKind = PluginKind::Bsdf;
     type Made = Arc<dyn Bsdf>;
-    type Input<'i> = ();
-    fn call(factory: Factory, params: &Params, (): ()) -> Result<Self::Made> {
+    type Input<'i> = &'i Textures;
+    fn textures<'i>(input: &Self::Input<'i>) -> Option<&'i Textures> {
+        Some(*input)
+    }
+    fn call(factory: Factory, params: &Params, _: &Textures) -> Result<Self::Made> {
         let Factory::Bsdf(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -360,6 +399,7 @@ mod tests {
     use crate::error::Location;
     use crate::params::ParamType;
     use crate::spectrum::Rgb;
+    use crate::texture::NO_TEXTURES;
 
     /// A BSDF of one parameter, `albedo`, returned by `f`.
     struct Grey(Rgb);
@@ -403,13 +443,13 @@ mod tests {
     fn creates_from_a_document_table_and_from_a_built_one() {
         let registry = registry();
         let read = entity("type = \"grey\"\nalbedo = 0.25\n", PluginKind::Bsdf);
-        let bsdf = registry.create::<dyn Bsdf>(&read, ()).unwrap();
+        let bsdf = registry.create::<dyn Bsdf>(&read, &NO_TEXTURES).unwrap();
         let ctx = BsdfContext::default();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.25));
 
         let table = Table::built(&Location::Builtin, [("albedo", Value::from([0.5f32; 3]))]);
         let built = PluginEntity::new(PluginKind::Bsdf, "x", "grey", table, Location::Builtin);
-        let bsdf = registry.create::<dyn Bsdf>(&built, ()).unwrap();
+        let bsdf = registry.create::<dyn Bsdf>(&built, &NO_TEXTURES).unwrap();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.5));
     }
 
@@ -417,7 +457,10 @@ mod tests {
     fn errors_name_the_type_key_and_kind() {
         let registry = registry();
         let unknown = entity("type = \"gray\"\n", PluginKind::Bsdf);
-        let err = registry.create::<dyn Bsdf>(&unknown, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&unknown, &NO_TEXTURES)
+            .err()
+            .unwrap();
         let text = err.to_string();
         assert!(
             text.starts_with("s.toml:1:8")
@@ -429,14 +472,20 @@ mod tests {
             "type = \"grey\"\nalbedo = 0.5\nalbedoo = 1\n",
             PluginKind::Bsdf,
         );
-        let err = registry.create::<dyn Bsdf>(&typo, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&typo, &NO_TEXTURES)
+            .err()
+            .unwrap();
         assert!(
             err.to_string().starts_with("s.toml:3:1") && err.message.contains("'albedoo'"),
             "{err}"
         );
 
         let light = entity("type = \"grey\"\nalbedo = 0.5\n", PluginKind::Light);
-        let err = registry.create::<dyn Bsdf>(&light, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&light, &NO_TEXTURES)
+            .err()
+            .unwrap();
         assert!(
             err.message
                 .contains("a light plugin where a bsdf plugin is expected"),
@@ -461,6 +510,8 @@ mod tests {
             PluginEntity::from_table_or(PluginKind::Bsdf, "b", table, Location::Builtin, "grey")
                 .unwrap();
         assert_eq!(defaulted.type_name, "grey");
-        assert!(registry().create::<dyn Bsdf>(&defaulted, ()).is_ok());
+        assert!(registry()
+            .create::<dyn Bsdf>(&defaulted, &NO_TEXTURES)
+            .is_ok());
     }
 }

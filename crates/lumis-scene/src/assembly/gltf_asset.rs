@@ -140,7 +140,9 @@ fn place_materials<'m>(
         let bsdf = match &material.bsdf {
             MaterialBsdf::Scene(reference) => asm.bsdfs.index_of(reference, owner)?,
             MaterialBsdf::Asset(asset) => {
-                let mut bsdf = asm.registry.create::<dyn Bsdf>(&asset.entity, ())?;
+                let mut bsdf = asm
+                    .registry
+                    .create::<dyn Bsdf>(&asset.entity, &lumis_core::texture::NO_TEXTURES)?;
                 if asset.two_sided {
                     bsdf = Arc::new(TwoSided { inner: bsdf });
                 }

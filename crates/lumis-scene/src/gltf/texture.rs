@@ -232,7 +232,7 @@ impl AlbedoTextured {
     /// The context with the texel at its uv as the albedo scale.
     #[inline]
     fn textured(&self, ctx: &BsdfContext) -> BsdfContext {
-        let texel = self.texture.lookup(ctx.uv);
+        let texel = self.texture.lookup(ctx.texture.uv);
         BsdfContext {
             albedo_scale: Some(ctx.albedo_scale.map_or(texel, |s| s * texel)),
             ..*ctx
@@ -250,7 +250,7 @@ impl Bsdf for AlbedoTextured {
         if self.through_context {
             self.inner.f(&self.textured(ctx), wo, wi)
         } else {
-            self.texture.lookup(ctx.uv) * self.inner.f(ctx, wo, wi)
+            self.texture.lookup(ctx.texture.uv) * self.inner.f(ctx, wo, wi)
         }
     }
 
@@ -260,7 +260,7 @@ impl Bsdf for AlbedoTextured {
             return self.inner.sample_f(&self.textured(ctx), wo, u1, u2);
         }
         let mut s = self.inner.sample_f(ctx, wo, u1, u2)?;
-        s.f = self.texture.lookup(ctx.uv) * s.f;
+        s.f = self.texture.lookup(ctx.texture.uv) * s.f;
         Some(s)
     }
 
@@ -280,7 +280,7 @@ impl Bsdf for AlbedoTextured {
             return self.inner.eval(&self.textured(ctx), wo, wi);
         }
         let (f, pdf) = self.inner.eval(ctx, wo, wi);
-        (self.texture.lookup(ctx.uv) * f, pdf)
+        (self.texture.lookup(ctx.texture.uv) * f, pdf)
     }
 }
 

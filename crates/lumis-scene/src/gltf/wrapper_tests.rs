@@ -66,7 +66,7 @@ fn wrappers_eval_matches_their_f_and_pdf() {
         vec![[255, 0, 0], [0, 255, 0], [0, 0, 255], [200, 100, 50]],
     ));
     let ctx = BsdfContext {
-        uv: Vec2::new(0.3, 0.7),
+        texture: lumis_core::TextureQuery::at(Vec2::new(0.3, 0.7)),
         ..Default::default()
     };
     let directions = [

@@ -7,11 +7,14 @@
 
 mod bsdf_table;
 
-use lumis_core::{Bsdf, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler};
+use lumis_core::{
+    Bsdf, Error, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler, Texture,
+    Textures,
+};
 
 pub(crate) use bsdf_table::BsdfTable;
 
-use crate::description::{NamedBsdf, PluginLibraries};
+use crate::description::{NamedPlugin, PluginLibraries};
 
 /// The plugins a scene names outside its shapes.
 pub(crate) struct Plugins {
@@ -22,17 +25,34 @@ pub(crate) struct Plugins {
     pub lights: Vec<Box<dyn Light>>,
 }
 
-/// Creates the `[[bsdf]]`s, `[[light]]`s, sampler and integrator.
+/// Creates the `[[texture]]`s, `[[bsdf]]`s (whose parameters may name the
+/// textures), `[[light]]`s, sampler and integrator.
 pub(crate) fn instantiate(
     registry: &Registry,
-    bsdfs: &[NamedBsdf],
+    textures: &[NamedPlugin],
+    bsdfs: &[NamedPlugin],
     lights: &[PluginEntity],
     sampler: &PluginEntity,
     integrator: &PluginEntity,
 ) -> Result<Plugins> {
+    let mut by_name = Textures::new();
+    for texture in textures {
+        let made = registry.create::<dyn Texture>(&texture.entity, ())?;
+        if !by_name.insert(texture.name.clone(), made) {
+            return Err(Error::at(
+                &texture.entity.location,
+                format!("a [[texture]] named \"{}\" already exists", texture.name),
+            ));
+        }
+    }
     let named = bsdfs
         .iter()
-        .map(|b| Ok((b.name.clone(), registry.create::<dyn Bsdf>(&b.entity, ())?)))
+        .map(|b| {
+            Ok((
+                b.name.clone(),
+                registry.create::<dyn Bsdf>(&b.entity, &by_name)?,
+            ))
+        })
         .collect::<Result<Vec<_>>>()?;
     let lights = lights
         .iter()

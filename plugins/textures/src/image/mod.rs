@@ -1,0 +1,140 @@
+//! `image`: a texture read from a PNG, JPEG or EXR file, wrapped and
+//! filtered.
+
+mod decode;
+mod texels;
+
+use std::path::PathBuf;
+
+use lumis_core::{
+    ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery,
+    UvTransform,
+};
+
+pub use decode::{decode, srgb_to_linear, Stored};
+pub use texels::{Texels, Wrap};
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Texture,
+    name: "image",
+    doc: "an image file (PNG, JPEG or EXR); uv (0, 0) is its top-left corner",
+    params: ImageParams::SPECS,
+};
+
+#[derive(Debug, Clone, PluginParams)]
+pub struct ImageParams {
+    /// the image file (PNG, JPEG or EXR), relative to the scene file
+    pub filename: PathBuf,
+    /// how the stored values encode linear ones: "auto" (sRGB for PNG and
+    /// JPEG, linear for EXR), "srgb" or "linear"
+    #[param(default = Auto)]
+    pub encoding: Encoding,
+    /// lookups outside [0, 1]: "repeat", "mirror" or "clamp"
+    #[param(default = Repeat)]
+    pub wrap: Wrap,
+    /// reconstruction: "bilinear" or "nearest"
+    #[param(default = Bilinear)]
+    pub filter: ImageFilter,
+    #[param(flatten)]
+    pub transform: UvTransform,
+}
+
+/// How stored texel values encode linear RGB.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum Encoding {
+    /// sRGB for integer formats (PNG, JPEG), linear for floating point.
+    Auto,
+    /// The sRGB transfer function (IEC 61966-2-1).
+    Srgb,
+    /// The values are linear.
+    Linear,
+}
+
+/// How a lookup between texel centres is reconstructed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum ImageFilter {
+    Nearest,
+    Bilinear,
+}
+
+/// An image texture.
+#[derive(Debug, Clone)]
+pub struct ImageTexture {
+    texels: Texels,
+    wrap: Wrap,
+    filter: ImageFilter,
+    transform: UvTransform,
+}
+
+impl ImageTexture {
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let p = ImageParams::read(params)?;
+        let keys = ImageParams::KEYS;
+        let stored = decode::read(&p.filename)
+            .map_err(|e| params.error(keys.filename, format!("{}: {e}", p.filename.display())))?;
+        Ok(Self::new(stored, p.encoding, p.wrap, p.filter, p.transform))
+    }
+
+    /// A texture of decoded image data (e.g. an image embedded in an asset).
+    pub fn new(
+        stored: Stored,
+        encoding: Encoding,
+        wrap: Wrap,
+        filter: ImageFilter,
+        transform: UvTransform,
+    ) -> Self {
+        let srgb = match encoding {
+            Encoding::Auto => !stored.is_float,
+            Encoding::Srgb => true,
+            Encoding::Linear => false,
+        };
+        let values = if srgb {
+            stored
+                .values
+                .into_iter()
+                .map(|v| v.map(srgb_to_linear))
+                .collect()
+        } else {
+            stored.values
+        };
+        Self {
+            texels: Texels {
+                width: stored.width,
+                height: stored.height,
+                values,
+            },
+            wrap,
+            filter,
+            transform,
+        }
+    }
+
+    /// The linear texels.
+    pub fn texels(&self) -> &Texels {
+        &self.texels
+    }
+
+    /// Bytes held by the texels.
+    pub fn byte_size(&self) -> usize {
+        self.texels.values.capacity() * std::mem::size_of::<Rgb>()
+    }
+}
+
+impl Texture for ImageTexture {
+    #[inline]
+    fn eval(&self, query: &TextureQuery) -> Rgb {
+        let uv = self.transform.apply(query).uv;
+        // A non-finite uv (a degenerate parameterization) reads one texel
+        // rather than indexing with a NaN.
+        if !uv.is_finite() {
+            return self.texels.texel(0, 0, self.wrap);
+        }
+        match self.filter {
+            ImageFilter::Nearest => self.texels.nearest(uv, self.wrap),
+            ImageFilter::Bilinear => self.texels.bilinear(uv, self.wrap),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
