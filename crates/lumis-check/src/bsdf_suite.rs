@@ -355,9 +355,11 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
             } else {
                 TransportMode::Importance
             },
-            albedo_scale: (bsdf.takes_albedo_scale() && i % 7 == 3)
-                .then_some(Rgb::new(0.5, 0.25, 1.0)),
-            ..Default::default()
+            // Each lane at its own uv, so a textured BSDF's lanes differ.
+            texture: lumis_core::TextureQuery::at(Vec2::new(
+                (i as f32 * 0.37).fract(),
+                (i as f32 * 0.61).fract(),
+            )),
         })
         .collect();
     let u1: Vec<f32> = lanes.u.iter().map(|u| u.0).collect();

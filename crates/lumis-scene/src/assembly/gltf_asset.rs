@@ -11,7 +11,7 @@ use lumis_embree::{PaddedBuffer, SceneBuilder};
 
 use super::bvh::{PendingInstance, PendingPrototype};
 use super::state::Assembly;
-use crate::gltf::texture::{AlbedoTextured, TexturedEmitter};
+use crate::gltf::emitter::TexturedEmitter;
 use crate::gltf::two_sided::TwoSided;
 use crate::gltf::{AssetEmission, GltfImport, ImportedMaterial, MaterialBsdf};
 use crate::render_scene::{Geometry, MeshData, Placement, NO_LIGHT};
@@ -123,8 +123,8 @@ pub(crate) fn add_gltf(
     Ok(())
 }
 
-/// Creates the BSDFs of the asset's own materials (wrapped for
-/// `doubleSided` and base colour textures) and finds the scene's
+/// Creates the BSDFs of the asset's own materials (with their base colour
+/// textures; wrapped for `doubleSided`) and finds the scene's
 /// replacements, in the importer's material order: the default material,
 /// then by index.
 fn place_materials<'m>(
@@ -142,12 +142,9 @@ fn place_materials<'m>(
             MaterialBsdf::Asset(asset) => {
                 let mut bsdf = asm
                     .registry
-                    .create::<dyn Bsdf>(&asset.entity, &lumis_core::texture::NO_TEXTURES)?;
+                    .create::<dyn Bsdf>(&asset.entity, &asset.textures)?;
                 if asset.two_sided {
                     bsdf = Arc::new(TwoSided { inner: bsdf });
-                }
-                if let Some(texture) = &asset.albedo_texture {
-                    bsdf = Arc::new(AlbedoTextured::new(bsdf, texture.clone()));
                 }
                 asm.bsdfs.push_unnamed(bsdf)
             }

@@ -14,11 +14,11 @@
 mod buffers;
 pub(crate) mod camera;
 mod decode;
+pub(crate) mod emitter;
 mod material;
 mod normals;
 mod resolve;
 mod scene_graph;
-pub(crate) mod texture;
 pub(crate) mod two_sided;
 mod unmodelled;
 #[cfg(test)]

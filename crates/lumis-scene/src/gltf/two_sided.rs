@@ -60,8 +60,4 @@ impl Bsdf for TwoSided {
         let (wo, wi) = to_front(wo, wi);
         self.inner.eval(ctx, wo, wi)
     }
-
-    fn takes_albedo_scale(&self) -> bool {
-        self.inner.takes_albedo_scale()
-    }
 }

@@ -35,6 +35,10 @@ pub struct ImageParams {
     /// reconstruction: "bilinear" or "nearest"
     #[param(default = Bilinear)]
     pub filter: ImageFilter,
+    /// multiplies every texel after decoding (pbrt-v4's scale; a glTF
+    /// material's colour factor)
+    #[param(default = 1.0)]
+    pub scale: Rgb,
     #[param(flatten)]
     pub transform: UvTransform,
 }
@@ -61,7 +65,8 @@ pub enum ImageFilter {
 #[derive(Debug, Clone)]
 pub struct ImageTexture {
     texels: Texels,
-    wrap: Wrap,
+    /// In u and in v.
+    wrap: [Wrap; 2],
     filter: ImageFilter,
     transform: UvTransform,
 }
@@ -72,31 +77,37 @@ impl ImageTexture {
         let keys = ImageParams::KEYS;
         let stored = decode::read(&p.filename)
             .map_err(|e| params.error(keys.filename, format!("{}: {e}", p.filename.display())))?;
-        Ok(Self::new(stored, p.encoding, p.wrap, p.filter, p.transform))
+        Ok(Self::new(
+            stored,
+            p.encoding,
+            [p.wrap; 2],
+            p.filter,
+            p.transform,
+            p.scale,
+        ))
     }
 
-    /// A texture of decoded image data (e.g. an image embedded in an asset).
+    /// A texture of decoded image data (e.g. an image embedded in an
+    /// asset), wrapped in u and in v by `wrap`.
     pub fn new(
         stored: Stored,
         encoding: Encoding,
-        wrap: Wrap,
+        wrap: [Wrap; 2],
         filter: ImageFilter,
         transform: UvTransform,
+        scale: Rgb,
     ) -> Self {
         let srgb = match encoding {
             Encoding::Auto => !stored.is_float,
             Encoding::Srgb => true,
             Encoding::Linear => false,
         };
-        let values = if srgb {
-            stored
-                .values
-                .into_iter()
-                .map(|v| v.map(srgb_to_linear))
-                .collect()
-        } else {
-            stored.values
-        };
+        let values = stored
+            .values
+            .into_iter()
+            .map(|v| if srgb { v.map(srgb_to_linear) } else { v })
+            .map(|v| if scale == Rgb::WHITE { v } else { v * scale })
+            .collect();
         Self {
             texels: Texels {
                 width: stored.width,

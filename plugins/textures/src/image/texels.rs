@@ -45,17 +45,17 @@ pub struct Texels {
 }
 
 impl Texels {
-    /// The texel at integer coordinates `(x, y)`, wrapped.
+    /// The texel at integer coordinates `(x, y)`, wrapped in u and in v.
     #[inline]
-    pub fn texel(&self, x: i64, y: i64, wrap: Wrap) -> Rgb {
-        let x = wrap.index(x, self.width);
-        let y = wrap.index(y, self.height);
+    pub fn texel(&self, x: i64, y: i64, wrap: [Wrap; 2]) -> Rgb {
+        let x = wrap[0].index(x, self.width);
+        let y = wrap[1].index(y, self.height);
         self.values[y * self.width + x]
     }
 
     /// The texel that covers `uv`.
     #[inline]
-    pub fn nearest(&self, uv: Vec2, wrap: Wrap) -> Rgb {
+    pub fn nearest(&self, uv: Vec2, wrap: [Wrap; 2]) -> Rgb {
         let x = (uv.x * self.width as f32).floor() as i64;
         let y = (uv.y * self.height as f32).floor() as i64;
         self.texel(x, y, wrap)
@@ -64,7 +64,7 @@ impl Texels {
     /// Bilinear interpolation between the four texel centres around `uv`
     /// (texel `(x, y)` has its centre at `((x + 1/2) / w, (y + 1/2) / h)`).
     #[inline]
-    pub fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Rgb {
+    pub fn bilinear(&self, uv: Vec2, wrap: [Wrap; 2]) -> Rgb {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
@@ -111,10 +111,10 @@ mod tests {
             for y in 0..2 {
                 for x in 0..3 {
                     let uv = Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 2.0);
-                    let got = t.bilinear(uv, wrap);
+                    let got = t.bilinear(uv, [wrap; 2]);
                     let want = t.values[y * 3 + x];
                     assert!(close(got, want), "{wrap:?} {x} {y}: {got:?}");
-                    assert_eq!(t.nearest(uv, wrap), want);
+                    assert_eq!(t.nearest(uv, [wrap; 2]), want);
                 }
             }
         }
@@ -124,14 +124,53 @@ mod tests {
     fn bilinear_interpolates_and_wraps_between_edges() {
         let t = ramp();
         // Half way between texels 0 and 1 of the top row.
-        let mid = t.bilinear(Vec2::new(1.0 / 3.0, 0.25), Wrap::Clamp);
+        let mid = t.bilinear(Vec2::new(1.0 / 3.0, 0.25), [Wrap::Clamp; 2]);
         assert!((mid.r - 0.5).abs() < 1e-6 && mid.g == 0.0, "{mid:?}");
         // At u = 0 the left neighbour is texel 2 (repeat), texel 0 (mirror,
         // clamp): half way between the last and first column's values.
         let u0 = Vec2::new(0.0, 0.25);
-        assert!((t.bilinear(u0, Wrap::Repeat).r - 1.0).abs() < 1e-6);
-        assert!((t.bilinear(u0, Wrap::Mirror).r - 0.0).abs() < 1e-6);
-        assert!((t.bilinear(u0, Wrap::Clamp).r - 0.0).abs() < 1e-6);
+        assert!((t.bilinear(u0, [Wrap::Repeat; 2]).r - 1.0).abs() < 1e-6);
+        assert!((t.bilinear(u0, [Wrap::Mirror; 2]).r - 0.0).abs() < 1e-6);
+        assert!((t.bilinear(u0, [Wrap::Clamp; 2]).r - 0.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn wrap_modes_apply_per_axis() {
+        // 2 x 2: red, green / blue, white.
+        let t = Texels {
+            width: 2,
+            height: 2,
+            values: vec![
+                Rgb::new(1.0, 0.0, 0.0),
+                Rgb::new(0.0, 1.0, 0.0),
+                Rgb::new(0.0, 0.0, 1.0),
+                Rgb::WHITE,
+            ],
+        };
+        let wrap = [Wrap::Clamp, Wrap::Mirror];
+        // Clamped in u: far right is the right column; mirrored in v: v in
+        // (1, 1.5) reflects to the bottom row, (1.5, 2) to the top.
+        assert_eq!(
+            t.nearest(Vec2::new(7.0, 0.2), wrap),
+            Rgb::new(0.0, 1.0, 0.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(-3.0, 1.2), wrap),
+            Rgb::new(0.0, 0.0, 1.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(0.2, 1.7), wrap),
+            Rgb::new(1.0, 0.0, 0.0)
+        );
+        // Nearest: no blend halfway between red and green.
+        assert_eq!(
+            t.nearest(Vec2::new(0.49, 0.25), wrap),
+            Rgb::new(1.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(0.51, 0.25), wrap),
+            Rgb::new(0.0, 1.0, 0.0)
+        );
     }
 
     #[test]
@@ -145,7 +184,7 @@ mod tests {
         for i in 0..200 {
             let uv = Vec2::new(i as f32 * 0.173 - 7.0, i as f32 * -0.291 + 3.0);
             for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
-                let got = t.bilinear(uv, wrap);
+                let got = t.bilinear(uv, [wrap; 2]);
                 assert!(close(got, c), "{uv}: {got:?}");
             }
         }
