@@ -345,7 +345,7 @@ fn dielectric(rgb: [f32; 3]) -> [f32; 3] {
     )
     .unwrap();
     let bsdf = registry
-        .create::<dyn Bsdf>(&entity, &lumis_core::texture::NO_TEXTURES)
+        .create::<dyn Bsdf>(&entity, lumis_core::texture::BsdfScope::EMPTY)
         .unwrap();
     let f = bsdf.f(&BsdfContext::default(), Vec3::Z, Vec3::Z);
     let pi = std::f32::consts::PI;

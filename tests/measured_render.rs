@@ -72,7 +72,7 @@ fn bsdf(toml: &str) -> std::sync::Arc<dyn Bsdf> {
     )
     .unwrap();
     registry
-        .create::<dyn Bsdf>(&entity, &lumis_core::texture::NO_TEXTURES)
+        .create::<dyn Bsdf>(&entity, lumis_core::texture::BsdfScope::EMPTY)
         .unwrap()
 }
 

@@ -19,9 +19,10 @@ use std::sync::Arc;
 
 use lumis_core::doc::{self, Table};
 use lumis_core::params::ParamDefault;
+use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginEntity, PluginKind, PluginSpec,
-    Registry, Result, Rgb, TransportMode, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfScope, Error, Location, ParamType, PluginEntity, PluginKind,
+    PluginSpec, Registry, Result, Rgb, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -101,6 +102,7 @@ fn stand_in(
 ) -> Result<String> {
     Ok(match ty {
         ParamType::Rgb | ParamType::TexturedRgb => "0.5".into(),
+        ParamType::Bsdf => format!("\"{}\"", STAND_IN_BSDFS[0].0),
         ParamType::Float | ParamType::TexturedFloat => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
         ParamType::Int => range.map_or("1".into(), |(a, _)| format!("{}", a as i64)),
         ParamType::Bool => "false".into(),
@@ -181,6 +183,11 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
             }
             ParamType::Bool => values.extend(["true".to_string(), "false".to_string()]),
             ParamType::String => values.extend(p.choices.iter().map(|c| format!("\"{c}\""))),
+            ParamType::Bsdf => values.extend(
+                STAND_IN_BSDFS
+                    .iter()
+                    .map(|(name, ..)| format!("\"{name}\"")),
+            ),
             _ => {}
         }
         for v in values {
@@ -200,7 +207,40 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
         .collect()
 }
 
-/// The BSDF plugin `name` with the parameters of `variant`.
+/// The BSDFs that a BSDF parameter (an adapter's inner BSDF, e.g.
+/// `twosided`'s) is swept over: name, built-in plugin, parameters.
+pub const STAND_IN_BSDFS: &[(&str, &str, &str)] = &[
+    (
+        "rough-plastic",
+        "plastic",
+        "roughness = 0.3\nnonlinear = true\n",
+    ),
+    ("diffuse", "diffuse", "reflectance = 0.5\n"),
+    ("gold", "conductor", "material = \"Au\"\nroughness = 0.2\n"),
+];
+
+/// [`STAND_IN_BSDFS`], made by `registry`.
+fn stand_in_bsdfs(registry: &Registry) -> Result<Named<dyn Bsdf>> {
+    let mut out = Named::new();
+    for &(name, type_name, params) in STAND_IN_BSDFS {
+        let table = doc::parse(params, "<stand-in>")?;
+        let entity = PluginEntity::new(
+            PluginKind::Bsdf,
+            format!("stand-in bsdf \"{name}\""),
+            type_name,
+            table,
+            Location::Builtin,
+        );
+        out.insert(
+            name,
+            registry.create::<dyn Bsdf>(&entity, BsdfScope::EMPTY)?,
+        );
+    }
+    Ok(out)
+}
+
+/// The BSDF plugin `name` with the parameters of `variant` (which may name
+/// a [`STAND_IN_BSDFS`] BSDF).
 pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
     let owner = format!("bsdf \"{name}\" [{}]", variant.label);
     let entity = PluginEntity::new(
@@ -210,7 +250,19 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
         variant.table.clone(),
         Location::Builtin,
     );
-    registry.create::<dyn Bsdf>(&entity, &lumis_core::texture::NO_TEXTURES)
+    let declares_bsdfs = registry
+        .find(PluginKind::Bsdf, name)
+        .is_some_and(|p| p.spec.params.iter().any(|s| s.ty == ParamType::Bsdf));
+    let bsdfs = if declares_bsdfs {
+        stand_in_bsdfs(registry)?
+    } else {
+        Named::new()
+    };
+    let scope = BsdfScope {
+        textures: &lumis_core::texture::NO_TEXTURES,
+        bsdfs: &bsdfs,
+    };
+    registry.create::<dyn Bsdf>(&entity, scope)
 }
 
 fn direction(cos_theta: f32, phi: f32) -> Vec3 {

@@ -45,7 +45,7 @@ pub use sampler::{ConcreteLanes, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;
-pub use texture::{Texture, TextureQuery, Textures, UvTransform};
+pub use texture::{BsdfScope, Texture, TextureQuery, Textures, UvTransform};
 
 /// `#[derive(PluginParams)]` and `#[derive(ParamChoice)]`: a plugin's
 /// parameters declared once, as a struct (see [`PluginParams`](trait@PluginParams)).

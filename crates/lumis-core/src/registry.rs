@@ -16,7 +16,7 @@ use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
 use crate::params::{ParamSpec, Params};
 use crate::sampler::Sampler;
-use crate::texture::{Texture, Textures};
+use crate::texture::{BsdfScope, Texture};
 
 /// The plugin interfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -196,7 +196,7 @@ impl Registry {
     /// `type`, checks its table against the plugin's declaration, calls the
     /// factory with `input` and rejects keys the plugin did not read. The
     /// one path by which any plugin is made:
-    /// `registry.create::<dyn Bsdf>(&entity, &textures)`.
+    /// `registry.create::<dyn Bsdf>(&entity, scope)`.
     pub fn create<P: PluginInterface + ?Sized>(
         &self,
         entity: &PluginEntity,
@@ -223,8 +223,8 @@ impl Registry {
             plugin.spec.params,
             entity.structural,
         )?;
-        let params = match P::textures(&input) {
-            Some(textures) => params.with_textures(textures),
+        let params = match P::scope(&input) {
+            Some(scope) => params.with_scope(scope),
             None => params,
         };
         let made = P::call(plugin.factory, &params, input)?;
@@ -268,8 +268,8 @@ pub trait PluginInterface: sealed::Sealed {
     /// What the factory takes besides its parameters: the shape an area
     /// light is attached to, the lights a light sampler chooses among.
     type Input<'i>;
-    /// The textures its parameters may refer to, if it takes any.
-    fn textures<'i>(_input: &Self::Input<'i>) -> Option<&'i Textures> {
+    /// What its parameters may refer to by name, if anything.
+    fn scope<'i>(_input: &Self::Input<'i>) -> Option<BsdfScope<'i>> {
         None
     }
     #[doc(hidden)]
@@ -335,16 +335,16 @@ impl PluginInterface for dyn Texture {
     }
 }
 
-/// A BSDF is made with the textures its parameters may name
-/// ([`crate::texture::NO_TEXTURES`] outside a scene).
+/// A BSDF is made with the textures and BSDFs its parameters may name
+/// ([`BsdfScope::EMPTY`] outside a scene).
 impl PluginInterface for dyn Bsdf {
     const KIND: PluginKind = PluginKind::Bsdf;
     type Made = Arc<dyn Bsdf>;
-    type Input<'i> = &'i Textures;
-    fn textures<'i>(input: &Self::Input<'i>) -> Option<&'i Textures> {
+    type Input<'i> = BsdfScope<'i>;
+    fn scope<'i>(input: &Self::Input<'i>) -> Option<BsdfScope<'i>> {
         Some(*input)
     }
-    fn call(factory: Factory, params: &Params, _: &Textures) -> Result<Self::Made> {
+    fn call(factory: Factory, params: &Params, _: BsdfScope<'_>) -> Result<Self::Made> {
         let Factory::Bsdf(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -399,7 +399,6 @@ mod tests {
     use crate::error::Location;
     use crate::params::ParamType;
     use crate::spectrum::Rgb;
-    use crate::texture::NO_TEXTURES;
 
     /// A BSDF of one parameter, `albedo`, returned by `f`.
     struct Grey(Rgb);
@@ -443,13 +442,17 @@ mod tests {
     fn creates_from_a_document_table_and_from_a_built_one() {
         let registry = registry();
         let read = entity("type = \"grey\"\nalbedo = 0.25\n", PluginKind::Bsdf);
-        let bsdf = registry.create::<dyn Bsdf>(&read, &NO_TEXTURES).unwrap();
+        let bsdf = registry
+            .create::<dyn Bsdf>(&read, BsdfScope::EMPTY)
+            .unwrap();
         let ctx = BsdfContext::default();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.25));
 
         let table = Table::built(&Location::Builtin, [("albedo", Value::from([0.5f32; 3]))]);
         let built = PluginEntity::new(PluginKind::Bsdf, "x", "grey", table, Location::Builtin);
-        let bsdf = registry.create::<dyn Bsdf>(&built, &NO_TEXTURES).unwrap();
+        let bsdf = registry
+            .create::<dyn Bsdf>(&built, BsdfScope::EMPTY)
+            .unwrap();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.5));
     }
 
@@ -458,7 +461,7 @@ mod tests {
         let registry = registry();
         let unknown = entity("type = \"gray\"\n", PluginKind::Bsdf);
         let err = registry
-            .create::<dyn Bsdf>(&unknown, &NO_TEXTURES)
+            .create::<dyn Bsdf>(&unknown, BsdfScope::EMPTY)
             .err()
             .unwrap();
         let text = err.to_string();
@@ -473,7 +476,7 @@ mod tests {
             PluginKind::Bsdf,
         );
         let err = registry
-            .create::<dyn Bsdf>(&typo, &NO_TEXTURES)
+            .create::<dyn Bsdf>(&typo, BsdfScope::EMPTY)
             .err()
             .unwrap();
         assert!(
@@ -483,7 +486,7 @@ mod tests {
 
         let light = entity("type = \"grey\"\nalbedo = 0.5\n", PluginKind::Light);
         let err = registry
-            .create::<dyn Bsdf>(&light, &NO_TEXTURES)
+            .create::<dyn Bsdf>(&light, BsdfScope::EMPTY)
             .err()
             .unwrap();
         assert!(
@@ -511,7 +514,7 @@ mod tests {
                 .unwrap();
         assert_eq!(defaulted.type_name, "grey");
         assert!(registry()
-            .create::<dyn Bsdf>(&defaulted, &NO_TEXTURES)
+            .create::<dyn Bsdf>(&defaulted, BsdfScope::EMPTY)
             .is_ok());
     }
 }

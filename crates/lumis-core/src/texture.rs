@@ -61,14 +61,31 @@ pub trait Texture: Send + Sync {
     }
 }
 
-/// The textures of a scene, by the name its `[[texture]]` tables give them:
-/// what a BSDF's `{ texture = "name" }` parameters refer to.
-#[derive(Clone, Default)]
-pub struct Textures {
-    by_name: BTreeMap<String, Arc<dyn Texture>>,
+/// Plugins of a scene by the name its tables give them: the `[[texture]]`s
+/// that a BSDF's `{ texture = "name" }` parameters refer to, the
+/// `[[bsdf]]`s that an adapter (`twosided`) wraps.
+pub struct Named<T: ?Sized> {
+    by_name: BTreeMap<String, Arc<T>>,
 }
 
-impl Textures {
+/// The textures of a scene, by name.
+pub type Textures = Named<dyn Texture>;
+
+impl<T: ?Sized> Clone for Named<T> {
+    fn clone(&self) -> Self {
+        Self {
+            by_name: self.by_name.clone(),
+        }
+    }
+}
+
+impl<T: ?Sized> Default for Named<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: ?Sized> Named<T> {
     pub const fn new() -> Self {
         Self {
             by_name: BTreeMap::new(),
@@ -77,17 +94,17 @@ impl Textures {
 
     /// Adds `texture` under `name`; `false` (and no change) if the name is
     /// taken.
-    pub fn insert(&mut self, name: impl Into<String>, texture: Arc<dyn Texture>) -> bool {
+    pub fn insert(&mut self, name: impl Into<String>, plugin: Arc<T>) -> bool {
         match self.by_name.entry(name.into()) {
             std::collections::btree_map::Entry::Occupied(_) => false,
             std::collections::btree_map::Entry::Vacant(slot) => {
-                slot.insert(texture);
+                slot.insert(plugin);
                 true
             }
         }
     }
 
-    pub fn get(&self, name: &str) -> Option<&Arc<dyn Texture>> {
+    pub fn get(&self, name: &str) -> Option<&Arc<T>> {
         self.by_name.get(name)
     }
 
@@ -107,6 +124,35 @@ impl Textures {
 
 /// No textures: what a BSDF made outside a scene (a tool, a test) sees.
 pub static NO_TEXTURES: Textures = Textures::new();
+
+/// What a BSDF's parameters may name: the scene's textures and the BSDFs
+/// declared before it.
+#[derive(Clone, Copy)]
+pub struct BsdfScope<'a> {
+    pub textures: &'a Textures,
+    pub bsdfs: &'a Named<dyn crate::Bsdf>,
+}
+
+/// No BSDFs: what a BSDF made outside a scene sees.
+pub static NO_BSDFS: Named<dyn crate::Bsdf> = Named::new();
+
+impl BsdfScope<'static> {
+    /// Nothing to refer to: a BSDF made outside a scene (a tool, a test).
+    pub const EMPTY: Self = Self {
+        textures: &NO_TEXTURES,
+        bsdfs: &NO_BSDFS,
+    };
+}
+
+impl<'a> BsdfScope<'a> {
+    /// The scene's textures, no BSDFs.
+    pub fn textures(textures: &'a Textures) -> Self {
+        Self {
+            textures,
+            bsdfs: &NO_BSDFS,
+        }
+    }
+}
 
 /// A transform of texture coordinates that any texture can apply before its
 /// lookup: scale, then rotate counter-clockwise, then offset (the order of

@@ -12,6 +12,7 @@
 //! `ParamSpec` lists by hand and read them by name with [`Params::get`].
 
 mod convert;
+mod nested;
 mod spec;
 mod textured;
 mod typed;
@@ -20,6 +21,7 @@ use std::borrow::Cow;
 use std::cell::RefCell;
 
 pub use convert::{FromParam, Param};
+pub use nested::NestedBsdf;
 pub use spec::{
     check_unique, concat, declares, override_default, total_len, ParamDefault, ParamSpec,
     ParamType, ParamValue,
@@ -29,7 +31,7 @@ pub use typed::{choice_from_node, ParamChoice, PluginParams};
 
 use crate::doc::{Node, Table, Value};
 use crate::error::{Error, Location, Result};
-use crate::texture::Textures;
+use crate::texture::BsdfScope;
 
 /// A plugin's table, checked against its declaration.
 pub struct Params<'a> {
@@ -38,9 +40,9 @@ pub struct Params<'a> {
     location: Location,
     spec: &'a [ParamSpec],
     read: RefCell<Vec<bool>>,
-    /// What `{ texture = "name" }` values refer to; `None` where textures
-    /// are not accepted (every plugin but a scene's BSDFs).
-    textures: Option<&'a Textures>,
+    /// What `{ texture = "name" }` values and BSDF names refer to; `None`
+    /// where no references are accepted (every plugin but BSDFs).
+    scope: Option<BsdfScope<'a>>,
 }
 
 impl<'a> Params<'a> {
@@ -76,13 +78,14 @@ impl<'a> Params<'a> {
             location,
             spec,
             read: RefCell::new(vec![false; spec.len()]),
-            textures: None,
+            scope: None,
         })
     }
 
-    /// Lets textured parameters ([`Textured`]) refer to `textures`.
-    pub fn with_textures(mut self, textures: &'a Textures) -> Self {
-        self.textures = Some(textures);
+    /// Lets textured parameters ([`Textured`]) and BSDF references
+    /// ([`NestedBsdf`]) refer to what `scope` holds.
+    pub fn with_scope(mut self, scope: BsdfScope<'a>) -> Self {
+        self.scope = Some(scope);
         self
     }
 

@@ -23,6 +23,8 @@ pub enum ParamType {
     TexturedRgb,
     /// A `float`, or `{ texture = "name" }`.
     TexturedFloat,
+    /// The name of a `[[bsdf]]` declared before.
+    Bsdf,
     Vec2,
     Vec3,
     /// Two non-negative integers, e.g. a resolution.
@@ -45,6 +47,7 @@ impl ParamType {
             ParamType::Rgb => "rgb",
             ParamType::TexturedRgb => "rgb or texture",
             ParamType::TexturedFloat => "float or texture",
+            ParamType::Bsdf => "bsdf name",
             ParamType::Vec2 => "vec2",
             ParamType::Vec3 => "vec3",
             ParamType::UIntPair => "[uint, uint]",
@@ -101,7 +104,7 @@ impl ParamValue {
             ParamType::Bool => matches!(self, ParamValue::Bool(_)),
             ParamType::Int => matches!(self, ParamValue::Int(_)),
             ParamType::Float | ParamType::TexturedFloat => self.is_number(),
-            ParamType::String => matches!(self, ParamValue::Str(_)),
+            ParamType::String | ParamType::Bsdf => matches!(self, ParamValue::Str(_)),
             ParamType::Rgb | ParamType::TexturedRgb => self.is_number() || self.is_numbers(3),
             ParamType::Vec2 => self.is_numbers(2),
             ParamType::Vec3 => self.is_numbers(3),

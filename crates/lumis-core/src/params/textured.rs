@@ -162,7 +162,7 @@ impl Params<'_> {
                 ))
             }
         };
-        let Some(textures) = self.textures else {
+        let Some(textures) = self.scope.map(|s| s.textures) else {
             return Err(here(format!(
                 "a texture (\"{texture_name}\") is not accepted here: only the BSDFs of a scene take textures"
             )));
@@ -220,7 +220,7 @@ mod tests {
         let table = crate::doc::parse(text, "s.toml").unwrap();
         let params = Params::new("bsdf \"b\"", &table, Location::Builtin, SPEC, &[]).unwrap();
         let params = match textures {
-            Some(t) => params.with_textures(t),
+            Some(t) => params.with_scope(crate::texture::BsdfScope::textures(t)),
             None => params,
         };
         params.value(name)

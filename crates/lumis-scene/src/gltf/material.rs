@@ -31,7 +31,7 @@ const DIELECTRIC_IOR: f32 = 1.5;
 ///   colour is the base's albedo seen through the coat at normal incidence
 ///   (plastic's linear mode), where glTF mixes the two by Schlick's Fresnel.
 ///
-/// `doubleSided` wraps either in [`super::two_sided::TwoSided`]. With
+/// `doubleSided` wraps either in the `twosided` BSDF plugin. With
 /// `base_color_textured`, the conductor's reflectance or the plastic's
 /// base is `{ texture = BASE_COLOR }` (the texture carries the factor),
 /// which the caller creates the BSDF with. What is approximated is said in

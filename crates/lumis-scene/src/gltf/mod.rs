@@ -19,10 +19,7 @@ mod material;
 mod normals;
 mod resolve;
 mod scene_graph;
-pub(crate) mod two_sided;
 mod unmodelled;
-#[cfg(test)]
-mod wrapper_tests;
 
 use std::collections::HashMap;
 use std::path::PathBuf;

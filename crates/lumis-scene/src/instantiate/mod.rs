@@ -7,9 +7,10 @@
 
 mod bsdf_table;
 
+use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, Error, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler, Texture,
-    Textures,
+    Bsdf, BsdfScope, Error, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler,
+    Texture, Textures,
 };
 
 pub(crate) use bsdf_table::BsdfTable;
@@ -45,15 +46,18 @@ pub(crate) fn instantiate(
             ));
         }
     }
-    let named = bsdfs
-        .iter()
-        .map(|b| {
-            Ok((
-                b.name.clone(),
-                registry.create::<dyn Bsdf>(&b.entity, &by_name)?,
-            ))
-        })
-        .collect::<Result<Vec<_>>>()?;
+    // Each BSDF may name the textures and the BSDFs declared before it.
+    let mut before = Named::<dyn Bsdf>::new();
+    let mut named = Vec::with_capacity(bsdfs.len());
+    for b in bsdfs {
+        let scope = BsdfScope {
+            textures: &by_name,
+            bsdfs: &before,
+        };
+        let made = registry.create::<dyn Bsdf>(&b.entity, scope)?;
+        before.insert(b.name.clone(), made.clone());
+        named.push((b.name.clone(), made));
+    }
     let lights = lights
         .iter()
         .map(|l| registry.create::<dyn Light>(l, &LightShape::None))
