@@ -2,6 +2,7 @@
 //! filtered.
 
 mod decode;
+mod mipmap;
 mod texels;
 
 use std::path::PathBuf;
@@ -32,7 +33,9 @@ pub struct ImageParams {
     /// lookups outside [0, 1]: "repeat", "mirror" or "clamp"
     #[param(default = Repeat)]
     pub wrap: Wrap,
-    /// reconstruction: "bilinear" or "nearest"
+    /// filtering: "nearest", "bilinear", or over the hit's footprint
+    /// through a mip map, "trilinear" or "ewa" (bilinear where a hit has
+    /// no footprint)
     #[param(default = Bilinear)]
     pub filter: ImageFilter,
     /// multiplies every texel after decoding (pbrt-v4's scale; a glTF
@@ -54,17 +57,26 @@ pub enum Encoding {
     Linear,
 }
 
-/// How a lookup between texel centres is reconstructed.
+/// How a lookup is filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
 pub enum ImageFilter {
+    /// The texel that covers the point.
     Nearest,
+    /// The four texel centres around the point.
     Bilinear,
+    /// Two mip-map levels chosen by the footprint's larger extent, each
+    /// bilinear, blended.
+    Trilinear,
+    /// An elliptical Gaussian over the footprint on the mip-map level of
+    /// its minor axis.
+    Ewa,
 }
 
 /// An image texture.
 #[derive(Debug, Clone)]
 pub struct ImageTexture {
-    texels: Texels,
+    /// The image, then its mip-map levels for the filters that use them.
+    levels: Vec<Texels>,
     /// In u and in v.
     wrap: [Wrap; 2],
     filter: ImageFilter,
@@ -108,12 +120,17 @@ impl ImageTexture {
             .map(|v| if srgb { v.map(srgb_to_linear) } else { v })
             .map(|v| if scale == Rgb::WHITE { v } else { v * scale })
             .collect();
+        let base = Texels {
+            width: stored.width,
+            height: stored.height,
+            values,
+        };
+        let levels = match filter {
+            ImageFilter::Trilinear | ImageFilter::Ewa => mipmap::pyramid(base, wrap),
+            ImageFilter::Nearest | ImageFilter::Bilinear => vec![base],
+        };
         Self {
-            texels: Texels {
-                width: stored.width,
-                height: stored.height,
-                values,
-            },
+            levels,
             wrap,
             filter,
             transform,
@@ -122,27 +139,34 @@ impl ImageTexture {
 
     /// The linear texels.
     pub fn texels(&self) -> &Texels {
-        &self.texels
+        &self.levels[0]
     }
 
-    /// Bytes held by the texels.
+    /// Bytes held by the texels and mip-map levels.
     pub fn byte_size(&self) -> usize {
-        self.texels.values.capacity() * std::mem::size_of::<Rgb>()
+        self.levels
+            .iter()
+            .map(|l| l.values.capacity() * std::mem::size_of::<Rgb>())
+            .sum()
     }
 }
 
 impl Texture for ImageTexture {
     #[inline]
     fn eval(&self, query: &TextureQuery) -> Rgb {
-        let uv = self.transform.apply(query).uv;
+        let query = self.transform.apply(query);
+        let uv = query.uv;
+        let base = &self.levels[0];
         // A non-finite uv (a degenerate parameterization) reads one texel
         // rather than indexing with a NaN.
         if !uv.is_finite() {
-            return self.texels.texel(0, 0, self.wrap);
+            return base.texel(0, 0, self.wrap);
         }
         match self.filter {
-            ImageFilter::Nearest => self.texels.nearest(uv, self.wrap),
-            ImageFilter::Bilinear => self.texels.bilinear(uv, self.wrap),
+            ImageFilter::Nearest => base.nearest(uv, self.wrap),
+            ImageFilter::Bilinear => base.bilinear(uv, self.wrap),
+            ImageFilter::Trilinear => mipmap::trilinear(&self.levels, &query, uv, self.wrap),
+            ImageFilter::Ewa => mipmap::ewa(&self.levels, &query, uv, self.wrap),
         }
     }
 }
