@@ -344,7 +344,9 @@ fn dielectric(rgb: [f32; 3]) -> [f32; 3] {
         TYPE_KEY,
     )
     .unwrap();
-    let bsdf = registry.create::<dyn Bsdf>(&entity, ()).unwrap();
+    let bsdf = registry
+        .create::<dyn Bsdf>(&entity, lumis_core::texture::BsdfScope::EMPTY)
+        .unwrap();
     let f = bsdf.f(&BsdfContext::default(), Vec3::Z, Vec3::Z);
     let pi = std::f32::consts::PI;
     [f.r * pi, f.g * pi, f.b * pi]
@@ -623,7 +625,7 @@ fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
     let ray = Ray::new(Vec3::new(0.2, 0.2, 1.0), Vec3::NEG_Z);
     let hit = from_gltf.scene.intersect(&ray).expect("hit");
     let ctx = BsdfContext {
-        uv: hit.uv,
+        texture: lumis_core::TextureQuery::at(hit.uv),
         ..BsdfContext::default()
     };
     let wo = Vec3::new(0.6, 0.0, 0.8);
@@ -1043,7 +1045,7 @@ fn reflectance_at_uv(scene: &LoadedScene, x: f32, y: f32) -> [f32; 3] {
     let ray = Ray::new(Vec3::new(x, y, 10.0), Vec3::NEG_Z);
     let hit = scene.scene.intersect(&ray).expect("hit");
     let ctx = BsdfContext {
-        uv: hit.uv,
+        texture: lumis_core::TextureQuery::at(hit.uv),
         ..BsdfContext::default()
     };
     let f = hit.bsdf.f(&ctx, Vec3::Z, Vec3::Z);

@@ -71,7 +71,9 @@ fn bsdf(toml: &str) -> std::sync::Arc<dyn Bsdf> {
         lumis_core::entity::TYPE_KEY,
     )
     .unwrap();
-    registry.create::<dyn Bsdf>(&entity, ()).unwrap()
+    registry
+        .create::<dyn Bsdf>(&entity, lumis_core::texture::BsdfScope::EMPTY)
+        .unwrap()
 }
 
 /// Directional albedo (luminance) from `wo` by the BSDF's own sampling,

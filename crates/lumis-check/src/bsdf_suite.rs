@@ -19,9 +19,10 @@ use std::sync::Arc;
 
 use lumis_core::doc::{self, Table};
 use lumis_core::params::ParamDefault;
+use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, Error, Location, ParamType, PluginEntity, PluginKind, PluginSpec,
-    Registry, Result, Rgb, TransportMode, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfScope, Error, Location, ParamType, PluginEntity, PluginKind,
+    PluginSpec, Registry, Result, Rgb, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -104,8 +105,9 @@ fn stand_in(
     choices: &[&str],
 ) -> Result<String> {
     Ok(match ty {
-        ParamType::Rgb => "0.5".into(),
-        ParamType::Float => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
+        ParamType::Rgb | ParamType::TexturedRgb => "0.5".into(),
+        ParamType::Bsdf => format!("\"{}\"", STAND_IN_BSDFS[0].0),
+        ParamType::Float | ParamType::TexturedFloat => range.map_or("0.5".into(), |(a, b)| format!("{:?}", 0.5 * (a + b))),
         ParamType::Int => range.map_or("1".into(), |(a, _)| format!("{}", a as i64)),
         ParamType::Bool => "false".into(),
         ParamType::String if !choices.is_empty() => format!("\"{}\"", choices[0]),
@@ -201,7 +203,7 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
     {
         let mut values: Vec<String> = Vec::new();
         match p.ty {
-            ParamType::Float | ParamType::Int => {
+            ParamType::Float | ParamType::TexturedFloat | ParamType::Int => {
                 if let Some((a, b)) = p.range {
                     let fmt = |v: f64| {
                         if p.ty == ParamType::Int {
@@ -248,6 +250,11 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
             }
             ParamType::Bool => values.extend(["true".to_string(), "false".to_string()]),
             ParamType::String => values.extend(p.choices.iter().map(|c| format!("\"{c}\""))),
+            ParamType::Bsdf => values.extend(
+                STAND_IN_BSDFS
+                    .iter()
+                    .map(|(name, ..)| format!("\"{name}\"")),
+            ),
             _ => {}
         }
         for v in values {
@@ -267,7 +274,40 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
         .collect()
 }
 
-/// The BSDF plugin `name` with the parameters of `variant`.
+/// The BSDFs that a BSDF parameter (an adapter's inner BSDF, e.g.
+/// `twosided`'s) is swept over: name, built-in plugin, parameters.
+pub const STAND_IN_BSDFS: &[(&str, &str, &str)] = &[
+    (
+        "rough-plastic",
+        "plastic",
+        "roughness = 0.3\nnonlinear = true\n",
+    ),
+    ("diffuse", "diffuse", "reflectance = 0.5\n"),
+    ("gold", "conductor", "material = \"Au\"\nroughness = 0.2\n"),
+];
+
+/// [`STAND_IN_BSDFS`], made by `registry`.
+fn stand_in_bsdfs(registry: &Registry) -> Result<Named<dyn Bsdf>> {
+    let mut out = Named::new();
+    for &(name, type_name, params) in STAND_IN_BSDFS {
+        let table = doc::parse(params, "<stand-in>")?;
+        let entity = PluginEntity::new(
+            PluginKind::Bsdf,
+            format!("stand-in bsdf \"{name}\""),
+            type_name,
+            table,
+            Location::Builtin,
+        );
+        out.insert(
+            name,
+            registry.create::<dyn Bsdf>(&entity, BsdfScope::EMPTY)?,
+        );
+    }
+    Ok(out)
+}
+
+/// The BSDF plugin `name` with the parameters of `variant` (which may name
+/// a [`STAND_IN_BSDFS`] BSDF).
 pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result<Arc<dyn Bsdf>> {
     let owner = owner(name, variant);
     let entity = PluginEntity::new(
@@ -277,7 +317,19 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
         variant.table.clone(),
         Location::Builtin,
     );
-    registry.create::<dyn Bsdf>(&entity, ())
+    let declares_bsdfs = registry
+        .find(PluginKind::Bsdf, name)
+        .is_some_and(|p| p.spec.params.iter().any(|s| s.ty == ParamType::Bsdf));
+    let bsdfs = if declares_bsdfs {
+        stand_in_bsdfs(registry)?
+    } else {
+        Named::new()
+    };
+    let scope = BsdfScope {
+        textures: &lumis_core::texture::NO_TEXTURES,
+        bsdfs: &bsdfs,
+    };
+    registry.create::<dyn Bsdf>(&entity, scope)
 }
 
 /// The case of a variant the plugin did not make: refused (its factory
@@ -469,9 +521,11 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
             } else {
                 TransportMode::Importance
             },
-            albedo_scale: (bsdf.takes_albedo_scale() && i % 7 == 3)
-                .then_some(Rgb::new(0.5, 0.25, 1.0)),
-            ..Default::default()
+            // Each lane at its own uv, so a textured BSDF's lanes differ.
+            texture: lumis_core::TextureQuery::at(Vec2::new(
+                (i as f32 * 0.37).fract(),
+                (i as f32 * 0.61).fract(),
+            )),
         })
         .collect();
     let u1: Vec<f32> = lanes.u.iter().map(|u| u.0).collect();
@@ -855,16 +909,16 @@ mod tests {
     #[test]
     fn sweep_adds_interior_values_and_colours_at_their_maximum() {
         let sweep = parameter_sweep(&SPEC).unwrap();
-        let interior: Vec<f64> = sweep
+        let inside: Vec<f64> = sweep
             .iter()
             .filter_map(|v| v.label.strip_prefix("roughness = "))
             .map(|v| v.parse().unwrap())
             .filter(|&v| v != 1e-4 && v != 1.0)
             .collect();
-        assert_eq!(interior.len(), INTERIOR_VALUES, "{interior:?}");
+        assert_eq!(inside.len(), INTERIOR_VALUES, "{inside:?}");
         assert!(
-            interior.iter().all(|&v| 1e-4 < v && v < 1.0),
-            "{interior:?}"
+            inside.iter().all(|&v| 1e-4 < v && v < 1.0),
+            "{inside:?}"
         );
         let again: Vec<String> = parameter_sweep(&SPEC)
             .unwrap()

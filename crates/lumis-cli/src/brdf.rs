@@ -57,7 +57,7 @@ pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String>
         table,
         Location::Builtin,
     );
-    let bsdf = registry.create::<dyn Bsdf>(&entity, ())?;
+    let bsdf = registry.create::<dyn Bsdf>(&entity, lumis_core::texture::BsdfScope::EMPTY)?;
     let progress = if args.quiet {
         ProgressBar::hidden()
     } else {

@@ -37,6 +37,7 @@ use lumis_core::{Registry, Result};
 pub fn builtin_registry() -> Result<Registry> {
     let mut registry = Registry::new();
     lumis_samplers::register(&mut registry)?;
+    lumis_textures::register(&mut registry)?;
     lumis_bsdfs::register(&mut registry)?;
     lumis_measured::register(&mut registry)?;
     lumis_lights::register(&mut registry)?;

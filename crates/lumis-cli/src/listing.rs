@@ -95,6 +95,9 @@ pub fn plugin_markdown(registry: &Registry) -> String {
 fn kind_heading(kind: PluginKind) -> &'static str {
     match kind {
         PluginKind::Sampler => "Samplers (`[sampler]`)",
+        PluginKind::Texture => {
+            "Textures (`[[texture]]`, named by a BSDF parameter's `{ texture = \"..\" }`)"
+        }
         PluginKind::Bsdf => "BSDFs (`[[bsdf]]`)",
         PluginKind::Light => "Lights (`[[light]]`, and a shape's `emission`)",
         PluginKind::LightSampler => "Light samplers (`[light_sampler]`)",
@@ -192,7 +195,7 @@ mod tests {
             "## Samplers (`[sampler]`)",
             "### `independent`",
             "| `spp` | int | `16` |",
-            "| `reflectance` | rgb | required |",
+            "| `reflectance` | rgb or texture | required |",
             "`\"bsdf\"`, `\"light\"`, `\"mis\"`",
             "[0, 1e6]",
             PLUGIN_MARKDOWN_COMMAND,

@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::spectrum::Rgb;
+use crate::texture::TextureQuery;
 
 /// Which quantity is transported; refraction scales radiance by 1/eta^2 but
 /// not importance (Veach 1997, section 5.2).
@@ -16,14 +17,10 @@ pub enum TransportMode {
 /// Per-hit information a BSDF may read, so evaluation needs no allocation.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct BsdfContext {
-    pub uv: Vec2,
+    /// Where the hit's textured parameters are looked up (its uv and, with
+    /// ray differentials, its footprint).
+    pub texture: TextureQuery,
     pub mode: TransportMode,
-    /// A texture's value at this hit that scales the BSDF's diffuse albedo
-    /// (pbrt-v4's textured parameters: the material looks the texture up,
-    /// the BSDF uses the value). Set only for a BSDF whose
-    /// [`Bsdf::takes_albedo_scale`] is true; `None` (untextured): the
-    /// albedo the BSDF was built with.
-    pub albedo_scale: Option<Rgb>,
 }
 
 /// Lobe classification: what a BSDF (or one sample of it) is.
@@ -164,14 +161,5 @@ pub trait Bsdf: Send + Sync {
         for (i, out) in out.iter_mut().enumerate() {
             *out = self.eval(&ctx[i], wo[i], wi[i]);
         }
-    }
-
-    /// Whether `f`, `sample_f` and `pdf` read [`BsdfContext::albedo_scale`]
-    /// for a diffuse part that a texture may scale without the rest (e.g.
-    /// the base under a clear coat). A BSDF that does not is textured by
-    /// scaling its whole value, which is exact only if `f` is linear in
-    /// its colour and sampling ignores the colour.
-    fn takes_albedo_scale(&self) -> bool {
-        false
     }
 }

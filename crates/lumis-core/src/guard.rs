@@ -34,6 +34,7 @@ use crate::sampler::{Sampler, SamplerLanes};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use crate::stats::RenderStats;
+use crate::texture::{Texture, TextureQuery};
 
 /// The faults of guarded plugins; shared by a registry and every guard it
 /// made.
@@ -245,10 +246,14 @@ impl Bsdf for Guarded<Arc<dyn Bsdf>> {
             out.fill((Rgb::BLACK, 0.0));
         }
     }
-    fn takes_albedo_scale(&self) -> bool {
-        self.value("Bsdf::takes_albedo_scale", false, |b| {
-            b.takes_albedo_scale()
-        })
+}
+
+impl Texture for Guarded<Arc<dyn Texture>> {
+    fn eval(&self, query: &TextureQuery) -> Rgb {
+        self.value("Texture::eval", Rgb::BLACK, |t| t.eval(query))
+    }
+    fn eval_float(&self, query: &TextureQuery) -> f32 {
+        self.value("Texture::eval_float", 0.0, |t| t.eval_float(query))
     }
 }
 

@@ -2,8 +2,8 @@
 //!
 //! Math (a glam re-export plus frames and floating-point helpers), RGB
 //! radiance, rays and surface interactions with pbrt-v4 style error bounds,
-//! the plugin traits ([`Sampler`], [`Bsdf`], [`Light`], [`LightSampler`],
-//! [`Integrator`]) with the [`Scene`] they query, and the plugin machinery:
+//! the plugin traits ([`Sampler`], [`Bsdf`], [`Texture`], [`Light`],
+//! [`LightSampler`], [`Integrator`]) with the [`Scene`] they query, and the plugin machinery:
 //! the scene document model, [`Params`] and the [`Registry`].
 
 // The derives name `::lumis_core`, which this lets them do here too.
@@ -28,6 +28,7 @@ pub mod sampler;
 pub mod scene;
 pub mod spectrum;
 pub mod stats;
+pub mod texture;
 
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
 pub use entity::PluginEntity;
@@ -37,13 +38,16 @@ pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use light::{Light, LightKind, LightSample, LightShape};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;
-pub use params::{ParamChoice, ParamSpec, ParamType, ParamValue, Params, PluginParams};
+pub use params::{
+    ParamChoice, ParamSpec, ParamType, ParamValue, Params, PluginParams, TexturedFloat, TexturedRgb,
+};
 pub use ray::Ray;
 pub use registry::{PluginInterface, PluginKind, PluginSpec, Registry};
 pub use sampler::{ConcreteLanes, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;
+pub use texture::{BsdfScope, Texture, TextureQuery, Textures, UvTransform};
 
 /// `#[derive(PluginParams)]` and `#[derive(ParamChoice)]`: a plugin's
 /// parameters declared once, as a struct (see [`PluginParams`](trait@PluginParams)).

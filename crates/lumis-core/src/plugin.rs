@@ -12,7 +12,7 @@ use crate::error::Result;
 use crate::registry::Registry;
 
 /// Bumped whenever [`PluginDeclaration`] or the plugin traits change shape.
-pub const PLUGIN_ABI_VERSION: u32 = 9;
+pub const PLUGIN_ABI_VERSION: u32 = 10;
 /// The compiler that built this copy of lumis-core.
 pub const RUSTC_VERSION: &str = env!("LUMIS_RUSTC_VERSION");
 /// The version of this copy of lumis-core.

@@ -17,11 +17,13 @@ use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
 use crate::params::{ParamSpec, Params};
 use crate::sampler::Sampler;
+use crate::texture::{BsdfScope, Texture};
 
 /// The plugin interfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum PluginKind {
     Sampler,
+    Texture,
     Bsdf,
     Light,
     LightSampler,
@@ -29,8 +31,9 @@ pub enum PluginKind {
 }
 
 impl PluginKind {
-    pub const ALL: [PluginKind; 5] = [
+    pub const ALL: [PluginKind; 6] = [
         PluginKind::Sampler,
+        PluginKind::Texture,
         PluginKind::Bsdf,
         PluginKind::Light,
         PluginKind::LightSampler,
@@ -41,6 +44,7 @@ impl PluginKind {
     pub fn table_name(self) -> &'static str {
         match self {
             PluginKind::Sampler => "sampler",
+            PluginKind::Texture => "texture",
             PluginKind::Bsdf => "bsdf",
             PluginKind::Light => "light",
             PluginKind::LightSampler => "light_sampler",
@@ -67,6 +71,9 @@ pub struct PluginSpec {
 }
 
 pub type SamplerFactory = fn(&Params) -> Result<Box<dyn Sampler>>;
+pub type TextureFactory = fn(&Params) -> Result<Arc<dyn Texture>>;
+/// A BSDF's textured parameters ([`crate::params::Textured`]) refer to the
+/// scene's textures through its `Params`.
 pub type BsdfFactory = fn(&Params) -> Result<Arc<dyn Bsdf>>;
 /// Lights get the geometry they are attached to ([`LightShape::None`] for
 /// `[[light]]` tables); a factory refuses shapes it cannot emit from.
@@ -77,6 +84,7 @@ pub type IntegratorFactory = fn(&Params) -> Result<Box<dyn Integrator>>;
 // Factories as registered: the plugin's own function, or that function
 // guarded; shared, since registries are cloned per scene.
 type MakeSampler = Arc<dyn Fn(&Params) -> Result<Box<dyn Sampler>> + Send + Sync>;
+type MakeTexture = Arc<dyn Fn(&Params) -> Result<Arc<dyn Texture>> + Send + Sync>;
 type MakeBsdf = Arc<dyn Fn(&Params) -> Result<Arc<dyn Bsdf>> + Send + Sync>;
 type MakeLight = Arc<dyn Fn(&Params, &LightShape) -> Result<Box<dyn Light>> + Send + Sync>;
 type MakeLightSampler =
@@ -202,6 +210,22 @@ impl Registry {
         self.add(spec, Factory::Sampler(make))
     }
 
+    pub fn add_texture(&mut self, spec: PluginSpec, factory: TextureFactory) -> Result<()> {
+        Self::check_kind(&spec, PluginKind::Texture)?;
+        let make: MakeTexture = match self.guard.clone() {
+            None => Arc::new(factory),
+            Some(guard) => Arc::new(move |params: &Params| {
+                guarded(
+                    &guard,
+                    params,
+                    || factory(params),
+                    |made, guard, label| Arc::new(Guarded::new(made, guard, label)),
+                )
+            }),
+        };
+        self.add(spec, Factory::Texture(make))
+    }
+
     pub fn add_bsdf(&mut self, spec: PluginSpec, factory: BsdfFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Bsdf)?;
         let make: MakeBsdf = match self.guard.clone() {
@@ -287,7 +311,7 @@ impl Registry {
     /// `type`, checks its table against the plugin's declaration, calls the
     /// factory with `input` and rejects keys the plugin did not read. The
     /// one path by which any plugin is made:
-    /// `registry.create::<dyn Bsdf>(&entity, ())`.
+    /// `registry.create::<dyn Bsdf>(&entity, scope)`.
     pub fn create<P: PluginInterface + ?Sized>(
         &self,
         entity: &PluginEntity,
@@ -314,6 +338,10 @@ impl Registry {
             plugin.spec.params,
             entity.structural,
         )?;
+        let params = match P::scope(&input) {
+            Some(scope) => params.with_scope(scope),
+            None => params,
+        };
         // A factory's own error (a degenerate light shape, a file it could
         // not read) is placed at the entity that asked for it.
         let made = P::call(&plugin.factory, &params, input).map_err(|e| match e.location {
@@ -356,7 +384,7 @@ impl Registry {
 }
 
 /// A plugin interface: its kind, what its factory takes besides the
-/// parameters, and what it makes. Implemented for the five plugin traits
+/// parameters, and what it makes. Implemented for the six plugin traits
 /// (`dyn Sampler`, `dyn Bsdf`, ...), which name the kind in
 /// [`Registry::create`].
 pub trait PluginInterface: sealed::Sealed {
@@ -366,6 +394,10 @@ pub trait PluginInterface: sealed::Sealed {
     /// What the factory takes besides its parameters: the shape an area
     /// light is attached to, the lights a light sampler chooses among.
     type Input<'i>;
+    /// What its parameters may refer to by name, if anything.
+    fn scope<'i>(_input: &Self::Input<'i>) -> Option<BsdfScope<'i>> {
+        None
+    }
     #[doc(hidden)]
     fn call(
         factory: &sealed::Factory,
@@ -384,6 +416,7 @@ mod sealed {
     #[derive(Clone)]
     pub enum Factory {
         Sampler(MakeSampler),
+        Texture(MakeTexture),
         Bsdf(MakeBsdf),
         Light(MakeLight),
         LightSampler(MakeLightSampler),
@@ -391,6 +424,7 @@ mod sealed {
     }
 
     impl Sealed for dyn Sampler {}
+    impl Sealed for dyn Texture {}
     impl Sealed for dyn Bsdf {}
     impl Sealed for dyn Light {}
     impl Sealed for dyn LightSampler {}
@@ -416,11 +450,28 @@ impl PluginInterface for dyn Sampler {
     }
 }
 
+impl PluginInterface for dyn Texture {
+    const KIND: PluginKind = PluginKind::Texture;
+    type Made = Arc<dyn Texture>;
+    type Input<'i> = ();
+    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Texture(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params)
+    }
+}
+
+/// A BSDF is made with the textures and BSDFs its parameters may name
+/// ([`BsdfScope::EMPTY`] outside a scene).
 impl PluginInterface for dyn Bsdf {
     const KIND: PluginKind = PluginKind::Bsdf;
     type Made = Arc<dyn Bsdf>;
-    type Input<'i> = ();
-    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
+    type Input<'i> = BsdfScope<'i>;
+    fn scope<'i>(input: &Self::Input<'i>) -> Option<BsdfScope<'i>> {
+        Some(*input)
+    }
+    fn call(factory: &Factory, params: &Params, _: BsdfScope<'_>) -> Result<Self::Made> {
         let Factory::Bsdf(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
@@ -518,13 +569,17 @@ mod tests {
     fn creates_from_a_document_table_and_from_a_built_one() {
         let registry = registry();
         let read = entity("type = \"grey\"\nalbedo = 0.25\n", PluginKind::Bsdf);
-        let bsdf = registry.create::<dyn Bsdf>(&read, ()).unwrap();
+        let bsdf = registry
+            .create::<dyn Bsdf>(&read, BsdfScope::EMPTY)
+            .unwrap();
         let ctx = BsdfContext::default();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.25));
 
         let table = Table::built(&Location::Builtin, [("albedo", Value::from([0.5f32; 3]))]);
         let built = PluginEntity::new(PluginKind::Bsdf, "x", "grey", table, Location::Builtin);
-        let bsdf = registry.create::<dyn Bsdf>(&built, ()).unwrap();
+        let bsdf = registry
+            .create::<dyn Bsdf>(&built, BsdfScope::EMPTY)
+            .unwrap();
         assert_eq!(bsdf.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.5));
     }
 
@@ -532,7 +587,10 @@ mod tests {
     fn errors_name_the_type_key_and_kind() {
         let registry = registry();
         let unknown = entity("type = \"gray\"\n", PluginKind::Bsdf);
-        let err = registry.create::<dyn Bsdf>(&unknown, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&unknown, BsdfScope::EMPTY)
+            .err()
+            .unwrap();
         let text = err.to_string();
         assert!(
             text.starts_with("s.toml:1:8")
@@ -544,14 +602,20 @@ mod tests {
             "type = \"grey\"\nalbedo = 0.5\nalbedoo = 1\n",
             PluginKind::Bsdf,
         );
-        let err = registry.create::<dyn Bsdf>(&typo, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&typo, BsdfScope::EMPTY)
+            .err()
+            .unwrap();
         assert!(
             err.to_string().starts_with("s.toml:3:1") && err.message.contains("'albedoo'"),
             "{err}"
         );
 
         let light = entity("type = \"grey\"\nalbedo = 0.5\n", PluginKind::Light);
-        let err = registry.create::<dyn Bsdf>(&light, ()).err().unwrap();
+        let err = registry
+            .create::<dyn Bsdf>(&light, BsdfScope::EMPTY)
+            .err()
+            .unwrap();
         assert!(
             err.message
                 .contains("a light plugin where a bsdf plugin is expected"),
@@ -576,6 +640,8 @@ mod tests {
             PluginEntity::from_table_or(PluginKind::Bsdf, "b", table, Location::Builtin, "grey")
                 .unwrap();
         assert_eq!(defaulted.type_name, "grey");
-        assert!(registry().create::<dyn Bsdf>(&defaulted, ()).is_ok());
+        assert!(registry()
+            .create::<dyn Bsdf>(&defaulted, BsdfScope::EMPTY)
+            .is_ok());
     }
 }

@@ -263,9 +263,6 @@ impl Bsdf for ProfiledBsdf {
     fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
         in_stage(Stage::Bsdf, || self.0.eval_batch(ctx, wo, wi, out))
     }
-    fn takes_albedo_scale(&self) -> bool {
-        self.0.takes_albedo_scale()
-    }
 }
 
 /// A light whose calls count as [`Stage::LightSampling`].

@@ -85,6 +85,7 @@ pub fn load_str(
     let registry = extended.as_ref().unwrap_or(registry);
     let plugins = instantiate(
         registry,
+        &description.textures,
         &description.bsdfs,
         &description.lights,
         &description.sampler,

@@ -11,7 +11,7 @@
 
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
-    Rgb, Vec2, Vec3,
+    Rgb, TexturedRgb, Vec2, Vec3,
 };
 
 use lumis_sampling::real::{load, F32x8, Real, V3};
@@ -50,7 +50,7 @@ pub const MIRROR_SPEC: PluginSpec = PluginSpec {
     params: MetalParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct ConductorParams {
     #[param(flatten)]
     pub microfacet: MicrofacetParams,
@@ -99,6 +99,8 @@ pub struct Conductor {
     microfacet: Option<Microfacet>,
     fresnel: ConductorFresnel,
     scale: Rgb,
+    /// A textured `specular_reflectance`, which multiplies every value.
+    tint: Option<TexturedRgb>,
     sampling: LobeSampling,
 }
 
@@ -112,6 +114,7 @@ impl Conductor {
             }),
             fresnel,
             scale: Rgb::WHITE,
+            tint: None,
             sampling,
         }
     }
@@ -121,6 +124,7 @@ impl Conductor {
             microfacet: None,
             fresnel,
             scale: Rgb::WHITE,
+            tint: None,
             sampling: LobeSampling::Cosine,
         }
     }
@@ -130,6 +134,7 @@ impl Conductor {
         let fresnel = p.metal.fresnel(params)?;
         Ok(Self {
             scale: p.metal.scale(params)?,
+            tint: p.metal.tint(),
             ..Self::new(p.microfacet.microfacet(), fresnel, p.sampling.into())
         })
     }
@@ -138,8 +143,54 @@ impl Conductor {
         let metal = MetalParams::read(params)?;
         Ok(Self {
             scale: metal.scale(params)?,
+            tint: metal.tint(),
             ..Self::mirror(metal.fresnel(params)?)
         })
+    }
+
+    /// [`Bsdf::sample_f`] before a textured tint.
+    fn sample_untinted(&self, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let Some(mf) = &self.microfacet else {
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(BsdfSample {
+                f: self.scale * self.fresnel.eval(wo.z) / wo.z,
+                wi,
+                pdf: 1.0,
+                flags: BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
+                eta: 1.0,
+            });
+        };
+        let wi = match self.sampling {
+            LobeSampling::Model(_) => {
+                let m = mf.sample_normal(wo, u2);
+                // A facet facing away from wo would reflect into itself.
+                if wo.dot(m) <= 0.0 {
+                    return None;
+                }
+                fresnel::reflect(wo, m)
+            }
+            baseline => baseline.sample_baseline(u2)?,
+        };
+        let lobe = LobeTerms::at(mf, wo, wi)?;
+        let (f, pdf) = self.rough_eval(mf, &lobe, wi);
+        BsdfSample::reflection(
+            wi,
+            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+            |_| pdf,
+            |_| f,
+        )
+    }
+
+    /// `f` times the textured tint at this hit, if there is one.
+    #[inline]
+    fn tinted(&self, ctx: &BsdfContext, f: Rgb) -> Rgb {
+        match &self.tint {
+            Some(tint) => tint.eval(&ctx.texture) * f,
+            None => f,
+        }
     }
 
     /// `f` of the rough lobe (one pair, or a pair per lane) from what it
@@ -282,49 +333,23 @@ impl Bsdf for Conductor {
     }
 
     #[inline]
-    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         let Some(mf) = &self.microfacet else {
             return Rgb::BLACK;
         };
         LobeTerms::at(mf, wo, wi).map_or(Rgb::BLACK, |lobe| {
             let fresnel = || self.fresnel.eval(lobe.wo_m).to_array();
-            self.rough_f(&lobe, wi.z, || mf.lambda(wi), fresnel).into()
+            self.tinted(
+                ctx,
+                self.rough_f(&lobe, wi.z, || mf.lambda(wi), fresnel).into(),
+            )
         })
     }
 
-    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let Some(mf) = &self.microfacet else {
-            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
-            return Some(BsdfSample {
-                f: self.scale * self.fresnel.eval(wo.z) / wo.z,
-                wi,
-                pdf: 1.0,
-                flags: BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
-                eta: 1.0,
-            });
-        };
-        let wi = match self.sampling {
-            LobeSampling::Model(_) => {
-                let m = mf.sample_normal(wo, u2);
-                // A facet facing away from wo would reflect into itself.
-                if wo.dot(m) <= 0.0 {
-                    return None;
-                }
-                fresnel::reflect(wo, m)
-            }
-            baseline => baseline.sample_baseline(u2)?,
-        };
-        let lobe = LobeTerms::at(mf, wo, wi)?;
-        let (f, pdf) = self.rough_eval(mf, &lobe, wi);
-        BsdfSample::reflection(
-            wi,
-            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            |_| pdf,
-            |_| f,
-        )
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let mut s = self.sample_untinted(wo, u1, u2)?;
+        s.f = self.tinted(ctx, s.f);
+        Some(s)
     }
 
     #[inline]
@@ -336,20 +361,29 @@ impl Bsdf for Conductor {
     }
 
     #[inline]
-    fn eval(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         let Some(mf) = &self.microfacet else {
             return (Rgb::BLACK, 0.0);
         };
-        LobeTerms::at(mf, wo, wi).map_or((Rgb::BLACK, 0.0), |lobe| self.rough_eval(mf, &lobe, wi))
+        LobeTerms::at(mf, wo, wi).map_or((Rgb::BLACK, 0.0), |lobe| {
+            let (f, pdf) = self.rough_eval(mf, &lobe, wi);
+            (self.tinted(ctx, f), pdf)
+        })
     }
 
     /// [`Bsdf::eval`] a SIMD chunk of lanes at a time
     /// (`Conductor::eval_lanes`), each lane bit for bit `eval`'s answer.
-    fn eval_batch(&self, _ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
+    fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
         let Some(mf) = &self.microfacet else {
             out.fill((Rgb::BLACK, 0.0));
             return;
         };
+        if self.tint.is_some() {
+            for (i, out) in out.iter_mut().enumerate() {
+                *out = self.eval(&ctx[i], wo[i], wi[i]);
+            }
+            return;
+        }
         let width = Lanes::LANES;
         for ((wo, wi), out) in wo
             .chunks(width)
@@ -379,7 +413,11 @@ impl Bsdf for Conductor {
         out: &mut [Option<BsdfSample>],
     ) {
         let mf = match (&self.microfacet, self.sampling) {
-            (Some(mf), LobeSampling::Model(_)) if mf.sampling == NormalSampling::Visible => mf,
+            (Some(mf), LobeSampling::Model(_))
+                if mf.sampling == NormalSampling::Visible && self.tint.is_none() =>
+            {
+                mf
+            }
             _ => {
                 for (i, out) in out.iter_mut().enumerate() {
                     *out = self.sample_f(&ctx[i], wo[i], u1[i], u2[i]);
@@ -431,6 +469,67 @@ impl Bsdf for Conductor {
 mod tests {
     use super::*;
     use crate::microfacet::Distribution;
+
+    /// A texture that is `c` times `(1 + u)`.
+    struct UvRamp(Rgb);
+
+    impl lumis_core::Texture for UvRamp {
+        fn eval(&self, q: &lumis_core::TextureQuery) -> Rgb {
+            self.0 * (1.0 + q.uv.x)
+        }
+    }
+
+    #[test]
+    fn a_textured_tint_multiplies_every_value_and_leaves_sampling_alone() {
+        let mf = Microfacet::new(Distribution::Ggx, 0.3, 0.3);
+        let sampling: LobeSampling = MicrofacetLobeSampling::Visible.into();
+        let plain = Conductor::new(mf, ConductorFresnel::Perfect, sampling);
+        let tint = Rgb::new(0.5, 0.25, 0.125);
+        let tinted = Conductor {
+            tint: Some(lumis_core::params::Textured::Texture(std::sync::Arc::new(
+                UvRamp(tint),
+            ))),
+            ..plain.clone()
+        };
+        let n = 16;
+        let ctx: Vec<BsdfContext> = (0..n)
+            .map(|i| BsdfContext {
+                texture: lumis_core::TextureQuery::at(Vec2::new(i as f32 / n as f32, 0.5)),
+                ..Default::default()
+            })
+            .collect();
+        let mut rng = lumis_sampling::Pcg32::new(5, 6);
+        let wo: Vec<Vec3> = (0..n)
+            .map(|_| {
+                lumis_sampling::warp::square_to_cosine_hemisphere(Vec2::new(
+                    rng.next_f32(),
+                    rng.next_f32(),
+                ))
+            })
+            .collect();
+        let u2: Vec<Vec2> = (0..n)
+            .map(|_| Vec2::new(rng.next_f32(), rng.next_f32()))
+            .collect();
+        let mut batch = vec![None; n];
+        tinted.sample_f_batch(&ctx, &wo, &vec![0.5; n], &u2, &mut batch);
+        for i in 0..n {
+            let scale = tint * (1.0 + ctx[i].texture.uv.x);
+            let want = plain.sample_f(&ctx[i], wo[i], 0.5, u2[i]);
+            let got = tinted.sample_f(&ctx[i], wo[i], 0.5, u2[i]);
+            assert_eq!(got.map(|s| (s.wi, s.pdf)), want.map(|s| (s.wi, s.pdf)));
+            assert_eq!(got.map(|s| s.f), want.map(|s| scale * s.f));
+            assert_eq!(batch[i], got, "lane {i}");
+            let wi = Vec3::new(-wo[i].x, 0.1, wo[i].z).normalize();
+            assert_eq!(
+                tinted.eval(&ctx[i], wo[i], wi).0,
+                scale * plain.f(&ctx[i], wo[i], wi)
+            );
+            assert_eq!(
+                tinted.pdf(&ctx[i], wo[i], wi),
+                plain.pdf(&ctx[i], wo[i], wi)
+            );
+        }
+    }
 
     #[test]
     fn below_the_threshold_roughness_is_a_mirror() {

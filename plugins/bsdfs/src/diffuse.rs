@@ -4,7 +4,7 @@ use std::f32::consts::FRAC_1_PI;
 
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
-    PluginSpec, Result, Rgb, Vec2, Vec3,
+    PluginSpec, Result, Rgb, TexturedRgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -15,10 +15,10 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: DiffuseParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct DiffuseParams {
-    /// albedo R in linear RGB, each channel in [0, 1]
-    pub reflectance: Rgb,
+    /// albedo R in linear RGB, each channel in [0, 1], or a texture
+    pub reflectance: TexturedRgb,
     /// reflect on both sides (one-sided surfaces are black from behind,
     /// like Mitsuba's)
     #[param(default = false)]
@@ -37,15 +37,19 @@ pub enum DiffuseSampling {
 
 #[derive(Debug, Clone)]
 pub struct Diffuse {
-    reflectance: Rgb,
+    reflectance: TexturedRgb,
     two_sided: bool,
     sampling: DiffuseSampling,
 }
 
 impl Diffuse {
-    pub fn new(reflectance: Rgb, two_sided: bool, sampling: DiffuseSampling) -> Self {
+    pub fn new(
+        reflectance: impl Into<TexturedRgb>,
+        two_sided: bool,
+        sampling: DiffuseSampling,
+    ) -> Self {
         Self {
-            reflectance,
+            reflectance: reflectance.into(),
             two_sided,
             sampling,
         }
@@ -53,16 +57,15 @@ impl Diffuse {
 
     pub fn from_params(params: &Params) -> Result<Self> {
         let p = DiffuseParams::read(params)?;
-        let reflectance = p.reflectance;
-        if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
-            return Err(params.error(
-                DiffuseParams::KEYS.reflectance,
-                format!(
-                    "each channel must be in [0, 1] (energy conservation), got {reflectance:?}"
-                ),
-            ));
+        if let Some(r) = p.reflectance.constant() {
+            if !(r.min_component() >= 0.0 && r.max_component() <= 1.0) {
+                return Err(params.error(
+                    DiffuseParams::KEYS.reflectance,
+                    format!("each channel must be in [0, 1] (energy conservation), got {r:?}"),
+                ));
+            }
         }
-        Ok(Self::new(reflectance, p.two_sided, p.sampling))
+        Ok(Self::new(p.reflectance, p.two_sided, p.sampling))
     }
 
     /// Maps `(wo, wi)` into the upper hemisphere if this side reflects;
@@ -93,15 +96,15 @@ impl Bsdf for Diffuse {
     }
 
     #[inline]
-    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         match self.oriented(wo, wi) {
-            Some(_) => self.reflectance * FRAC_1_PI,
+            Some(_) => self.reflectance.eval(&ctx.texture) * FRAC_1_PI,
             None => Rgb::BLACK,
         }
     }
 
     #[inline]
-    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
         let flip = if wo.z > 0.0 {
             1.0
         } else if self.two_sided && wo.z < 0.0 {
@@ -120,7 +123,7 @@ impl Bsdf for Diffuse {
         }
         let pdf = self.pdf_upper(local.z);
         Some(BsdfSample {
-            f: self.reflectance * FRAC_1_PI,
+            f: self.reflectance.eval(&ctx.texture) * FRAC_1_PI,
             wi: Vec3::new(local.x, local.y, local.z * flip),
             pdf,
             flags: BsdfFlags::DIFFUSE_REFLECTION,
@@ -137,9 +140,12 @@ impl Bsdf for Diffuse {
     }
 
     #[inline]
-    fn eval(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         match self.oriented(wo, wi) {
-            Some((_, wi)) => (self.reflectance * FRAC_1_PI, self.pdf_upper(wi.z)),
+            Some((_, wi)) => (
+                self.reflectance.eval(&ctx.texture) * FRAC_1_PI,
+                self.pdf_upper(wi.z),
+            ),
             None => (Rgb::BLACK, 0.0),
         }
     }

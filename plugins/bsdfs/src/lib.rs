@@ -1,6 +1,6 @@
 //! Standard BSDFs: diffuse, Blinn, rough conductor and mirror, smooth and
-//! rough dielectric, plastic; with the microfacet and Fresnel machinery
-//! they share.
+//! rough dielectric, plastic; the `twosided` adapter; with the microfacet
+//! and Fresnel machinery they share.
 
 mod blinn;
 mod conductor;
@@ -11,6 +11,7 @@ mod lobe_sampling;
 mod metal_params;
 pub mod microfacet;
 mod plastic;
+mod twosided;
 
 pub use blinn::{Blinn, BlinnParams, BlinnSampling};
 pub use conductor::{Conductor, ConductorFresnel, ConductorParams};
@@ -19,6 +20,7 @@ pub use diffuse::{Diffuse, DiffuseParams, DiffuseSampling};
 pub use lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
 pub use metal_params::{MetalName, MetalParams};
 pub use plastic::{Plastic, PlasticParams};
+pub use twosided::{TwoSided, TwoSidedParams};
 
 use std::sync::Arc;
 
@@ -37,5 +39,6 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_bsdf(dielectric::SPEC, |p| {
         Ok(Arc::new(Dielectric::from_params(p)?))
     })?;
-    registry.add_bsdf(plastic::SPEC, |p| Ok(Arc::new(Plastic::from_params(p)?)))
+    registry.add_bsdf(plastic::SPEC, |p| Ok(Arc::new(Plastic::from_params(p)?)))?;
+    registry.add_bsdf(twosided::SPEC, |p| Ok(Arc::new(TwoSided::from_params(p)?)))
 }

@@ -1,7 +1,8 @@
 //! The parameters that choose a metal's reflectance, shared by `conductor`
 //! and `mirror`: a named metal, or its complex index of refraction.
 
-use lumis_core::{ParamChoice, Params, PluginParams, Result, Rgb};
+use lumis_core::params::Textured;
+use lumis_core::{ParamChoice, Params, PluginParams, Result, Rgb, TexturedRgb};
 
 use crate::conductor::ConductorFresnel;
 use crate::fresnel;
@@ -27,7 +28,7 @@ pub enum MetalName {
     Pt,
 }
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct MetalParams {
     /// named metal (complex IOR at 650/550/450 nm) or none: a perfect
     /// reflector, Fresnel = 1
@@ -38,9 +39,9 @@ pub struct MetalParams {
     /// imaginary part (absorption) of the IOR per channel, with eta
     pub k: Option<Rgb>,
     /// multiplies the Fresnel term (not physical; for artistic tints), each
-    /// channel in [0, 1]
+    /// channel in [0, 1], or a texture
     #[param(default = 1.0)]
-    pub specular_reflectance: Rgb,
+    pub specular_reflectance: TexturedRgb,
 }
 
 impl MetalParams {
@@ -80,7 +81,9 @@ impl MetalParams {
 
     /// `specular_reflectance`, each channel in [0, 1].
     pub fn scale(&self, params: &Params) -> Result<Rgb> {
-        let scale = self.specular_reflectance;
+        let Some(scale) = self.specular_reflectance.constant() else {
+            return Ok(Rgb::WHITE);
+        };
         if !(scale.min_component() >= 0.0 && scale.max_component() <= 1.0) {
             return Err(params.error(
                 Self::KEYS.specular_reflectance,
@@ -88,6 +91,17 @@ impl MetalParams {
             ));
         }
         Ok(scale)
+    }
+
+    /// The texture that gives `specular_reflectance`, if one does: it
+    /// multiplies the BSDF's value at each hit ([`Self::scale`] is then
+    /// white), exact since the value is linear in it and sampling ignores
+    /// it.
+    pub fn tint(&self) -> Option<TexturedRgb> {
+        match &self.specular_reflectance {
+            Textured::Constant(_) => None,
+            textured => Some(textured.clone()),
+        }
     }
 }
 

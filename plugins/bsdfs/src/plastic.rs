@@ -18,15 +18,15 @@
 //! else the base (cosine-weighted); `pdf` is the mixture (one-sample MIS
 //! between the lobes). One-sided.
 //!
-//! A texture scales the base's albedo alone (`BsdfContext::albedo_scale`):
-//! the coat stays white, and `f`, `sample_f` and `pdf` derive the base term
-//! and the lobe choice from the same scaled albedo.
+//! A textured `diffuse_reflectance` is the base's albedo at each hit: the
+//! coat stays white, and `f`, `sample_f` and `pdf` derive the base term and
+//! the lobe choice from the same texture value.
 
 use std::f32::consts::FRAC_1_PI;
 
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
-    Rgb, Vec2, Vec3,
+    Rgb, TexturedRgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -40,11 +40,11 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: PlasticParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct PlasticParams {
-    /// albedo rho of the base, each channel in [0, 1]
+    /// albedo rho of the base, each channel in [0, 1], or a texture
     #[param(default = 0.5)]
-    pub diffuse_reflectance: Rgb,
+    pub diffuse_reflectance: TexturedRgb,
     /// scale of the coat's reflection (1 is physical), in [0, 1]
     #[param(default = 1.0)]
     pub specular_reflectance: Rgb,
@@ -75,10 +75,11 @@ struct Base {
 
 #[derive(Debug, Clone)]
 pub struct Plastic {
-    /// The untextured base, precomputed.
+    /// The untextured base, precomputed (`diffuse` is a constant), or the
+    /// base of a white albedo (unused).
     untextured: Base,
-    /// `rho`, for a textured base.
-    diffuse: Rgb,
+    /// `rho`, a constant or a texture.
+    diffuse: TexturedRgb,
     /// The coat's internal diffuse reflectance `F_dr,int`.
     fdr_int: f32,
     nonlinear: bool,
@@ -90,11 +91,19 @@ pub struct Plastic {
 }
 
 impl Plastic {
-    pub fn new(diffuse: Rgb, specular: Rgb, eta: f32, coat: Microfacet, nonlinear: bool) -> Self {
+    pub fn new(
+        diffuse: impl Into<TexturedRgb>,
+        specular: Rgb,
+        eta: f32,
+        coat: Microfacet,
+        nonlinear: bool,
+    ) -> Self {
+        let diffuse = diffuse.into();
         // Light inside the coat meets it from the side of index 1/eta.
         let fdr_int = fresnel::diffuse_reflectance(1.0 / eta);
+        let constant = diffuse.constant().unwrap_or(Rgb::WHITE);
         Self {
-            untextured: Self::base_of(diffuse, fdr_int, eta, nonlinear),
+            untextured: Self::base_of(constant, fdr_int, eta, nonlinear),
             diffuse,
             fdr_int,
             nonlinear,
@@ -109,9 +118,10 @@ impl Plastic {
         let p = PlasticParams::read(params)?;
         let keys = PlasticParams::KEYS;
         for (key, v) in [
-            (keys.diffuse_reflectance, p.diffuse_reflectance),
-            (keys.specular_reflectance, p.specular_reflectance),
+            (keys.diffuse_reflectance, p.diffuse_reflectance.constant()),
+            (keys.specular_reflectance, Some(p.specular_reflectance)),
         ] {
+            let Some(v) = v else { continue };
             if !(v.min_component() >= 0.0 && v.max_component() <= 1.0) {
                 return Err(params.error(key, format!("each channel must be in [0, 1], got {v:?}")));
             }
@@ -138,15 +148,15 @@ impl Plastic {
         }
     }
 
-    /// The base at this hit: the precomputed one, or the albedo scaled by
-    /// the texture value the context carries (clamped to [0, 1], where the
-    /// internal reflections' series converges).
+    /// The base at this hit: the precomputed one, or the texture's value
+    /// there (clamped to [0, 1], where the internal reflections' series
+    /// converges).
     #[inline]
     fn base(&self, ctx: &BsdfContext) -> Base {
-        match ctx.albedo_scale {
-            None => self.untextured,
-            Some(scale) => Self::base_of(
-                (self.diffuse * scale).map(|r| r.clamp(0.0, 1.0)),
+        match &self.diffuse {
+            lumis_core::params::Textured::Constant(_) => self.untextured,
+            textured => Self::base_of(
+                textured.eval(&ctx.texture).map(|r| r.clamp(0.0, 1.0)),
                 self.fdr_int,
                 self.eta,
                 self.nonlinear,
@@ -316,10 +326,6 @@ impl Bsdf for Plastic {
             self.pdf_above(&base, fo, half, wo, wi),
         )
     }
-
-    fn takes_albedo_scale(&self) -> bool {
-        true
-    }
 }
 
 #[cfg(test)]
@@ -358,38 +364,43 @@ mod tests {
         );
     }
 
+    /// A texture of constant value `c`.
+    struct Flat(Rgb);
+
+    impl lumis_core::Texture for Flat {
+        fn eval(&self, _: &lumis_core::TextureQuery) -> Rgb {
+            self.0
+        }
+    }
+
     #[test]
-    fn a_scaled_albedo_is_the_plastic_of_that_albedo() {
-        // f, pdf and every sample (lobe choice included) of a textured
-        // base equal those of the plastic built with the product, so the
+    fn a_textured_base_is_the_plastic_of_the_texture_value() {
+        // f, pdf and every sample (lobe choice included) of a base textured
+        // with c equal those of the plastic built with c, to the bit, so the
         // chi-square coverage of the untextured model carries over.
-        let rho = Rgb::new(0.9, 0.6, 0.3);
-        let scale = Rgb::new(1.0, 0.25, 0.0);
+        let rho = Rgb::new(0.9, 0.15, 0.0);
         for (alpha, nonlinear) in [(0.0, false), (0.3, false), (0.3, true)] {
             let coat = Microfacet::new(Distribution::Ggx, alpha, alpha);
-            let textured = Plastic::new(rho, Rgb::WHITE, 1.5, coat, nonlinear);
-            let product = Plastic::new(rho * scale, Rgb::WHITE, 1.5, coat, nonlinear);
-            let ctx = BsdfContext {
-                albedo_scale: Some(scale),
-                ..Default::default()
-            };
-            let plain = BsdfContext::default();
+            let texture = lumis_core::params::Textured::Texture(std::sync::Arc::new(Flat(rho)));
+            let textured = Plastic::new(texture, Rgb::WHITE, 1.5, coat, nonlinear);
+            let constant = Plastic::new(rho, Rgb::WHITE, 1.5, coat, nonlinear);
+            let ctx = BsdfContext::default();
             let mut rng = lumis_sampling::Pcg32::new(3, 4);
             for _ in 0..2000 {
                 let wo =
                     warp::square_to_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
                 let wi =
                     warp::square_to_cosine_hemisphere(Vec2::new(rng.next_f32(), rng.next_f32()));
-                assert_eq!(textured.f(&ctx, wo, wi), product.f(&plain, wo, wi));
-                assert_eq!(textured.pdf(&ctx, wo, wi), product.pdf(&plain, wo, wi));
+                assert_eq!(textured.f(&ctx, wo, wi), constant.f(&ctx, wo, wi));
+                assert_eq!(textured.pdf(&ctx, wo, wi), constant.pdf(&ctx, wo, wi));
                 let (u1, u2) = (rng.next_f32(), Vec2::new(rng.next_f32(), rng.next_f32()));
                 assert_eq!(
                     textured.sample_f(&ctx, wo, u1, u2),
-                    product.sample_f(&plain, wo, u1, u2)
+                    constant.sample_f(&ctx, wo, u1, u2)
                 );
             }
             // The coat is not tinted: the smooth coat's mirror sample is
-            // white under a scale that removes blue from the base.
+            // white under a base without blue.
             if alpha == 0.0 {
                 let wo = Vec3::new(0.6, 0.0, 0.8);
                 let s = textured.sample_f(&ctx, wo, 0.0, Vec2::splat(0.5)).unwrap();

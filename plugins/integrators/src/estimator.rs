@@ -189,7 +189,7 @@ impl Vertex<'_> {
 #[inline]
 pub fn bsdf_context(hit: &SurfaceInteraction) -> BsdfContext {
     BsdfContext {
-        uv: hit.uv,
+        texture: lumis_core::TextureQuery::at(hit.uv),
         ..Default::default()
     }
 }

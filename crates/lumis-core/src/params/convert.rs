@@ -16,6 +16,10 @@ pub trait FromParam: Sized {
     fn from_node(node: &Node) -> std::result::Result<Self, String>;
 }
 
+/// Said of `{ texture = ".." }` given to a parameter declared without
+/// textures.
+const NO_TEXTURE: &str = "this parameter takes no texture";
+
 /// A finite number: TOML's `nan` and `inf` are valid floats, but no scene
 /// value means them, and a NaN would pass every range check (all its
 /// comparisons are false) and poison the render.
@@ -23,6 +27,7 @@ fn number(node: &Node) -> std::result::Result<f64, String> {
     let v = match node.value {
         Value::Float(f) => f,
         Value::Int(i) => i as f64,
+        Value::Table(ref t) if t.get("texture").is_some() => return Err(NO_TEXTURE.into()),
         ref v => return Err(format!("expected a number, found {}", v.type_name())),
     };
     if v.is_finite() {
@@ -109,6 +114,9 @@ impl FromParam for Rgb {
         match &node.value {
             Value::Float(_) | Value::Int(_) => Ok(Rgb::splat(single(node)?)),
             Value::Array(_) => floats::<3>(node, "expected [r, g, b] or one number").map(Rgb::from),
+            Value::Table(t) if t.get("texture").is_some() => {
+                Err(format!("expected [r, g, b] or one number; {NO_TEXTURE}"))
+            }
             v => Err(format!(
                 "expected [r, g, b] or one number, found {}",
                 v.type_name()
@@ -202,6 +210,12 @@ pub trait Param: FromParam {
             "a range [{min}, {max}] is declared on a parameter of type {}",
             Self::TYPE.name()
         ))
+    }
+
+    /// Converts the node given for `name`; a type whose value may refer to
+    /// other plugins (a texture) resolves it through `params`.
+    fn read_node(params: &super::Params, name: &str, node: &Node) -> crate::Result<Self> {
+        params.convert(name, node)
     }
 }
 

@@ -12,21 +12,26 @@
 //! `ParamSpec` lists by hand and read them by name with [`Params::get`].
 
 mod convert;
+mod nested;
 mod spec;
+mod textured;
 mod typed;
 
 use std::borrow::Cow;
 use std::cell::RefCell;
 
 pub use convert::{FromParam, Param};
+pub use nested::NestedBsdf;
 pub use spec::{
     check_unique, concat, declares, override_default, total_len, ParamDefault, ParamSpec,
     ParamType, ParamValue,
 };
+pub use textured::{Textured, TexturedFloat, TexturedRgb};
 pub use typed::{choice_from_node, ParamChoice, PluginParams};
 
 use crate::doc::{Node, Table, Value};
 use crate::error::{Error, Location, Result};
+use crate::texture::BsdfScope;
 
 /// A plugin's table, checked against its declaration.
 pub struct Params<'a> {
@@ -35,6 +40,9 @@ pub struct Params<'a> {
     location: Location,
     spec: &'a [ParamSpec],
     read: RefCell<Vec<bool>>,
+    /// What `{ texture = "name" }` values and BSDF names refer to; `None`
+    /// where no references are accepted (every plugin but BSDFs).
+    scope: Option<BsdfScope<'a>>,
 }
 
 impl<'a> Params<'a> {
@@ -70,7 +78,15 @@ impl<'a> Params<'a> {
             location,
             spec,
             read: RefCell::new(vec![false; spec.len()]),
+            scope: None,
         })
+    }
+
+    /// Lets textured parameters ([`Textured`]) and BSDF references
+    /// ([`NestedBsdf`]) refer to what `scope` holds.
+    pub fn with_scope(mut self, scope: BsdfScope<'a>) -> Self {
+        self.scope = Some(scope);
+        self
     }
 
     /// A `Params` over a table built in code (tests, programmatic scenes).
@@ -157,18 +173,26 @@ impl<'a> Params<'a> {
     /// A declared parameter's value, or its default, checked against its
     /// declared range: what `#[derive(PluginParams)]` reads a field with.
     pub fn value<T: Param>(&self, name: &str) -> Result<T> {
-        let v: T = self.get(name)?;
-        self.check_range(name, &v)?;
-        Ok(v)
+        match self.optional_value(name)? {
+            Some(v) => Ok(v),
+            None => Err(Error::at(
+                &self.location,
+                format!(
+                    "plugin bug: {} reads optional '{name}' as required; declare it as an Option",
+                    self.owner
+                ),
+            )),
+        }
     }
 
     /// [`Self::value`] for a parameter that may be absent.
     pub fn optional_value<T: Param>(&self, name: &str) -> Result<Option<T>> {
-        let v: Option<T> = self.get_opt(name)?;
-        if let Some(v) = &v {
-            self.check_range(name, v)?;
-        }
-        Ok(v)
+        let Some(node) = self.node(name)? else {
+            return Ok(None);
+        };
+        let v = T::read_node(self, name, &node)?;
+        self.check_range(name, &v)?;
+        Ok(Some(v))
     }
 
     fn check_range<T: Param>(&self, name: &str, v: &T) -> Result<()> {

@@ -19,6 +19,12 @@ pub enum ParamType {
     String,
     /// `[r, g, b]` or one number for grey.
     Rgb,
+    /// An `rgb`, or `{ texture = "name" }`.
+    TexturedRgb,
+    /// A `float`, or `{ texture = "name" }`.
+    TexturedFloat,
+    /// The name of a `[[bsdf]]` declared before.
+    Bsdf,
     Vec2,
     Vec3,
     /// Two non-negative integers, e.g. a resolution.
@@ -39,6 +45,9 @@ impl ParamType {
             ParamType::Float => "float",
             ParamType::String => "string",
             ParamType::Rgb => "rgb",
+            ParamType::TexturedRgb => "rgb or texture",
+            ParamType::TexturedFloat => "float or texture",
+            ParamType::Bsdf => "bsdf name",
             ParamType::Vec2 => "vec2",
             ParamType::Vec3 => "vec3",
             ParamType::UIntPair => "[uint, uint]",
@@ -52,7 +61,10 @@ impl ParamType {
 
     /// Whether a range can apply to it.
     const fn is_number(self) -> bool {
-        matches!(self, ParamType::Int | ParamType::Float)
+        matches!(
+            self,
+            ParamType::Int | ParamType::Float | ParamType::TexturedFloat
+        )
     }
 }
 
@@ -91,9 +103,9 @@ impl ParamValue {
         match ty {
             ParamType::Bool => matches!(self, ParamValue::Bool(_)),
             ParamType::Int => matches!(self, ParamValue::Int(_)),
-            ParamType::Float => self.is_number(),
-            ParamType::String => matches!(self, ParamValue::Str(_)),
-            ParamType::Rgb => self.is_number() || self.is_numbers(3),
+            ParamType::Float | ParamType::TexturedFloat => self.is_number(),
+            ParamType::String | ParamType::Bsdf => matches!(self, ParamValue::Str(_)),
+            ParamType::Rgb | ParamType::TexturedRgb => self.is_number() || self.is_numbers(3),
             ParamType::Vec2 => self.is_numbers(2),
             ParamType::Vec3 => self.is_numbers(3),
             ParamType::UIntPair => match self {

@@ -5,15 +5,19 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use lumis_core::doc::Table;
 use lumis_core::glam::{Mat3, Mat4};
-use lumis_core::{Bsdf, Error, Light, LightShape, Location, Result, Vec2, Vec3};
+use lumis_core::texture::Named;
+use lumis_core::{
+    Bsdf, BsdfScope, Error, Light, LightShape, Location, PluginEntity, PluginKind, Result, Vec2,
+    Vec3,
+};
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 
 use super::bvh::{PendingInstance, PendingPrototype};
 use super::has_area;
 use super::state::Assembly;
-use crate::gltf::texture::{AlbedoTextured, TexturedEmitter};
-use crate::gltf::two_sided::TwoSided;
+use crate::gltf::emitter::TexturedEmitter;
 use crate::gltf::{AssetEmission, GltfImport, ImportedMaterial, MaterialBsdf};
 use crate::render_scene::{Geometry, MeshData, Placement, NO_LIGHT};
 
@@ -124,8 +128,8 @@ pub(crate) fn add_gltf(
     Ok(())
 }
 
-/// Creates the BSDFs of the asset's own materials (wrapped for
-/// `doubleSided` and base colour textures) and finds the scene's
+/// Creates the BSDFs of the asset's own materials (with their base colour
+/// textures; wrapped for `doubleSided`) and finds the scene's
 /// replacements, in the importer's material order: the default material,
 /// then by index.
 fn place_materials<'m>(
@@ -141,12 +145,10 @@ fn place_materials<'m>(
         let bsdf = match &material.bsdf {
             MaterialBsdf::Scene(reference) => asm.bsdfs.index_of(reference, owner)?,
             MaterialBsdf::Asset(asset) => {
-                let mut bsdf = asm.registry.create::<dyn Bsdf>(&asset.entity, ())?;
+                let scope = BsdfScope::textures(&asset.textures);
+                let mut bsdf = asm.registry.create::<dyn Bsdf>(&asset.entity, scope)?;
                 if asset.two_sided {
-                    bsdf = Arc::new(TwoSided { inner: bsdf });
-                }
-                if let Some(texture) = &asset.albedo_texture {
-                    bsdf = Arc::new(AlbedoTextured::new(bsdf, texture.clone()));
+                    bsdf = two_sided(bsdf, &asset.entity, asm)?;
                 }
                 asm.bsdfs.push_unnamed(bsdf)
             }
@@ -155,6 +157,27 @@ fn place_materials<'m>(
         placed.insert(*index, PlacedMaterial { bsdf, emission });
     }
     Ok(placed)
+}
+
+/// A `doubleSided` material's BSDF: `inner` in the `twosided` plugin, made
+/// as a scene's `[[bsdf]] type = "twosided"` naming it would be.
+fn two_sided(inner: Arc<dyn Bsdf>, entity: &PluginEntity, asm: &Assembly) -> Result<Arc<dyn Bsdf>> {
+    const INNER: &str = "doubleSided material";
+    let mut bsdfs = Named::<dyn Bsdf>::new();
+    bsdfs.insert(INNER, inner);
+    let table = Table::built(&entity.location, [("bsdf", INNER.into())]);
+    let outer = PluginEntity::new(
+        PluginKind::Bsdf,
+        format!("{} (doubleSided)", entity.owner),
+        "twosided",
+        table,
+        entity.location.clone(),
+    );
+    let scope = BsdfScope {
+        textures: &lumis_core::texture::NO_TEXTURES,
+        bsdfs: &bsdfs,
+    };
+    asm.registry.create::<dyn Bsdf>(&outer, scope)
 }
 
 /// One triangle light per non-degenerate triangle (world-space vertices,

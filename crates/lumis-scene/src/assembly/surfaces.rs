@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use lumis_core::{Error, LightShape, PluginEntity, Result, Vec3};
+use lumis_core::{Error, LightShape, PluginEntity, Result, Vec2, Vec3};
 use lumis_embree::PaddedBuffer;
 
 use super::has_area;
@@ -51,7 +51,14 @@ pub(crate) fn add_surface(owner: &str, surface: Surface, asm: &mut Assembly) -> 
                 }
                 None => Vec::new(),
             };
-            add_mesh(owner, mesh, bsdf, lights, orientation, asm)?
+            // (u, v) runs along the edges from the corner, so a texture
+            // covers the quad once.
+            let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].to_vec();
+            let mut geometry = add_mesh(owner, mesh, bsdf, lights, orientation, asm)?;
+            if let Geometry::Mesh(data) = &mut geometry {
+                data.uvs = Some(uvs);
+            }
+            geometry
         }
         SurfaceGeometry::Mesh(mesh) => {
             let lights = triangle_lights(&mesh, emission, flip, asm)?;

@@ -9,11 +9,11 @@
 //! here, except the glTF asset a `[camera] type = "gltf"` names.
 
 mod accel;
-mod bsdfs;
 mod camera;
 mod document;
 mod film;
 mod gltf_shape;
+mod named;
 mod plugin_libraries;
 mod shapes;
 mod transform;
@@ -27,8 +27,8 @@ use lumis_render::PerspectiveCamera;
 
 pub(crate) use accel::AccelOptions;
 pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
-pub(crate) use bsdfs::NamedBsdf;
 pub(crate) use film::FilmDescription;
+pub(crate) use named::NamedPlugin;
 pub(crate) use plugin_libraries::PluginLibraries;
 pub(crate) use shapes::{ShapeEntity, ShapeSource, Surface, SurfaceGeometry};
 
@@ -40,6 +40,7 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "sampler",
     "integrator",
     "light_sampler",
+    "texture",
     "bsdf",
     "shape",
     "light",
@@ -59,7 +60,9 @@ pub(crate) struct SceneDescription {
     pub integrator: PluginEntity,
     /// `[light_sampler]`, or the uniform one when the scene has none.
     pub light_sampler: PluginEntity,
-    pub bsdfs: Vec<NamedBsdf>,
+    /// `[[texture]]`s, which BSDF parameters name.
+    pub textures: Vec<NamedPlugin>,
+    pub bsdfs: Vec<NamedPlugin>,
     pub shapes: Vec<ShapeEntity>,
     /// `[[light]]` tables (emitting shapes describe their own lights).
     pub lights: Vec<PluginEntity>,
@@ -80,7 +83,13 @@ impl SceneDescription {
             dir,
             film.resolution,
         )?;
-        let bsdfs = bsdfs::named_bsdfs(take_tables(&mut root, "bsdf")?)?;
+        let textures = named::named_plugins(
+            PluginKind::Texture,
+            "BSDF parameters",
+            take_tables(&mut root, "texture")?,
+        )?;
+        let bsdfs =
+            named::named_plugins(PluginKind::Bsdf, "shapes", take_tables(&mut root, "bsdf")?)?;
         let accel = accel::accel_options(take_table(&mut root, "accel")?)?;
         let shapes = take_tables(&mut root, "shape")?
             .into_iter()
@@ -116,6 +125,7 @@ impl SceneDescription {
             sampler,
             integrator,
             light_sampler,
+            textures,
             bsdfs,
             shapes,
             lights,

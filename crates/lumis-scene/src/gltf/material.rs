@@ -11,6 +11,10 @@ use lumis_core::{Location, PluginEntity, PluginKind, Rgb};
 /// of a metal and a dielectric lobe by `metallic` has no lumis BSDF.
 const METALLIC_THRESHOLD: f32 = 0.5;
 
+/// The name under which a material's BSDF parameters find its base colour
+/// texture (already multiplied by `baseColorFactor`).
+pub(crate) const BASE_COLOR: &str = "baseColorTexture";
+
 /// The glTF dielectric's coat: IOR 1.5 (its specular F0 of 0.04).
 const DIELECTRIC_IOR: f32 = 1.5;
 
@@ -27,15 +31,17 @@ const DIELECTRIC_IOR: f32 = 1.5;
 ///   colour is the base's albedo seen through the coat at normal incidence
 ///   (plastic's linear mode), where glTF mixes the two by Schlick's Fresnel.
 ///
-/// `doubleSided` wraps either in [`super::two_sided::TwoSided`], and a base
-/// colour texture tints the conductor's reflectance or the plastic's base
-/// (the caller wraps the BSDF). What is approximated is said in the
-/// warnings.
+/// `doubleSided` wraps either in the `twosided` BSDF plugin. With
+/// `base_color_textured`, the conductor's reflectance or the plastic's
+/// base is `{ texture = BASE_COLOR }` (the texture carries the factor),
+/// which the caller creates the BSDF with. What is approximated is said in
+/// the warnings.
 pub(crate) fn bsdf_entity(
     material: &gltf::Material,
     label: &str,
     owner: String,
     at: &Location,
+    base_color_textured: bool,
 ) -> Result<(PluginEntity, Vec<String>), String> {
     let pbr = material.pbr_metallic_roughness();
     let [r, g, b, _alpha] = pbr.base_color_factor();
@@ -45,6 +51,13 @@ pub(crate) fn bsdf_entity(
             "material {label}: baseColorFactor {rgb:?} must lie in [0, 1]"
         ));
     }
+    let base_color = || -> Value {
+        if base_color_textured {
+            Value::Table(Table::built(at, [("texture", BASE_COLOR.into())]))
+        } else {
+            rgb.into()
+        }
+    };
     let entity = |type_name: &str, params: Vec<(&str, Value)>| {
         let table = Table::built(at, params);
         PluginEntity::new(PluginKind::Bsdf, owner, type_name, table, at.clone())
@@ -55,7 +68,7 @@ pub(crate) fn bsdf_entity(
     // grey most exporters mean by "no material", and reports nothing.
     let Some(_) = material.index() else {
         return Ok((
-            entity("diffuse", vec![("reflectance", rgb.into())]),
+            entity("diffuse", vec![("reflectance", base_color())]),
             warnings,
         ));
     };
@@ -79,14 +92,14 @@ pub(crate) fn bsdf_entity(
             vec![
                 ("distribution", "ggx".into()),
                 ("roughness", alpha.into()),
-                ("specular_reflectance", rgb.into()),
+                ("specular_reflectance", base_color()),
             ],
         )
     } else {
         entity(
             "plastic",
             vec![
-                ("diffuse_reflectance", rgb.into()),
+                ("diffuse_reflectance", base_color()),
                 ("int_ior", DIELECTRIC_IOR.into()),
                 ("ext_ior", 1.0f32.into()),
                 ("distribution", "ggx".into()),

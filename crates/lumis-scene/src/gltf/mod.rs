@@ -14,15 +14,12 @@
 mod buffers;
 pub(crate) mod camera;
 mod decode;
+pub(crate) mod emitter;
 mod material;
 mod normals;
 mod resolve;
 mod scene_graph;
-pub(crate) mod texture;
-pub(crate) mod two_sided;
 mod unmodelled;
-#[cfg(test)]
-mod wrapper_tests;
 
 use std::collections::HashMap;
 use std::path::PathBuf;

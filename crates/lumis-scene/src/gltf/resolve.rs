@@ -7,9 +7,9 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use lumis_core::{Error, PluginEntity, Result};
+use lumis_core::{Error, PluginEntity, Result, Rgb, Texture, Textures, UvTransform};
+use lumis_textures::image::{self as image_texture, Encoding, ImageFilter, ImageTexture, Wrap};
 
-use super::texture::{Texture, Wrap};
 use super::{buffers, material, ImportRequest};
 use crate::bsdf_ref::BsdfRef;
 
@@ -34,15 +34,16 @@ pub(crate) struct AssetBsdf {
     pub entity: PluginEntity,
     /// `doubleSided`: the BSDF is seen from both sides.
     pub two_sided: bool,
-    /// `baseColorTexture`: multiplies the BSDF's albedo.
-    pub albedo_texture: Option<Arc<Texture>>,
+    /// What the entity's textured parameters name: the `baseColorTexture`
+    /// (times `baseColorFactor`) as [`material::BASE_COLOR`].
+    pub textures: Textures,
 }
 
 /// The light plugin of an emissive material's triangles.
 pub(crate) struct AssetEmission {
     pub entity: PluginEntity,
     /// `emissiveTexture`: scales the radiance, read at the material's uvs.
-    pub texture: Option<Arc<Texture>>,
+    pub texture: Option<Arc<dyn Texture>>,
 }
 
 /// Every material of an asset, and what mapping them left out.
@@ -123,21 +124,14 @@ pub(crate) fn resolve_materials(
         let bsdf = match replacement {
             Some(bsdf) => MaterialBsdf::Scene(bsdf),
             None => {
-                let (entity, warnings) = material::bsdf_entity(
-                    &material,
-                    &material_label,
-                    format!("{owner} '{label}' material {material_label}"),
-                    at,
-                )
-                .map_err(err)?;
-                out.warnings
-                    .extend(warnings.into_iter().map(|w| format!("'{label}': {w}")));
-                let mut albedo_texture = None;
-                if let Some(info) = material.pbr_metallic_roughness().base_color_texture() {
-                    match texture_of(asset, &info, &request.path) {
+                let pbr = material.pbr_metallic_roughness();
+                let mut textures = Textures::new();
+                if let Some(info) = pbr.base_color_texture() {
+                    let [r, g, b, _] = pbr.base_color_factor();
+                    match texture_of(asset, &info, &request.path, Rgb::new(r, g, b)) {
                         Ok((t, set)) => {
                             out.texture_bytes += t.byte_size();
-                            albedo_texture = Some(Arc::new(t));
+                            textures.insert(material::BASE_COLOR, Arc::new(t));
                             uv_set = Some(set);
                         }
                         Err(why) => out.warnings.push(format!(
@@ -145,17 +139,27 @@ pub(crate) fn resolve_materials(
                         )),
                     }
                 }
+                let (entity, warnings) = material::bsdf_entity(
+                    &material,
+                    &material_label,
+                    format!("{owner} '{label}' material {material_label}"),
+                    at,
+                    !textures.is_empty(),
+                )
+                .map_err(err)?;
+                out.warnings
+                    .extend(warnings.into_iter().map(|w| format!("'{label}': {w}")));
                 MaterialBsdf::Asset(AssetBsdf {
                     entity,
                     two_sided: material.index().is_some() && material.double_sided(),
-                    albedo_texture,
+                    textures,
                 })
             }
         };
         let radiance = material::emission(&material, &material_label).map_err(err)?;
         let mut emission_texture = None;
         if let (Some(_), Some(info)) = (radiance, material.emissive_texture()) {
-            let loaded = match (texture_of(asset, &info, &request.path), uv_set) {
+            let loaded = match (texture_of(asset, &info, &request.path, Rgb::WHITE), uv_set) {
                 (Ok((_, set)), Some(base)) if base != set => Err(format!(
                     "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
                 )),
@@ -164,7 +168,7 @@ pub(crate) fn resolve_materials(
             match loaded {
                 Ok((t, set)) => {
                     out.texture_bytes += t.byte_size();
-                    emission_texture = Some(Arc::new(t));
+                    emission_texture = Some(Arc::new(t) as Arc<dyn Texture>);
                     uv_set = Some(set);
                 }
                 Err(why) => out.warnings.push(format!(
@@ -193,32 +197,79 @@ pub(crate) fn resolve_materials(
     Ok(out)
 }
 
-/// A material's texture with its sampler and `KHR_texture_transform`, and
-/// the TEXCOORD set it reads (the transform's `texCoord` overrides the
-/// texture info's).
+/// A material's texture, its texels times `factor`, with its sampler and
+/// `KHR_texture_transform`, as the `image` texture plugin; and the TEXCOORD
+/// set it reads (the transform's `texCoord` overrides the texture info's).
 fn texture_of(
     asset: &buffers::Asset,
     info: &gltf::texture::Info,
     asset_path: &Path,
-) -> std::result::Result<(Texture, u32), String> {
-    let t = load_texture(asset, &info.texture(), asset_path)?;
-    Ok(match info.texture_transform() {
+    factor: Rgb,
+) -> std::result::Result<(ImageTexture, u32), String> {
+    let (transform, set) = match info.texture_transform() {
         Some(x) => (
-            t.with_uv_transform(x.offset(), x.rotation(), x.scale()),
+            khr_texture_transform(x.offset(), x.rotation(), x.scale()),
             x.tex_coord().unwrap_or(info.tex_coord()),
         ),
-        None => (t, info.tex_coord()),
-    })
+        None => (UvTransform::default(), info.tex_coord()),
+    };
+    let texture = info.texture();
+    let image = texture.source();
+    let bytes = image_bytes(asset, &image, asset_path)?;
+    let stored = image_texture::decode(&bytes).map_err(|e| {
+        let mime = match image.source() {
+            gltf::image::Source::View { mime_type, .. } => Some(mime_type),
+            gltf::image::Source::Uri { mime_type, .. } => mime_type,
+        };
+        format!(
+            "image #{}{}: {e}",
+            image.index(),
+            mime.map_or(String::new(), |m| format!(" ({m})"))
+        )
+    })?;
+    let sampler = texture.sampler();
+    let wrap = |mode: gltf::texture::WrappingMode| match mode {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+    };
+    let filter = match sampler.mag_filter() {
+        Some(gltf::texture::MagFilter::Nearest) => ImageFilter::Nearest,
+        _ => ImageFilter::Bilinear,
+    };
+    // glTF colour textures are sRGB (the specification, 3.9.6).
+    let texture = ImageTexture::new(
+        stored,
+        Encoding::Srgb,
+        [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+        filter,
+        transform,
+        factor,
+    );
+    Ok((texture, set))
 }
 
-/// Decodes a texture's image: PNG or JPEG from a buffer view, a file or a
-/// data URI, with the texture's sampler.
-fn load_texture(
+/// `KHR_texture_transform` as the texture plugins' uv transform: scale,
+/// then rotate, then offset. The extension rotates by `rotation` radians
+/// counter-clockwise in its prose and examples (an offset of [0, 1],
+/// rotation pi/2 and scale 0.5 selects the image's lower left quadrant);
+/// in uv with v down that is a clockwise turn of the coordinates, so the
+/// plugins' counter-clockwise `uv_rotation` is its negative. (The
+/// extension's GLSL snippet has the sign flipped against its prose.)
+fn khr_texture_transform(offset: [f32; 2], rotation: f32, scale: [f32; 2]) -> UvTransform {
+    UvTransform {
+        uv_scale: scale.into(),
+        uv_rotation: -rotation.to_degrees(),
+        uv_offset: offset.into(),
+    }
+}
+
+/// The encoded bytes of an image: from a buffer view, a file or a data URI.
+fn image_bytes(
     asset: &buffers::Asset,
-    texture: &gltf::Texture,
+    image: &gltf::Image,
     asset_path: &Path,
-) -> std::result::Result<Texture, String> {
-    let image = texture.source();
+) -> std::result::Result<Vec<u8>, String> {
     // `Image::source` unwraps the uri when there is no buffer view, and the
     // mimeType when there is one (gltf 1.4): both are checked first.
     let json = &asset.document.as_json().images[image.index()];
@@ -237,48 +288,53 @@ fn load_texture(
         }
         _ => {}
     }
-    let (bytes, mime): (Vec<u8>, Option<&str>) = match image.source() {
-        gltf::image::Source::View { view, mime_type } => {
+    Ok(match image.source() {
+        gltf::image::Source::View { view, .. } => {
             let data = asset.buffer(view.buffer().index());
-            let range = view.offset()..view.offset().saturating_add(view.length());
-            let bytes = data.get(range).ok_or_else(|| {
-                format!(
-                    "image #{} lies past the end of buffer #{} (truncated?)",
-                    image.index(),
-                    view.buffer().index()
-                )
-            })?;
-            (bytes.to_vec(), Some(mime_type))
+            let end = view.offset().saturating_add(view.length());
+            data.get(view.offset()..end)
+                .ok_or_else(|| {
+                    format!(
+                        "image #{} lies past the end of buffer #{} (truncated?)",
+                        image.index(),
+                        view.buffer().index()
+                    )
+                })?
+                .to_vec()
         }
-        gltf::image::Source::Uri { uri, mime_type } => {
+        gltf::image::Source::Uri { uri, .. } => {
             let dir = asset_path.parent().unwrap_or(Path::new("."));
-            (
-                buffers::read_uri(uri, dir, buffers::IMAGE_FILE, None)?,
-                mime_type,
-            )
+            buffers::read_uri(uri, dir, buffers::IMAGE_FILE, None)?
         }
-    };
-    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
-    const JPEG_MAGIC: &[u8] = &[0xff, 0xd8, 0xff];
-    let decoded = if bytes.starts_with(PNG_MAGIC) {
-        Texture::from_png(&bytes)
-    } else if bytes.starts_with(JPEG_MAGIC) {
-        Texture::from_jpeg(&bytes)
-    } else {
-        return Err(format!(
-            "image #{} is {}, only PNG and JPEG are supported",
-            image.index(),
-            mime.unwrap_or("neither PNG nor JPEG")
-        ));
-    };
-    let sampler = texture.sampler();
-    let wrap = |mode: gltf::texture::WrappingMode| match mode {
-        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
-        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
-    };
-    let nearest = sampler.mag_filter() == Some(gltf::texture::MagFilter::Nearest);
-    decoded
-        .map(|t| t.with_sampler([wrap(sampler.wrap_s()), wrap(sampler.wrap_t())], nearest))
-        .map_err(|e| format!("image #{}: {e}", image.index()))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use lumis_core::{TextureQuery, Vec2};
+
+    use super::*;
+
+    #[test]
+    fn texture_transform_follows_the_extension_examples() {
+        // "utilizes only the lower left quadrant of the source image,
+        // rotated clockwise 90 degrees".
+        let t = khr_texture_transform([0.0, 1.0], std::f32::consts::FRAC_PI_2, [0.5, 0.5]);
+        for (uv, expected) in [
+            ((0.0, 0.0), (0.0, 1.0)),
+            ((1.0, 0.0), (0.0, 0.5)),
+            ((0.0, 1.0), (0.5, 1.0)),
+            ((1.0, 1.0), (0.5, 0.5)),
+        ] {
+            let got = t.apply(&TextureQuery::at(Vec2::new(uv.0, uv.1))).uv;
+            assert!(
+                (got - Vec2::new(expected.0, expected.1)).length() < 1e-6,
+                "{uv:?} -> {got}"
+            );
+        }
+        // "inverts the T axis": offset [0, 1], scale [1, -1].
+        let flip = khr_texture_transform([0.0, 1.0], 0.0, [1.0, -1.0]);
+        let got = flip.apply(&TextureQuery::at(Vec2::new(0.25, 0.25))).uv;
+        assert_eq!(got, Vec2::new(0.25, 0.75));
+    }
 }

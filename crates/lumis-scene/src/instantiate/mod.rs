@@ -7,11 +7,15 @@
 
 mod bsdf_table;
 
-use lumis_core::{Bsdf, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler};
+use lumis_core::texture::Named;
+use lumis_core::{
+    Bsdf, BsdfScope, Error, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler,
+    Texture, Textures,
+};
 
 pub(crate) use bsdf_table::BsdfTable;
 
-use crate::description::{NamedBsdf, PluginLibraries};
+use crate::description::{NamedPlugin, PluginLibraries};
 
 /// The plugins a scene names outside its shapes.
 pub(crate) struct Plugins {
@@ -22,18 +26,38 @@ pub(crate) struct Plugins {
     pub lights: Vec<Box<dyn Light>>,
 }
 
-/// Creates the `[[bsdf]]`s, `[[light]]`s, sampler and integrator.
+/// Creates the `[[texture]]`s, `[[bsdf]]`s (whose parameters may name the
+/// textures), `[[light]]`s, sampler and integrator.
 pub(crate) fn instantiate(
     registry: &Registry,
-    bsdfs: &[NamedBsdf],
+    textures: &[NamedPlugin],
+    bsdfs: &[NamedPlugin],
     lights: &[PluginEntity],
     sampler: &PluginEntity,
     integrator: &PluginEntity,
 ) -> Result<Plugins> {
-    let named = bsdfs
-        .iter()
-        .map(|b| Ok((b.name.clone(), registry.create::<dyn Bsdf>(&b.entity, ())?)))
-        .collect::<Result<Vec<_>>>()?;
+    let mut by_name = Textures::new();
+    for texture in textures {
+        let made = registry.create::<dyn Texture>(&texture.entity, ())?;
+        if !by_name.insert(texture.name.clone(), made) {
+            return Err(Error::at(
+                &texture.entity.location,
+                format!("a [[texture]] named \"{}\" already exists", texture.name),
+            ));
+        }
+    }
+    // Each BSDF may name the textures and the BSDFs declared before it.
+    let mut before = Named::<dyn Bsdf>::new();
+    let mut named = Vec::with_capacity(bsdfs.len());
+    for b in bsdfs {
+        let scope = BsdfScope {
+            textures: &by_name,
+            bsdfs: &before,
+        };
+        let made = registry.create::<dyn Bsdf>(&b.entity, scope)?;
+        before.insert(b.name.clone(), made.clone());
+        named.push((b.name.clone(), made));
+    }
     let lights = lights
         .iter()
         .map(|l| registry.create::<dyn Light>(l, &LightShape::None))

@@ -1,0 +1,117 @@
+//! The image plugin through the registry: files of each format, encodings,
+//! and the errors of bad input.
+
+use std::path::Path;
+
+use lumis_core::doc;
+use lumis_core::entity::TYPE_KEY;
+use lumis_core::{Location, PluginEntity, PluginKind, Registry, Rgb, Texture, TextureQuery, Vec2};
+
+fn registry() -> Registry {
+    let mut registry = Registry::new();
+    crate::register(&mut registry).unwrap();
+    registry
+}
+
+/// The texture a scene table of `text` (written in `dir`) describes.
+fn create(dir: &Path, text: &str) -> lumis_core::Result<std::sync::Arc<dyn Texture>> {
+    let scene = dir.join("scene.toml");
+    let table = doc::parse(text, scene.to_str().unwrap()).unwrap();
+    let entity = PluginEntity::from_table(
+        PluginKind::Texture,
+        "texture \"t\"",
+        table,
+        Location::Builtin,
+        TYPE_KEY,
+    )?;
+    registry().create::<dyn Texture>(&entity, ())
+}
+
+/// 2 x 1 PNG: 8-bit sRGB values 0 and 188 (linear 0 and 0.5029).
+fn write_png(path: &Path) {
+    lumis_image::write_rgb8_png(path, 2, 1, &[0, 0, 0, 188, 188, 188]).unwrap();
+}
+
+fn at(t: &dyn Texture, u: f32, v: f32) -> Rgb {
+    t.eval(&TextureQuery::at(Vec2::new(u, v)))
+}
+
+#[test]
+fn png_decodes_srgb_unless_told_linear() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("two.png"));
+    let srgb = create(
+        dir.path(),
+        "type = \"image\"\nfilename = \"two.png\"\nfilter = \"nearest\"\n",
+    )
+    .unwrap();
+    assert_eq!(at(&*srgb, 0.25, 0.5), Rgb::BLACK);
+    assert!((at(&*srgb, 0.75, 0.5).g - 0.502_886).abs() < 1e-5);
+    let linear = create(
+        dir.path(),
+        "type = \"image\"\nfilename = \"two.png\"\nfilter = \"nearest\"\nencoding = \"linear\"\n",
+    )
+    .unwrap();
+    assert_eq!(at(&*linear, 0.75, 0.5), Rgb::splat(188.0 / 255.0));
+}
+
+#[test]
+fn exr_is_linear_and_keeps_values_above_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut image = lumis_image::Image::new(1, 2);
+    image.set(0, 0, [2.5, 0.25, 0.0]);
+    image.set(0, 1, [0.5, 0.5, 0.5]);
+    lumis_image::write_exr(&dir.path().join("hdr.exr"), &image).unwrap();
+    let t = create(
+        dir.path(),
+        "type = \"image\"\nfilename = \"hdr.exr\"\nfilter = \"nearest\"\n",
+    )
+    .unwrap();
+    assert_eq!(at(&*t, 0.5, 0.25), Rgb::new(2.5, 0.25, 0.0));
+    assert_eq!(at(&*t, 0.5, 0.75), Rgb::splat(0.5));
+}
+
+#[test]
+fn uv_transform_applies_before_the_lookup() {
+    let dir = tempfile::tempdir().unwrap();
+    write_png(&dir.path().join("two.png"));
+    let t = create(
+        dir.path(),
+        "type = \"image\"\nfilename = \"two.png\"\nfilter = \"nearest\"\nuv_offset = [0.5, 0.0]\n",
+    )
+    .unwrap();
+    // u = 0.25 is looked up at 0.75: the second texel.
+    assert!(at(&*t, 0.25, 0.5).g > 0.5);
+}
+
+#[test]
+fn bad_files_are_errors_naming_the_key_and_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let err = create(dir.path(), "type = \"image\"\nfilename = \"missing.png\"\n")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("texture \"t\" (type = \"image\") key 'filename'")
+            && err.contains("missing.png")
+            && err.contains("cannot read the file"),
+        "{err}"
+    );
+    std::fs::write(dir.path().join("notes.png"), "not an image").unwrap();
+    let err = create(dir.path(), "type = \"image\"\nfilename = \"notes.png\"\n")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("notes.png") && err.contains("not a PNG, JPEG or EXR image"),
+        "{err}"
+    );
+    let err = create(
+        dir.path(),
+        "type = \"image\"\nfilename = \"notes.png\"\nwrap = \"tile\"\n",
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(err.contains("\"repeat\", \"mirror\", \"clamp\""), "{err}");
+}

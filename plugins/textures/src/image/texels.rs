@@ -1,0 +1,192 @@
+//! A grid of linear texels and its lookups: wrapped texel access, nearest
+//! and bilinear reconstruction (pbrt-v4 `Image::Bilerp`).
+
+use lumis_core::{ParamChoice, Rgb, Vec2};
+
+/// How coordinates outside the image map back into it (pbrt-v4
+/// `WrapMode`, Mitsuba 3's `wrap_mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum Wrap {
+    /// The image tiles the plane.
+    Repeat,
+    /// The image tiles the plane, every other copy mirrored, so edges meet.
+    Mirror,
+    /// The edge texels extend outwards.
+    Clamp,
+}
+
+impl Wrap {
+    /// The texel index that `i` refers to in a row (or column) of `n`.
+    #[inline]
+    pub fn index(self, i: i64, n: usize) -> usize {
+        let n = n as i64;
+        (match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Mirror => {
+                let m = i.rem_euclid(2 * n);
+                if m >= n {
+                    2 * n - 1 - m
+                } else {
+                    m
+                }
+            }
+            Wrap::Clamp => i.clamp(0, n - 1),
+        }) as usize
+    }
+}
+
+/// Linear RGB texels, row by row from the top (texture coordinate
+/// `(0, 0)` is the top-left corner of the image, as in glTF).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texels {
+    pub width: usize,
+    pub height: usize,
+    pub values: Vec<Rgb>,
+}
+
+impl Texels {
+    /// The texel at integer coordinates `(x, y)`, wrapped in u and in v.
+    #[inline]
+    pub fn texel(&self, x: i64, y: i64, wrap: [Wrap; 2]) -> Rgb {
+        let x = wrap[0].index(x, self.width);
+        let y = wrap[1].index(y, self.height);
+        self.values[y * self.width + x]
+    }
+
+    /// The texel that covers `uv`.
+    #[inline]
+    pub fn nearest(&self, uv: Vec2, wrap: [Wrap; 2]) -> Rgb {
+        let x = (uv.x * self.width as f32).floor() as i64;
+        let y = (uv.y * self.height as f32).floor() as i64;
+        self.texel(x, y, wrap)
+    }
+
+    /// Bilinear interpolation between the four texel centres around `uv`
+    /// (texel `(x, y)` has its centre at `((x + 1/2) / w, (y + 1/2) / h)`).
+    #[inline]
+    pub fn bilinear(&self, uv: Vec2, wrap: [Wrap; 2]) -> Rgb {
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = uv.y * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        (1.0 - fy) * ((1.0 - fx) * self.texel(x0, y0, wrap) + fx * self.texel(x0 + 1, y0, wrap))
+            + fy * ((1.0 - fx) * self.texel(x0, y0 + 1, wrap)
+                + fx * self.texel(x0 + 1, y0 + 1, wrap))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: Rgb, b: Rgb) -> bool {
+        (a - b).max_component() < 1e-6 && (b - a).max_component() < 1e-6
+    }
+
+    /// A 3 x 2 image whose texel (x, y) has red x and green y.
+    fn ramp() -> Texels {
+        Texels {
+            width: 3,
+            height: 2,
+            values: (0..2)
+                .flat_map(|y| (0..3).map(move |x| Rgb::new(x as f32, y as f32, 1.0)))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn wrap_modes_at_the_edges() {
+        let n = 3;
+        let indices = |w: Wrap| (-4..7).map(|i| w.index(i, n)).collect::<Vec<_>>();
+        assert_eq!(indices(Wrap::Repeat), [2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0]);
+        assert_eq!(indices(Wrap::Mirror), [2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0]);
+        assert_eq!(indices(Wrap::Clamp), [0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn bilinear_reproduces_texels_at_their_centres() {
+        let t = ramp();
+        for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
+            for y in 0..2 {
+                for x in 0..3 {
+                    let uv = Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 2.0);
+                    let got = t.bilinear(uv, [wrap; 2]);
+                    let want = t.values[y * 3 + x];
+                    assert!(close(got, want), "{wrap:?} {x} {y}: {got:?}");
+                    assert_eq!(t.nearest(uv, [wrap; 2]), want);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bilinear_interpolates_and_wraps_between_edges() {
+        let t = ramp();
+        // Half way between texels 0 and 1 of the top row.
+        let mid = t.bilinear(Vec2::new(1.0 / 3.0, 0.25), [Wrap::Clamp; 2]);
+        assert!((mid.r - 0.5).abs() < 1e-6 && mid.g == 0.0, "{mid:?}");
+        // At u = 0 the left neighbour is texel 2 (repeat), texel 0 (mirror,
+        // clamp): half way between the last and first column's values.
+        let u0 = Vec2::new(0.0, 0.25);
+        assert!((t.bilinear(u0, [Wrap::Repeat; 2]).r - 1.0).abs() < 1e-6);
+        assert!((t.bilinear(u0, [Wrap::Mirror; 2]).r - 0.0).abs() < 1e-6);
+        assert!((t.bilinear(u0, [Wrap::Clamp; 2]).r - 0.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn wrap_modes_apply_per_axis() {
+        // 2 x 2: red, green / blue, white.
+        let t = Texels {
+            width: 2,
+            height: 2,
+            values: vec![
+                Rgb::new(1.0, 0.0, 0.0),
+                Rgb::new(0.0, 1.0, 0.0),
+                Rgb::new(0.0, 0.0, 1.0),
+                Rgb::WHITE,
+            ],
+        };
+        let wrap = [Wrap::Clamp, Wrap::Mirror];
+        // Clamped in u: far right is the right column; mirrored in v: v in
+        // (1, 1.5) reflects to the bottom row, (1.5, 2) to the top.
+        assert_eq!(
+            t.nearest(Vec2::new(7.0, 0.2), wrap),
+            Rgb::new(0.0, 1.0, 0.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(-3.0, 1.2), wrap),
+            Rgb::new(0.0, 0.0, 1.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(0.2, 1.7), wrap),
+            Rgb::new(1.0, 0.0, 0.0)
+        );
+        // Nearest: no blend halfway between red and green.
+        assert_eq!(
+            t.nearest(Vec2::new(0.49, 0.25), wrap),
+            Rgb::new(1.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            t.nearest(Vec2::new(0.51, 0.25), wrap),
+            Rgb::new(0.0, 1.0, 0.0)
+        );
+    }
+
+    #[test]
+    fn a_constant_image_reads_its_value_everywhere() {
+        let c = Rgb::new(0.2, 0.4, 0.8);
+        let t = Texels {
+            width: 5,
+            height: 3,
+            values: vec![c; 15],
+        };
+        for i in 0..200 {
+            let uv = Vec2::new(i as f32 * 0.173 - 7.0, i as f32 * -0.291 + 3.0);
+            for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
+                let got = t.bilinear(uv, [wrap; 2]);
+                assert!(close(got, c), "{uv}: {got:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,167 @@
+//! Textures from scene files: a constant texture renders what the
+//! untextured BSDF renders, to the bit; textured parameters of a scene and
+//! their errors name the file, key and what was expected.
+
+use lumis_tests::{render_toml, scenes_dir};
+
+/// A diffuse quad filling the view under a quad light, its reflectance
+/// given by `reflectance` (with any `[[texture]]`s in `textures`).
+fn scene(textures: &str, reflectance: &str) -> String {
+    format!(
+        r#"seed = 3
+[film]
+resolution = [24, 16]
+[camera]
+type = "perspective"
+origin = [0.0, 1.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fov = 50.0
+[sampler]
+type = "sobol"
+spp = 8
+[integrator]
+type = "path"
+max_depth = 4
+{textures}
+[[bsdf]]
+name = "floor"
+type = "diffuse"
+reflectance = {reflectance}
+[[bsdf]]
+name = "black"
+type = "diffuse"
+reflectance = 0.0
+[[shape]]
+type = "quad"
+corner = [-2.0, 0.0, 2.0]
+edge_u = [4.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, -4.0]
+bsdf = "floor"
+[[shape]]
+type = "quad"
+corner = [-0.5, 2.0, 0.5]
+edge_u = [0.0, 0.0, -1.0]
+edge_v = [1.0, 0.0, 0.0]
+bsdf = "black"
+emission = {{ radiance = 5.0 }}
+"#
+    )
+}
+
+#[test]
+fn a_constant_texture_renders_the_untextured_bsdf_bit_for_bit() {
+    let plain = render_toml(&scene("", "[0.3, 0.5, 0.7]"), &[], 2);
+    let constant = render_toml(
+        &scene(
+            "[[texture]]\nname = \"c\"\ntype = \"constant\"\nvalue = [0.3, 0.5, 0.7]\n",
+            "{ texture = \"c\" }",
+        ),
+        &[],
+        2,
+    );
+    assert!(plain.image.mean()[0] > 0.0);
+    assert_eq!(plain.image.pixels, constant.image.pixels);
+    // A checkerboard of two equal colours is the same constant.
+    let checks = render_toml(
+        &scene(
+            "[[texture]]\nname = \"c\"\ntype = \"checkerboard\"\ncolor0 = [0.3, 0.5, 0.7]\ncolor1 = [0.3, 0.5, 0.7]\nuv_scale = [3.0, 3.0]\n",
+            "{ texture = \"c\" }",
+        ),
+        &[],
+        2,
+    );
+    assert_eq!(plain.image.pixels, checks.image.pixels);
+}
+
+#[test]
+fn a_checkerboard_changes_the_image_where_its_squares_are() {
+    let plain = render_toml(&scene("", "0.5"), &[], 2);
+    let checks = render_toml(
+        &scene(
+            "[[texture]]\nname = \"c\"\ntype = \"checkerboard\"\ncolor0 = 0.5\ncolor1 = 0.1\n",
+            "{ texture = \"c\" }",
+        ),
+        &[],
+        2,
+    );
+    let darker = plain
+        .image
+        .pixels
+        .iter()
+        .zip(&checks.image.pixels)
+        .filter(|(p, c)| c[1] < p[1])
+        .count();
+    // The quad fills most of the view; about half of it is color1.
+    let n = plain.image.pixels.len();
+    assert!(darker > n / 5 && darker < 4 * n / 5, "{darker} of {n}");
+}
+
+fn load_error(toml: &str) -> String {
+    let registry = lumis_cli::builtin_registry().unwrap();
+    match lumis_scene::load_str(toml, "bad.toml", "bad", &scenes_dir(), &[], &registry) {
+        Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn bad_texture_references_are_located_errors() {
+    let err = load_error(&scene("", "{ texture = \"wood\" }"));
+    assert!(
+        err.starts_with("bad.toml:")
+            && err.contains("bsdf \"floor\" (type = \"diffuse\") key 'reflectance'")
+            && err.contains("unknown texture \"wood\"; the scene declares no [[texture]]"),
+        "{err}"
+    );
+    let err = load_error(&scene(
+        "[[texture]]\nname = \"a\"\ntype = \"constant\"\nvalue = 1\n[[texture]]\nname = \"a\"\ntype = \"constant\"\nvalue = 1\n",
+        "0.5",
+    ));
+    assert!(
+        err.contains("a [[texture]] named \"a\" already exists"),
+        "{err}"
+    );
+    let err = load_error(&scene(
+        "[[texture]]\nname = \"img\"\ntype = \"image\"\nfilename = \"no-such-image.png\"\n",
+        "{ texture = \"img\" }",
+    ));
+    assert!(
+        err.contains("texture \"img\" (type = \"image\") key 'filename'")
+            && err.contains("no-such-image.png")
+            && err.contains("cannot read the file"),
+        "{err}"
+    );
+    // A light's radiance takes no texture.
+    let err = load_error(&scene("", "0.5").replace(
+        "emission = { radiance = 5.0 }",
+        "emission = { radiance = { texture = \"c\" } }",
+    ));
+    assert!(
+        err.contains("'radiance'") && err.contains("this parameter takes no texture"),
+        "{err}"
+    );
+    let err = load_error(&scene(
+        "[[texture]]\ntype = \"constant\"\nvalue = 1\n",
+        "0.5",
+    ));
+    assert!(
+        err.contains("[[texture]] #1 needs a name = \"...\" that BSDF parameters refer to"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_example_scene_loads() {
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let text = lumis_tests::read_scene("textured-quads.toml");
+    let path = scenes_dir().join("textured-quads.toml");
+    lumis_scene::load_str(
+        &text,
+        path.to_str().unwrap(),
+        "textured-quads",
+        &scenes_dir(),
+        &[],
+        &registry,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
