@@ -169,7 +169,15 @@ fn missing_obj_file_and_unknown_bsdf_name() {
     let err = load(&with(
         "[[shape]]\ntype = \"obj\"\nfile = \"nope.obj\"\nbsdf = \"white\"\n",
     ));
-    assert_contains(&err, &["bad.toml:19:8", "cannot load OBJ", "nope.obj"]);
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:19:8",
+            "cannot read OBJ mesh",
+            "nope.obj",
+            "No such file",
+        ],
+    );
     let err = load(&with(
         "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"whte\"\n",
     ));

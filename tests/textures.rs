@@ -145,7 +145,7 @@ fn bad_texture_references_are_located_errors() {
         "0.5",
     ));
     assert!(
-        err.contains("[[texture]] #1 needs a name = \"...\" that BSDF parameters refer to"),
+        err.contains("[[texture]] #0 needs a name = \"...\" that BSDF parameters refer to"),
         "{err}"
     );
 }

@@ -916,10 +916,7 @@ mod tests {
             .filter(|&v| v != 1e-4 && v != 1.0)
             .collect();
         assert_eq!(inside.len(), INTERIOR_VALUES, "{inside:?}");
-        assert!(
-            inside.iter().all(|&v| 1e-4 < v && v < 1.0),
-            "{inside:?}"
-        );
+        assert!(inside.iter().all(|&v| 1e-4 < v && v < 1.0), "{inside:?}");
         let again: Vec<String> = parameter_sweep(&SPEC)
             .unwrap()
             .into_iter()

@@ -14,6 +14,11 @@ pub const MIB: u64 = 1 << 20;
 /// One gibibyte.
 pub const GIB: u64 = 1 << 30;
 
+/// A texture image (PNG, JPEG, EXR), a file of its own or inside an
+/// asset: far above any a renderer can hold (a 16k x 16k float EXR is
+/// 3 GiB).
+pub const IMAGE_FILE: FileKind = FileKind::new("image", 4 * GIB);
+
 /// What kind of file is read, named in messages, with its size bound.
 #[derive(Debug, Clone, Copy)]
 pub struct FileKind {

@@ -18,8 +18,6 @@ const GLTF_FILE: FileKind = FileKind::new("glTF asset", 4 * GIB);
 /// An external buffer: read up to its declared `byteLength` (a file may
 /// carry padding past it), which may not pass this.
 const BUFFER_FILE: FileKind = FileKind::new("glTF buffer", 16 * GIB);
-/// Images a material names: far above any texture a renderer can hold.
-pub(crate) const IMAGE_FILE: FileKind = FileKind::new("glTF image", GIB);
 
 /// A parsed and validated glTF document with its buffer data.
 pub(crate) struct Asset {

@@ -7,6 +7,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
+use lumis_core::files::IMAGE_FILE;
 use lumis_core::{Error, PluginEntity, Result, Rgb, Texture, Textures, UvTransform};
 use lumis_textures::image::{self as image_texture, Encoding, ImageFilter, ImageTexture, Wrap};
 
@@ -304,7 +305,7 @@ fn image_bytes(
         }
         gltf::image::Source::Uri { uri, .. } => {
             let dir = asset_path.parent().unwrap_or(Path::new("."));
-            buffers::read_uri(uri, dir, buffers::IMAGE_FILE, None)?
+            buffers::read_uri(uri, dir, IMAGE_FILE, None)?
         }
     })
 }

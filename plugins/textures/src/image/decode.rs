@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use lumis_core::files::{read_bounded, IMAGE_FILE};
 use lumis_core::Rgb;
 
 /// An image as stored: its texel values before any decoding of their
@@ -23,7 +24,7 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 /// Reads `path`; the message says what failed, not which file (the caller
 /// names it).
 pub fn read(path: &Path) -> Result<Stored, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("cannot read the file: {e}"))?;
+    let bytes = read_bounded(path, IMAGE_FILE).map_err(|e| format!("cannot read the file: {e}"))?;
     if bytes.starts_with(EXR_MAGIC) {
         return exr(path);
     }
