@@ -91,6 +91,22 @@ type MakeLightSampler =
     Arc<dyn Fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>> + Send + Sync>;
 type MakeIntegrator = Arc<dyn Fn(&Params) -> Result<Box<dyn Integrator>> + Send + Sync>;
 
+/// A factory as the registry keeps it: the plugin's own function for a
+/// built-in, or, while a library registers, a closure that calls it under
+/// the library's guard and guards what it makes (boxed by `$boxed`).
+macro_rules! registered {
+    ($registry:ident, $factory:ident, $boxed:path, |$params:ident $(, $input:ident: $ty:ty)?|) => {
+        match $registry.guard.clone() {
+            None => Arc::new($factory),
+            Some(guard) => Arc::new(move |$params: &Params $(, $input: $ty)?| {
+                guarded(&guard, $params, || $factory($params $(, $input)?), |made, guard, label| {
+                    $boxed(Guarded::new(made, guard, label))
+                })
+            }),
+        }
+    };
+}
+
 /// Calls a loaded plugin's `factory` under `guard`, and guards what it
 /// makes. Labels the plugin with its table as written, for messages.
 fn guarded<M>(
@@ -191,70 +207,30 @@ impl Registry {
     }
 
     // In a library's registration, each `add_*` below runs in the
-    // library's own copy of this code, so the closures it makes, and their
-    // `catch_unwind`, are the library's (see `crate::guard`).
+    // library's own copy of this code, so the closures `registered!` makes,
+    // and their `catch_unwind`, are the library's (see `crate::guard`).
 
     pub fn add_sampler(&mut self, spec: PluginSpec, factory: SamplerFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Sampler)?;
-        let make: MakeSampler = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params),
-                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeSampler = registered!(self, factory, Box::new, |params|);
         self.add(spec, Factory::Sampler(make))
     }
 
     pub fn add_texture(&mut self, spec: PluginSpec, factory: TextureFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Texture)?;
-        let make: MakeTexture = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params),
-                    |made, guard, label| Arc::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeTexture = registered!(self, factory, Arc::new, |params|);
         self.add(spec, Factory::Texture(make))
     }
 
     pub fn add_bsdf(&mut self, spec: PluginSpec, factory: BsdfFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Bsdf)?;
-        let make: MakeBsdf = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params),
-                    |made, guard, label| Arc::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeBsdf = registered!(self, factory, Arc::new, |params|);
         self.add(spec, Factory::Bsdf(make))
     }
 
     pub fn add_light(&mut self, spec: PluginSpec, factory: LightFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Light)?;
-        let make: MakeLight = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params, shape: &LightShape| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params, shape),
-                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeLight = registered!(self, factory, Box::new, |params, shape: &LightShape|);
         self.add(spec, Factory::Light(make))
     }
 
@@ -264,33 +240,14 @@ impl Registry {
         factory: LightSamplerFactory,
     ) -> Result<()> {
         Self::check_kind(&spec, PluginKind::LightSampler)?;
-        let make: MakeLightSampler = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params, lights: &[Box<dyn Light>]| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params, lights),
-                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeLightSampler =
+            registered!(self, factory, Box::new, |params, lights: &[Box<dyn Light>]|);
         self.add(spec, Factory::LightSampler(make))
     }
 
     pub fn add_integrator(&mut self, spec: PluginSpec, factory: IntegratorFactory) -> Result<()> {
         Self::check_kind(&spec, PluginKind::Integrator)?;
-        let make: MakeIntegrator = match self.guard.clone() {
-            None => Arc::new(factory),
-            Some(guard) => Arc::new(move |params: &Params| {
-                guarded(
-                    &guard,
-                    params,
-                    || factory(params),
-                    |made, guard, label| Box::new(Guarded::new(made, guard, label)),
-                )
-            }),
-        };
+        let make: MakeIntegrator = registered!(self, factory, Box::new, |params|);
         self.add(spec, Factory::Integrator(make))
     }
 
