@@ -29,6 +29,22 @@ pub struct ImageMetadata {
 
 const PREFIX: &str = "lumis.";
 
+/// Why saved work (a reference, a checkpoint) rendered from `saved_hash`
+/// and `saved_seed` cannot be continued with this scene and seed, or
+/// `None` when it can.
+pub fn other_scene_or_seed(
+    (saved_hash, saved_seed): (u64, u64),
+    scene_hash: u64,
+    seed: u64,
+) -> Option<String> {
+    if saved_hash != scene_hash {
+        return Some(format!(
+            "it was rendered from a different scene (scene hash {saved_hash:016x}, this scene {scene_hash:016x}: the scene, a file it names or a --set differs)"
+        ));
+    }
+    (saved_seed != seed).then(|| format!("it was rendered from seed {saved_seed}, not {seed}"))
+}
+
 impl ImageMetadata {
     /// The header attributes, `(name, value)`.
     pub fn attributes(&self) -> Vec<(String, String)> {

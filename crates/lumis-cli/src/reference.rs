@@ -10,7 +10,7 @@ use lumis_core::{Error, Registry, Result};
 use lumis_image::{read_exr, Image};
 use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, RenderProgress};
 
-use crate::metadata::{lumis_version, ImageMetadata};
+use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
 use crate::render::{load, output_paths, RenderArgs};
 
@@ -55,17 +55,8 @@ fn reason_to_keep(
             existing.command
         ));
     }
-    if existing.scene_hash != scene_hash {
-        return Some(format!(
-            "it was rendered from a different scene (scene hash {:016x}, this scene {scene_hash:016x}: the scene, a file it names or a --set differs)",
-            existing.scene_hash
-        ));
-    }
-    if existing.seed != seed {
-        return Some(format!(
-            "it was rendered from seed {}, not {seed}",
-            existing.seed
-        ));
+    if let Some(why) = other_scene_or_seed((existing.scene_hash, existing.seed), scene_hash, seed) {
+        return Some(why);
     }
     if existing.spp > args.spp {
         return Some(format!(

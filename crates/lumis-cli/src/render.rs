@@ -12,7 +12,7 @@ use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, R
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
-use crate::metadata::{lumis_version, ImageMetadata};
+use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
 
 /// What `lumis render` was asked to do; also its command-line flags.
@@ -248,17 +248,8 @@ fn starting_state(
             saved.film.samples
         )));
     }
-    if saved.scene_hash != scene_hash {
-        return refuse(format!(
-            "it was rendered from a different scene (scene hash {:016x}, this scene {scene_hash:016x}: the scene, a file it names or a --set differs)",
-            saved.scene_hash
-        ));
-    }
-    if saved.seed != seed {
-        return refuse(format!(
-            "it was rendered with seed {}, not {seed}",
-            saved.seed
-        ));
+    if let Some(why) = other_scene_or_seed((saved.scene_hash, saved.seed), scene_hash, seed) {
+        return refuse(why);
     }
     if (saved.film.width as u32, saved.film.height as u32) != (resolution.x, resolution.y) {
         return refuse(format!(
