@@ -12,6 +12,7 @@ pub mod bsdf_suite;
 pub mod chi_square;
 pub mod lobe_zoom;
 pub mod quadrature;
+pub mod sweep;
 pub mod uniformity;
 
 pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
