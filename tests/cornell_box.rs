@@ -214,7 +214,7 @@ fn stored_flat_frames_match_frames_computed_at_the_hit() {
             flipped_hits += usize::from((a.n() + quad_normal).length() < 1e-5);
             assert_eq!(a.point.p, b.point.p);
             assert_eq!(a.point.p_error, b.point.p_error);
-            assert_eq!((a.light, a.uv), (b.light, b.uv));
+            assert_eq!((a.light, a.texture), (b.light, b.texture));
             assert!((a.n() - b.n()).length() < 1e-6, "{ray:?}");
             assert!(
                 close(a.shading.x, b.shading.x)

@@ -165,3 +165,83 @@ fn the_example_scene_loads() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// A floor receding to the horizon under a white sky, its reflectance an
+/// image repeated 1024 times, lit so that each pixel is exactly its
+/// texture's value (one bounce, cosine-sampled diffuse). A pixel there
+/// covers several repeats of the image, so at one sample per pixel a
+/// bilinear lookup picks one texel and aliases, while the
+/// filters driven by the camera's pixel footprint average the texels the
+/// pixel covers.
+fn receding_floor(filter: &str) -> Vec<f32> {
+    let image = scenes_dir().join("textures/quadrants.png");
+    let image = image.display();
+    let toml = format!(
+        r#"seed = 1
+[film]
+resolution = [48, 32]
+[camera]
+type = "perspective"
+origin = [0.0, 0.5, 0.0]
+target = [0.0, 0.45, -1.0]
+fov = 40.0
+[sampler]
+type = "independent"
+spp = 1
+[integrator]
+type = "path"
+max_depth = 2
+strategy = "bsdf"
+[[texture]]
+name = "tiles"
+type = "image"
+filename = "{image}"
+filter = "{filter}"
+uv_scale = [1024.0, 1024.0]
+[[bsdf]]
+name = "floor"
+type = "diffuse"
+reflectance = {{ texture = "tiles" }}
+[[shape]]
+type = "quad"
+corner = [-50.0, 0.0, 1.0]
+edge_u = [100.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, -100.0]
+bsdf = "floor"
+[[light]]
+type = "constant"
+radiance = 1.0
+"#
+    );
+    let out = render_toml(&toml, &[], 2);
+    // The far floor: the rows just below the horizon.
+    let (w, h) = (out.image.width, out.image.height);
+    (h / 2 + 2..h / 2 + 8)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| out.image.pixels[y * w + x][1])
+        .collect()
+}
+
+fn mean_and_variance(v: &[f32]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let mean = v.iter().map(|&x| x as f64).sum::<f64>() / n;
+    let var = v.iter().map(|&x| (x as f64 - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, var)
+}
+
+#[test]
+fn the_pixel_footprint_filters_distant_texels() {
+    let (bilinear_mean, bilinear_var) = mean_and_variance(&receding_floor("bilinear"));
+    for filter in ["trilinear", "ewa"] {
+        let (mean, var) = mean_and_variance(&receding_floor(filter));
+        // The same average colour, without the aliasing.
+        assert!(
+            var < 0.01 * bilinear_var && bilinear_var > 0.0,
+            "{filter}: variance {var} against bilinear's {bilinear_var} (means {mean}, {bilinear_mean})"
+        );
+        assert!(
+            (mean - bilinear_mean).abs() < 4.0 * (bilinear_var / 288.0).sqrt(),
+            "{filter}: mean {mean} against bilinear's {bilinear_mean}"
+        );
+    }
+}

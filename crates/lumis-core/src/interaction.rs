@@ -2,11 +2,12 @@
 
 use std::num::NonZeroU32;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use crate::bsdf::{Bsdf, BsdfFlags};
 use crate::math::Frame;
 use crate::ray::{Ray, SurfacePoint};
+use crate::texture::TextureQuery;
 
 /// A ray-surface intersection, ready for shading.
 #[derive(Clone, Copy)]
@@ -16,9 +17,9 @@ pub struct SurfaceInteraction<'a> {
     pub point: SurfacePoint,
     /// Shading frame; `z` is the shading normal, on the same side as `point.n`.
     pub shading: Frame,
-    pub uv: Vec2,
-    /// Unit direction back along the incoming ray, in world space.
-    pub wo: Vec3,
+    /// The texture coordinates and, when the scene knows the camera, how
+    /// they change from pixel to pixel ([`crate::footprint`]).
+    pub texture: TextureQuery,
     pub bsdf: &'a dyn Bsdf,
     /// `bsdf.flags()`, read once when the scene was built: every path vertex
     /// asks whether it may sample lights, and the answer never changes.

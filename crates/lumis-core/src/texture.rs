@@ -10,36 +10,51 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
+use crate::footprint::PackedFootprint;
 use crate::spectrum::Rgb;
 
 /// Where a texture is looked up: the hit's texture coordinates and, when the
-/// camera ray carried differentials, how they change from one pixel to the
-/// next (pbrt-v4 `TextureEvalContext`: `uv`, `dudx`, `dudy`, `dvdx`, `dvdy`).
-/// Zero derivatives mean "no footprint known": a filtered texture then does
-/// a bilinear lookup.
+/// scene knows the camera, how they change from one pixel to the next
+/// (pbrt-v4 `TextureEvalContext`: `uv`, `dudx`, `dudy`, `dvdx`, `dvdy`;
+/// [`crate::footprint`] says where they come from). No footprint means a
+/// filtered texture does a bilinear lookup.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TextureQuery {
     pub uv: Vec2,
-    /// `(du/dx, dv/dx)`: the change of `uv` one pixel to the right.
-    pub duv_dx: Vec2,
-    /// `(du/dy, dv/dy)`: the change of `uv` one pixel down.
-    pub duv_dy: Vec2,
+    /// The derivatives, packed; [`TextureQuery::derivatives`] unpacks them.
+    pub footprint: PackedFootprint,
 }
 
 impl TextureQuery {
     /// A lookup at `uv` without a footprint.
+    #[inline]
     pub const fn at(uv: Vec2) -> Self {
         Self {
             uv,
-            duv_dx: Vec2::ZERO,
-            duv_dy: Vec2::ZERO,
+            footprint: PackedFootprint::NONE,
         }
+    }
+
+    /// A lookup at `uv` whose coordinates change by `duv_dx` one pixel to
+    /// the right and by `duv_dy` one pixel down.
+    #[inline]
+    pub fn new(uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Self {
+        Self {
+            uv,
+            footprint: PackedFootprint::new(duv_dx, duv_dy),
+        }
+    }
+
+    /// `(du/dx, dv/dx)` and `(du/dy, dv/dy)`.
+    #[inline]
+    pub fn derivatives(&self) -> (Vec2, Vec2) {
+        self.footprint.unpack()
     }
 
     /// Whether the query has a footprint to filter over.
     #[inline]
     pub fn has_footprint(&self) -> bool {
-        self.duv_dx != Vec2::ZERO || self.duv_dy != Vec2::ZERO
+        self.footprint != PackedFootprint::NONE
     }
 }
 
@@ -204,11 +219,12 @@ impl UvTransform {
             return *query;
         }
         let m = self.matrix();
-        TextureQuery {
-            uv: m * query.uv + self.uv_offset,
-            duv_dx: m * query.duv_dx,
-            duv_dy: m * query.duv_dy,
+        let uv = m * query.uv + self.uv_offset;
+        if !query.has_footprint() {
+            return TextureQuery::at(uv);
         }
+        let (dx, dy) = query.derivatives();
+        TextureQuery::new(uv, m * dx, m * dy)
     }
 }
 
@@ -223,11 +239,7 @@ mod tests {
             uv_rotation: 90.0,
             uv_offset: Vec2::new(0.5, 0.25),
         };
-        let q = TextureQuery {
-            uv: Vec2::new(1.0, 1.0),
-            duv_dx: Vec2::new(1.0, 0.0),
-            duv_dy: Vec2::ZERO,
-        };
+        let q = TextureQuery::new(Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::ZERO);
         let out = t.apply(&q);
         // (2, 3) rotated by 90 degrees is (-3, 2); then offset.
         assert!(
@@ -236,7 +248,10 @@ mod tests {
         );
         // The footprint is scaled and rotated, not offset.
         assert!(
-            (out.duv_dx - Vec2::new(0.0, 2.0)).abs().max_element() < 1e-6,
+            (out.derivatives().0 - Vec2::new(0.0, 2.0))
+                .abs()
+                .max_element()
+                < 1e-6,
             "{out:?}"
         );
         assert_eq!(UvTransform::default().apply(&q), q);

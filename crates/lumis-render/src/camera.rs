@@ -1,7 +1,7 @@
 //! A pinhole perspective camera.
 
 use lumis_core::glam::Vec3A;
-use lumis_core::{Error, Ray, Result, UVec2, Vec2, Vec3};
+use lumis_core::{Error, PixelFootprint, Ray, Result, UVec2, Vec2, Vec3};
 
 /// A pinhole camera at `origin` looking at `target`. `fov` is the full
 /// angle of the image's smaller axis (the vertical one for landscape and
@@ -85,6 +85,21 @@ impl PerspectiveCamera {
         self.resolution
     }
 
+    /// The pixel spacing textures filter over, at `spp` samples per pixel
+    /// ([`PixelFootprint`]).
+    pub fn pixel_footprint(&self, spp: u32) -> PixelFootprint {
+        let centre = self.top_left
+            + 0.5 * self.resolution.x as f32 * self.per_pixel_x
+            + 0.5 * self.resolution.y as f32 * self.per_pixel_y;
+        PixelFootprint {
+            origin: self.origin,
+            forward: centre.normalize().into(),
+            per_pixel_x: self.per_pixel_x.into(),
+            per_pixel_y: self.per_pixel_y.into(),
+            scale: PixelFootprint::spp_scale(spp),
+        }
+    }
+
     /// The ray through film position `pixel + offset` (offset in `[0,1)^2`;
     /// pixel (0, 0) is the top-left corner).
     #[inline]
@@ -119,6 +134,19 @@ mod tests {
         let corner = c.generate_ray(UVec2::ZERO, Vec2::ZERO);
         let expected = Vec3::new(-2.0, 1.0, -1.0).normalize();
         assert!((corner.d - expected).length() < 1e-6, "{:?}", corner.d);
+    }
+
+    /// The footprint's image plane is the one rays go through: a point one
+    /// unit ahead on the view axis moves by one pixel's width.
+    #[test]
+    fn the_footprint_steps_one_pixel() {
+        let c = camera();
+        let f = c.pixel_footprint(1);
+        assert!((f.forward - Vec3::NEG_Z).length() < 1e-6);
+        let a = c.generate_ray(UVec2::new(2, 1), Vec2::ZERO).d;
+        let b = c.generate_ray(UVec2::new(3, 1), Vec2::ZERO).d;
+        let (dx, _) = f.dp_dxy(c.origin + a, Vec3::Z);
+        assert!((dx - (b / b.z.abs() - a)).length() < 1e-6, "{dx}");
     }
 
     #[test]

@@ -114,7 +114,13 @@ pub fn load_str(
         counts: assembled.counts,
         report: assembled.report,
         packets: description.accel.packets,
-    };
+        footprint: None,
+    }
+    .with_footprint(
+        description
+            .camera
+            .pixel_footprint(plugins.sampler.samples_per_pixel()),
+    );
     Ok(LoadedScene {
         name: name.to_string(),
         scene,

@@ -6,7 +6,8 @@ use lumis_core::glam::{Mat3, Vec3A, Vec4};
 use lumis_core::math::{gamma, Frame};
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Bsdf, BsdfFlags, Light, LightIndex, LightSampler, Ray, Scene, SurfaceInteraction, Vec2, Vec3,
+    Bsdf, BsdfFlags, Light, LightIndex, LightSampler, PixelFootprint, Ray, Scene,
+    SurfaceInteraction, TextureQuery, Vec2, Vec3,
 };
 use lumis_embree::{Hit, PacketWidth, Packets, PaddedBuffer, Triangle, Vertex, INVALID_ID};
 
@@ -185,9 +186,29 @@ pub struct RenderScene {
     /// `[accel] packets`: every ray of a batch in packets, not only camera
     /// rays ([`Scene::intersect_batch`]).
     pub(crate) packets: bool,
+    /// The camera's pixel footprint, which gives hits on surfaces with
+    /// texture coordinates the uv footprint their textures filter over.
+    pub(crate) footprint: Option<PixelFootprint>,
 }
 
 impl RenderScene {
+    /// Gives hits on surfaces with texture coordinates the pixel footprint
+    /// of `camera` (none in a scene without texture coordinates, whose
+    /// hits then carry no footprint work).
+    pub(crate) fn with_footprint(mut self, camera: PixelFootprint) -> Self {
+        let has_uvs = |mesh: &MeshData| mesh.uvs.is_some();
+        let any_uvs = self.geometries.iter().any(|g| match g {
+            Geometry::Mesh(mesh) => has_uvs(mesh),
+            Geometry::Instance { prototype, .. } => self.prototypes[*prototype as usize]
+                .meshes
+                .iter()
+                .any(has_uvs),
+            Geometry::Sphere { .. } => true,
+        });
+        self.footprint = any_uvs.then_some(camera);
+        self
+    }
+
     pub fn counts(&self) -> &SceneCounts {
         &self.counts
     }
@@ -236,6 +257,23 @@ impl RenderScene {
         bounding_sphere(&self.embree)
     }
 
+    /// The texture lookup at `uv` on `point`, with a footprint where the
+    /// camera and the surface's `dp/du`, `dp/dv` give one.
+    #[inline(always)]
+    fn texture_query(
+        &self,
+        uv: Vec2,
+        point: &SurfacePoint,
+        dp_duv: Option<(Vec3, Vec3)>,
+    ) -> TextureQuery {
+        match (&self.footprint, dp_duv) {
+            (Some(footprint), Some((dpdu, dpdv))) => {
+                footprint.query(uv, point.p, point.n, dpdu, dpdv)
+            }
+            _ => TextureQuery::at(uv),
+        }
+    }
+
     /// The interaction at `point` with shading frame `shading` on a surface
     /// of scene BSDF `bsdf`.
     #[inline(always)]
@@ -243,8 +281,7 @@ impl RenderScene {
         &self,
         point: SurfacePoint,
         shading: Frame,
-        uv: Vec2,
-        wo: Vec3,
+        texture: TextureQuery,
         bsdf: u32,
         light: Option<LightIndex>,
     ) -> SurfaceInteraction<'_> {
@@ -252,8 +289,7 @@ impl RenderScene {
         SurfaceInteraction {
             point,
             shading,
-            uv,
-            wo,
+            texture,
             bsdf: bsdf.bsdf.as_ref(),
             bsdf_flags: bsdf.flags,
             light,
@@ -363,7 +399,7 @@ impl RenderScene {
 
     /// A hit inside an instance: shaded in object space, then placed.
     #[inline]
-    fn instance_hit(&self, hit: &Hit, wo: Vec3) -> SurfaceInteraction<'_> {
+    fn instance_hit(&self, hit: &Hit) -> SurfaceInteraction<'_> {
         let Geometry::Instance {
             prototype,
             placement,
@@ -373,7 +409,7 @@ impl RenderScene {
             unreachable!("inst_id names an instance geometry")
         };
         let mesh = &self.prototypes[*prototype as usize].meshes[hit.geom_id as usize];
-        let (local, local_shading, uv) = mesh_hit(mesh, hit);
+        let (local, local_shading, uv, dp_duv) = mesh_hit(mesh, hit, self.footprint.is_some());
         let (p, p_error) = placement.point(local.p, local.p_error);
         let n = placement.normal(local.n);
         let ns = placement.normal(local_shading.normal());
@@ -382,21 +418,22 @@ impl RenderScene {
             .get(hit.geom_id as usize)
             .and_then(|l| l.get(hit.prim_id as usize))
             .and_then(|&i| LightIndex::new(i));
-        self.interaction(
-            SurfacePoint { p, p_error, n },
-            Frame::from_z(ns),
-            uv,
-            wo,
-            mesh.bsdf,
-            light,
-        )
+        let point = SurfacePoint { p, p_error, n };
+        let dp_duv = dp_duv.map(|(u, v)| (placement.linear * u, placement.linear * v));
+        let texture = self.texture_query(uv, &point, dp_duv);
+        self.interaction(point, Frame::from_z(ns), texture, mesh.bsdf, light)
     }
 }
 
-/// The hit point (recomputed from barycentrics, with its error bound), the
-/// shading frame on a mesh, in the mesh's own space, and the uv.
+/// What a hit on a mesh gives shading, in the mesh's own space: the point
+/// (recomputed from barycentrics, with its error bound), the shading
+/// frame, the uv and, when asked for and the mesh has uvs, `dp/du` and
+/// `dp/dv`.
+type MeshHit = (SurfacePoint, Frame, Vec2, Option<(Vec3, Vec3)>);
+
+/// The [`MeshHit`] of `hit`; `dp_duv` asks for the uv derivatives.
 #[inline(always)]
-fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
+fn mesh_hit(mesh: &MeshData, hit: &Hit, dp_duv: bool) -> MeshHit {
     let tri = mesh.indices[hit.prim_id as usize];
     // Each vertex in one 16-byte load, and the arithmetic below on SIMD
     // lanes: with 12-byte `Vec3`s it takes three times the instructions.
@@ -410,6 +447,7 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
     let (q0, q1, q2) = (p0 * b0, p1 * b1, p2 * b2);
     let p = Vec3::from(q0 + q1 + q2);
     let p_error = Vec3::from(gamma(7) * (q0.abs() + q1.abs() + q2.abs()));
+    let (uv, derivatives) = mesh_uv(mesh, tri, [b0, b1, b2], [p0, p1, p2], dp_duv);
     // A flat triangle's frame, where the scene stored it.
     if let Some(&frame) = mesh.flat_frames.get(hit.prim_id as usize) {
         return (
@@ -419,7 +457,8 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
                 n: frame.normal(),
             },
             frame,
-            mesh_uv(mesh, tri, b0, b1, b2),
+            uv,
+            derivatives,
         );
     }
     // Embree's geometric normal is (p1 - p0) x (p2 - p0), unnormalised, in
@@ -441,20 +480,37 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit) -> (SurfacePoint, Frame, Vec2) {
         }
         None => n,
     };
-    let uv = mesh_uv(mesh, tri, b0, b1, b2);
-    (SurfacePoint { p, p_error, n }, Frame::from_z(ns), uv)
+    (
+        SurfacePoint { p, p_error, n },
+        Frame::from_z(ns),
+        uv,
+        derivatives,
+    )
 }
 
-/// The uv at barycentrics `(b0, b1, b2)` of triangle `tri`: interpolated
-/// texture coordinates, else the barycentrics themselves.
+/// The uv at barycentrics `b` of triangle `tri` (vertices `p`):
+/// interpolated texture coordinates, else the barycentrics themselves;
+/// with `dp_duv`, also the triangle's `dp/du` and `dp/dv` where its uvs
+/// are not degenerate.
 #[inline(always)]
-fn mesh_uv(mesh: &MeshData, tri: Triangle, b0: f32, b1: f32, b2: f32) -> Vec2 {
+fn mesh_uv(
+    mesh: &MeshData,
+    tri: Triangle,
+    [b0, b1, b2]: [f32; 3],
+    p: [Vec3A; 3],
+    dp_duv: bool,
+) -> (Vec2, Option<(Vec3, Vec3)>) {
     match &mesh.uvs {
         Some(uvs) => {
-            let [t0, t1, t2] = tri.map(|i| uvs[i as usize]);
-            t0 * b0 + t1 * b1 + t2 * b2
+            let t = tri.map(|i| uvs[i as usize]);
+            let derivatives = if dp_duv {
+                lumis_core::footprint::triangle_dp_duv(p.map(Vec3::from), t)
+            } else {
+                None
+            };
+            (t[0] * b0 + t[1] * b1 + t[2] * b2, derivatives)
         }
-        None => Vec2::new(b1, b2),
+        None => (Vec2::new(b1, b2), None),
     }
 }
 
@@ -462,18 +518,18 @@ impl RenderScene {
     /// The interaction where `ray` found `hit`.
     #[inline(always)]
     fn interaction_at(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction<'_> {
-        let wo = -ray.d;
         if hit.inst_id != INVALID_ID {
-            return self.instance_hit(hit, wo);
+            return self.instance_hit(hit);
         }
         match &self.geometries[hit.geom_id as usize] {
             Geometry::Mesh(mesh) => {
-                let (point, shading, uv) = mesh_hit(mesh, hit);
+                let (point, shading, uv, dp_duv) = mesh_hit(mesh, hit, self.footprint.is_some());
                 let light = mesh
                     .lights
                     .get(hit.prim_id as usize)
                     .and_then(|&i| LightIndex::new(i));
-                self.interaction(point, shading, uv, wo, mesh.bsdf, light)
+                let texture = self.texture_query(uv, &point, dp_duv);
+                self.interaction(point, shading, texture, mesh.bsdf, light)
             }
             Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
             Geometry::Sphere {
@@ -496,17 +552,33 @@ impl RenderScene {
                     (phi * 0.5 * std::f32::consts::FRAC_1_PI).rem_euclid(1.0),
                     outward.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
                 );
+                let point = SurfacePoint { p, p_error, n };
+                let dp_duv = self.footprint.is_some().then(|| sphere_dp_duv(local, phi));
+                let texture = self.texture_query(uv, &point, dp_duv);
                 self.interaction(
-                    SurfacePoint { p, p_error, n },
+                    point,
                     Frame::from_z(n),
-                    uv,
-                    wo,
+                    texture,
                     *bsdf,
                     light.and_then(LightIndex::new),
                 )
             }
         }
     }
+}
+
+/// `dp/du` and `dp/dv` of a sphere at `local` (relative to its centre),
+/// azimuth `phi`, for `u = phi / 2 pi` and `v = theta / pi` (pbrt-v4
+/// `Sphere::InteractionFromIntersection`, with its full ranges of phi and
+/// theta).
+#[inline]
+fn sphere_dp_duv(local: Vec3, phi: f32) -> (Vec3, Vec3) {
+    use std::f32::consts::PI;
+    let dpdu = 2.0 * PI * Vec3::new(-local.y, local.x, 0.0);
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let rho = local.truncate().length();
+    let dpdv = PI * Vec3::new(local.z * cos_phi, local.z * sin_phi, -rho);
+    (dpdu, dpdv)
 }
 
 impl Scene for RenderScene {
@@ -770,6 +842,7 @@ mod tests {
             counts: SceneCounts::default(),
             report: LoadReport::default(),
             packets,
+            footprint: None,
         }
     }
 
@@ -816,8 +889,7 @@ mod tests {
             && close(a.point.n, b.point.n)
             && close(a.shading.z.into(), b.shading.z.into())
             && close(a.shading.x.into(), b.shading.x.into())
-            && (a.uv - b.uv).abs().max_element() <= 1e-4
-            && a.wo == b.wo
+            && (a.texture.uv - b.texture.uv).abs().max_element() <= 1e-4
             && std::ptr::addr_eq(a.bsdf, b.bsdf)
             && a.bsdf_flags == b.bsdf_flags
             && a.light == b.light
@@ -847,8 +919,8 @@ mod tests {
                             (a, b) => panic!(
                                 "packets {packets}, batch {start}..{end}, ray {k} {:?}: single {:?}, batch {:?}",
                                 rays[k],
-                                a.as_ref().map(|h| (h.point, h.uv, h.light)),
-                                b.as_ref().map(|h| (h.point, h.uv, h.light)),
+                                a.as_ref().map(|h| (h.point, h.texture.uv, h.light)),
+                                b.as_ref().map(|h| (h.point, h.texture.uv, h.light)),
                             ),
                         }
                         assert_eq!(*occluded, blocked[k], "packets {packets}, ray {k}");

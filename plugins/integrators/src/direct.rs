@@ -76,7 +76,7 @@ impl Trace for DirectIntegrator {
         let vertex = Vertex {
             hit,
             origins: hit.point.ray_origins(),
-            wo: hit.shading.to_local(hit.wo),
+            wo: hit.shading.to_local(-camera_ray.d),
         };
         if plan.light_samples > 0 {
             let u_light = sampler.get_1d_2d();

@@ -189,7 +189,7 @@ impl Vertex<'_> {
 #[inline]
 pub fn bsdf_context(hit: &SurfaceInteraction) -> BsdfContext {
     BsdfContext {
-        texture: lumis_core::TextureQuery::at(hit.uv),
+        texture: hit.texture,
         ..Default::default()
     }
 }
@@ -621,7 +621,8 @@ impl Estimator {
         match found {
             Some(hit) => {
                 if let Some(emitter) = hit.light.map(LightIndex::get) {
-                    let le = scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.uv, hit.wo);
+                    let le =
+                        scene.lights[emitter as usize].l(hit.p(), hit.n(), hit.texture.uv, -ray.d);
                     if !le.is_black() {
                         let w = from.scale
                             * self.bsdf_weight(

@@ -58,7 +58,8 @@ pub fn trilinear(levels: &[Texels], query: &TextureQuery, uv: Vec2, wrap: [Wrap;
     if !query.has_footprint() {
         return levels[0].bilinear(uv, wrap);
     }
-    let width = 2.0 * query.duv_dx.abs().max(query.duv_dy.abs()).max_element();
+    let (dx, dy) = query.derivatives();
+    let width = 2.0 * dx.abs().max(dy.abs()).max_element();
     let level = level_of(levels, width);
     if level <= 0.0 {
         return levels[0].bilinear(uv, wrap);
@@ -76,7 +77,7 @@ pub fn trilinear(levels: &[Texels], query: &TextureQuery, uv: Vec2, wrap: [Wrap;
 /// ellipse whose axes are the footprint's derivatives, on the level where
 /// the minor axis spans a few texels, blended with the next level.
 pub fn ewa(levels: &[Texels], query: &TextureQuery, uv: Vec2, wrap: [Wrap; 2]) -> Rgb {
-    let (mut major, mut minor) = (query.duv_dx, query.duv_dy);
+    let (mut major, mut minor) = query.derivatives();
     if major.length_squared() < minor.length_squared() {
         std::mem::swap(&mut major, &mut minor);
     }
@@ -178,11 +179,7 @@ mod tests {
     const REPEAT: [Wrap; 2] = [Wrap::Repeat; 2];
 
     fn footprint(uv: Vec2, dx: Vec2, dy: Vec2) -> TextureQuery {
-        TextureQuery {
-            uv,
-            duv_dx: dx,
-            duv_dy: dy,
-        }
+        TextureQuery::new(uv, dx, dy)
     }
 
     #[test]
