@@ -44,7 +44,7 @@ impl PixelFootprint {
     pub fn dp_dxy(&self, p: Vec3, n: Vec3) -> (Vec3, Vec3) {
         let to_p = p - self.origin;
         let depth = to_p.dot(self.forward);
-        if !(depth > 0.0) {
+        if depth.is_nan() || depth <= 0.0 {
             return (Vec3::ZERO, Vec3::ZERO);
         }
         // The direction through p, scaled to reach the image plane at 1.
@@ -112,7 +112,7 @@ const F16_MAX: f32 = 65504.0;
 fn f16_bits(x: f32) -> u16 {
     let sign = ((x.to_bits() >> 16) & 0x8000) as u16;
     let a = x.abs();
-    if !(a >= F16_MIN_NORMAL) {
+    if a.is_nan() || a < F16_MIN_NORMAL {
         return sign;
     }
     let a = a.min(F16_MAX);
