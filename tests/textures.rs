@@ -245,3 +245,31 @@ fn the_pixel_footprint_filters_distant_texels() {
         );
     }
 }
+
+/// The floor of [`scene`] as a microfacet BSDF of type `bsdf` whose
+/// `roughness` is `roughness`.
+fn rough_scene(textures: &str, bsdf: &str, roughness: &str) -> String {
+    scene(textures, "0.5").replacen(
+        "type = \"diffuse\"\nreflectance = 0.5",
+        &format!("type = \"{bsdf}\"\nroughness = {roughness}"),
+        1,
+    )
+}
+
+/// Roughness textures: a constant one renders the constant roughness to
+/// the bit (the textured lobe is the fixed one, evaluated per hit), and a
+/// checkerboard of two roughnesses changes the image.
+#[test]
+fn every_microfacet_bsdf_takes_a_roughness_texture() {
+    let constant = "[[texture]]\nname = \"r\"\ntype = \"constant\"\nvalue = 0.3\n";
+    let checks =
+        "[[texture]]\nname = \"r\"\ntype = \"checkerboard\"\ncolor0 = 0.05\ncolor1 = 0.6\n";
+    for bsdf in ["conductor", "plastic", "dielectric"] {
+        let plain = render_toml(&rough_scene("", bsdf, "0.3"), &[], 2);
+        let textured = render_toml(&rough_scene(constant, bsdf, "{ texture = \"r\" }"), &[], 2);
+        assert!(plain.image.mean().iter().any(|&c| c > 0.0), "{bsdf}");
+        assert_eq!(plain.image.pixels, textured.image.pixels, "{bsdf}");
+        let checked = render_toml(&rough_scene(checks, bsdf, "{ texture = \"r\" }"), &[], 2);
+        assert_ne!(plain.image.pixels, checked.image.pixels, "{bsdf}");
+    }
+}

@@ -103,6 +103,7 @@ pub fn load_str(
     let light_sampler =
         registry.create::<dyn LightSampler>(&description.light_sampler, &assembled.lights)?;
 
+    let textured = !description.textures.is_empty() || assembled.report.texture_bytes > 0;
     let scene = RenderScene {
         embree: assembled.embree,
         geometries: assembled.geometries,
@@ -114,13 +115,14 @@ pub fn load_str(
         counts: assembled.counts,
         report: assembled.report,
         packets: description.accel.packets,
-        footprint: None,
-    }
-    .with_footprint(
-        description
-            .camera
-            .pixel_footprint(plugins.sampler.samples_per_pixel()),
-    );
+        // Only textures read the pixel footprint; a scene without them
+        // does no footprint work at its hits.
+        footprint: textured.then(|| {
+            description
+                .camera
+                .pixel_footprint(plugins.sampler.samples_per_pixel())
+        }),
+    };
     Ok(LoadedScene {
         name: name.to_string(),
         scene,

@@ -192,23 +192,6 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
-    /// Gives hits on surfaces with texture coordinates the pixel footprint
-    /// of `camera` (none in a scene without texture coordinates, whose
-    /// hits then carry no footprint work).
-    pub(crate) fn with_footprint(mut self, camera: PixelFootprint) -> Self {
-        let has_uvs = |mesh: &MeshData| mesh.uvs.is_some();
-        let any_uvs = self.geometries.iter().any(|g| match g {
-            Geometry::Mesh(mesh) => has_uvs(mesh),
-            Geometry::Instance { prototype, .. } => self.prototypes[*prototype as usize]
-                .meshes
-                .iter()
-                .any(has_uvs),
-            Geometry::Sphere { .. } => true,
-        });
-        self.footprint = any_uvs.then_some(camera);
-        self
-    }
-
     pub fn counts(&self) -> &SceneCounts {
         &self.counts
     }

@@ -20,7 +20,7 @@ use crate::fresnel;
 use crate::lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
 use crate::metal_params::MetalParams;
 use crate::microfacet::{
-    half_vector, half_vector_lanes, Microfacet, MicrofacetParams, NormalSampling,
+    half_vector, half_vector_lanes, Microfacet, MicrofacetParams, NormalSampling, Roughness,
 };
 
 /// The SIMD lanes of the batched methods: eight, two SSE2 halves without
@@ -95,8 +95,8 @@ impl ConductorFresnel {
 
 #[derive(Debug, Clone)]
 pub struct Conductor {
-    /// `None`: a delta mirror.
-    microfacet: Option<Microfacet>,
+    /// Its lobe, fixed or textured; a fixed delta is a mirror.
+    roughness: Roughness,
     fresnel: ConductorFresnel,
     scale: Rgb,
     /// A textured `specular_reflectance`, which multiplies every value.
@@ -107,11 +107,20 @@ pub struct Conductor {
 impl Conductor {
     /// A rough conductor; a delta mirror if `microfacet` is smooth.
     pub fn new(microfacet: Microfacet, fresnel: ConductorFresnel, sampling: LobeSampling) -> Self {
+        Self::with_roughness(microfacet.into(), fresnel, sampling)
+    }
+
+    /// A conductor of fixed or textured `roughness`.
+    pub fn with_roughness(
+        roughness: Roughness,
+        fresnel: ConductorFresnel,
+        sampling: LobeSampling,
+    ) -> Self {
         Self {
-            microfacet: (!microfacet.is_smooth()).then_some(match sampling {
-                LobeSampling::Model(s) => microfacet.with_sampling(s),
-                _ => microfacet,
-            }),
+            roughness: match sampling {
+                LobeSampling::Model(s) => roughness.with_sampling(s),
+                _ => roughness,
+            },
             fresnel,
             scale: Rgb::WHITE,
             tint: None,
@@ -121,7 +130,7 @@ impl Conductor {
 
     pub fn mirror(fresnel: ConductorFresnel) -> Self {
         Self {
-            microfacet: None,
+            roughness: Roughness::Fixed(None),
             fresnel,
             scale: Rgb::WHITE,
             tint: None,
@@ -135,7 +144,7 @@ impl Conductor {
         Ok(Self {
             scale: p.metal.scale(params)?,
             tint: p.metal.tint(),
-            ..Self::new(p.microfacet.microfacet(), fresnel, p.sampling.into())
+            ..Self::with_roughness(p.microfacet.roughness(), fresnel, p.sampling.into())
         })
     }
 
@@ -149,11 +158,11 @@ impl Conductor {
     }
 
     /// [`Bsdf::sample_f`] before a textured tint.
-    fn sample_untinted(&self, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+    fn sample_untinted(&self, ctx: &BsdfContext, wo: Vec3, u2: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
-        let Some(mf) = &self.microfacet else {
+        let Some(mf) = &self.roughness.at(&ctx.texture) else {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             return Some(BsdfSample {
                 f: self.scale * self.fresnel.eval(wo.z) / wo.z,
@@ -326,15 +335,16 @@ impl LobeTerms<f32> {
 
 impl Bsdf for Conductor {
     fn flags(&self) -> BsdfFlags {
-        match self.microfacet {
-            Some(_) => BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            None => BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
+        if self.roughness.is_delta() {
+            BsdfFlags::SPECULAR | BsdfFlags::REFLECTION
+        } else {
+            BsdfFlags::GLOSSY | BsdfFlags::REFLECTION
         }
     }
 
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        let Some(mf) = &self.microfacet else {
+        let Some(mf) = &self.roughness.at(&ctx.texture) else {
             return Rgb::BLACK;
         };
         LobeTerms::at(mf, wo, wi).map_or(Rgb::BLACK, |lobe| {
@@ -346,15 +356,15 @@ impl Bsdf for Conductor {
         })
     }
 
-    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        let mut s = self.sample_untinted(wo, u1, u2)?;
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let mut s = self.sample_untinted(ctx, wo, u2)?;
         s.f = self.tinted(ctx, s.f);
         Some(s)
     }
 
     #[inline]
-    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        let Some(mf) = &self.microfacet else {
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        let Some(mf) = &self.roughness.at(&ctx.texture) else {
             return 0.0;
         };
         LobeTerms::at(mf, wo, wi).map_or(0.0, |lobe| self.rough_pdf(mf, &lobe, wi.z))
@@ -362,7 +372,7 @@ impl Bsdf for Conductor {
 
     #[inline]
     fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        let Some(mf) = &self.microfacet else {
+        let Some(mf) = &self.roughness.at(&ctx.texture) else {
             return (Rgb::BLACK, 0.0);
         };
         LobeTerms::at(mf, wo, wi).map_or((Rgb::BLACK, 0.0), |lobe| {
@@ -374,16 +384,16 @@ impl Bsdf for Conductor {
     /// [`Bsdf::eval`] a SIMD chunk of lanes at a time
     /// (`Conductor::eval_lanes`), each lane bit for bit `eval`'s answer.
     fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
-        let Some(mf) = &self.microfacet else {
+        if self.roughness.is_delta() {
             out.fill((Rgb::BLACK, 0.0));
             return;
-        };
-        if self.tint.is_some() {
+        }
+        let (Some(mf), None) = (self.roughness.fixed(), &self.tint) else {
             for (i, out) in out.iter_mut().enumerate() {
                 *out = self.eval(&ctx[i], wo[i], wi[i]);
             }
             return;
-        }
+        };
         let width = Lanes::LANES;
         for ((wo, wi), out) in wo
             .chunks(width)
@@ -412,7 +422,7 @@ impl Bsdf for Conductor {
         u2: &[Vec2],
         out: &mut [Option<BsdfSample>],
     ) {
-        let mf = match (&self.microfacet, self.sampling) {
+        let mf = match (self.roughness.fixed(), self.sampling) {
             (Some(mf), LobeSampling::Model(_))
                 if mf.sampling == NormalSampling::Visible && self.tint.is_none() =>
             {

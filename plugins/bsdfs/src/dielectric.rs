@@ -18,7 +18,7 @@ use lumis_core::{
 };
 
 use crate::fresnel::{self, reflect, refract};
-use crate::microfacet::{Microfacet, MicrofacetParams, NormalSampling};
+use crate::microfacet::{Microfacet, MicrofacetParams, NormalSampling, Roughness};
 
 /// Relative indices closer to 1 than this are index-matched: reflection
 /// is below 3e-7 and the rough transmission lobe narrower than 1e-3 rad,
@@ -33,7 +33,7 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: DielectricParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct DielectricParams {
     /// index of refraction inside (the side opposite the normal); 1.5 is glass
     #[param(default = 1.5, range = (1.0, 5.0))]
@@ -64,23 +64,33 @@ struct HalfVector {
 pub struct Dielectric {
     /// Inside over outside.
     eta: f32,
-    /// `None`: smooth.
-    microfacet: Option<Microfacet>,
+    /// Its lobe, fixed or textured; a fixed delta is smooth glass.
+    roughness: Roughness,
 }
 
 impl Dielectric {
     pub fn new(eta: f32, microfacet: Microfacet) -> Self {
-        let smooth = microfacet.is_smooth() || (eta - 1.0).abs() < INDEX_MATCHED;
+        Self::with_roughness(eta, microfacet.into())
+    }
+
+    /// Glass of relative index `eta` and fixed or textured `roughness`;
+    /// smooth where the indices match, whatever the roughness.
+    pub fn with_roughness(eta: f32, roughness: Roughness) -> Self {
+        let matched = (eta - 1.0).abs() < INDEX_MATCHED;
         Self {
             eta,
-            microfacet: (!smooth).then_some(microfacet),
+            roughness: if matched {
+                Roughness::Fixed(None)
+            } else {
+                roughness
+            },
         }
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
         let p = DielectricParams::read(params)?;
-        let microfacet = p.microfacet.microfacet().with_sampling(p.sampling);
-        Ok(Self::new(p.int_ior / p.ext_ior, microfacet))
+        let roughness = p.microfacet.roughness().with_sampling(p.sampling);
+        Ok(Self::with_roughness(p.int_ior / p.ext_ior, roughness))
     }
 
     fn sample_smooth(&self, ctx: &BsdfContext, wo: Vec3, u1: f32) -> Option<BsdfSample> {
@@ -236,30 +246,31 @@ impl Dielectric {
 impl Bsdf for Dielectric {
     fn flags(&self) -> BsdfFlags {
         let lobes = BsdfFlags::REFLECTION | BsdfFlags::TRANSMISSION;
-        match self.microfacet {
-            Some(_) => lobes | BsdfFlags::GLOSSY,
-            None => lobes | BsdfFlags::SPECULAR,
+        if self.roughness.is_delta() {
+            lobes | BsdfFlags::SPECULAR
+        } else {
+            lobes | BsdfFlags::GLOSSY
         }
     }
 
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        match &self.microfacet {
+        match &self.roughness.at(&ctx.texture) {
             Some(mf) => Rgb::splat(self.rough_f(mf, ctx.mode, wo, wi)),
             None => Rgb::BLACK,
         }
     }
 
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        match &self.microfacet {
+        match &self.roughness.at(&ctx.texture) {
             Some(mf) => self.sample_rough(mf, ctx, wo, u1, u2),
             None => self.sample_smooth(ctx, wo, u1),
         }
     }
 
     #[inline]
-    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        match &self.microfacet {
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        match &self.roughness.at(&ctx.texture) {
             Some(mf) => self.rough_pdf(mf, wo, wi),
             None => 0.0,
         }
@@ -314,7 +325,7 @@ mod tests {
         // (Veach 1997, eq. 5.14, with the outside index 1): the
         // generalized half-vector denominator picks up eta^2 on swapping.
         let g = glass(0.3);
-        let mf = g.microfacet.unwrap();
+        let mf = *g.roughness.fixed().unwrap();
         let above = Vec3::new(0.3, 0.1, 0.9).normalize();
         let below = Vec3::new(-0.2, 0.05, -0.95).normalize();
         let a = g.rough_f(&mf, TransportMode::Importance, above, below);

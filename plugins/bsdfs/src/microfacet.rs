@@ -11,7 +11,7 @@
 use std::f32::consts::PI;
 use std::ops::{Add, Div, Mul};
 
-use lumis_core::{ParamChoice, PluginParams, Vec2, Vec3};
+use lumis_core::{ParamChoice, PluginParams, TextureQuery, TexturedFloat, Vec2, Vec3};
 use lumis_sampling::real::{Real, V3};
 use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
 use wide::f64x4;
@@ -43,26 +43,116 @@ pub enum NormalSampling {
 }
 
 /// The parameters every microfacet BSDF shares (flattened into its own).
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct MicrofacetParams {
     /// microfacet normal distribution: ggx (Trowbridge-Reitz) or beckmann
     #[param(default = Ggx)]
     pub distribution: Distribution,
     /// alpha, the RMS slope of the microfacets (Beckmann) or the GGX width;
-    /// below 1e-3 the lobe is a delta
+    /// below 1e-3 the lobe is a delta (a texture's values are held at 1e-3
+    /// and above: the lobe stays glossy everywhere)
     #[param(default = 0.1, range = (0.0, 1.0))]
-    pub roughness: f32,
+    pub roughness: TexturedFloat,
     /// alpha along the surface's second tangent (anisotropy); default:
     /// roughness; each axis is at least 1e-3 once the other is
     #[param(range = (0.0, 1.0))]
-    pub roughness_v: Option<f32>,
+    pub roughness_v: Option<TexturedFloat>,
 }
 
 impl MicrofacetParams {
-    /// The distribution they describe, sampling visible normals.
-    pub fn microfacet(&self) -> Microfacet {
-        let alpha_y = self.roughness_v.unwrap_or(self.roughness);
-        Microfacet::new(self.distribution, self.roughness, alpha_y)
+    /// The roughness they describe, sampling visible normals.
+    pub fn roughness(&self) -> Roughness {
+        let v = self.roughness_v.as_ref().unwrap_or(&self.roughness);
+        match (self.roughness.constant(), v.constant()) {
+            (Some(alpha_x), Some(alpha_y)) => {
+                Microfacet::new(self.distribution, alpha_x, alpha_y).into()
+            }
+            _ => Roughness::Textured {
+                distribution: self.distribution,
+                alpha_x: self.roughness.clone(),
+                alpha_y: v.clone(),
+                sampling: NormalSampling::Visible,
+            },
+        }
+    }
+}
+
+/// A surface's microfacet lobe: one distribution everywhere, or one per
+/// hit from roughness textures (pbrt-v4's materials evaluate their
+/// roughness textures per hit the same way).
+#[derive(Debug, Clone)]
+pub enum Roughness {
+    /// The same lobe everywhere; `None` for a delta.
+    Fixed(Option<Microfacet>),
+    /// The widths read at each hit, held at [`SMOOTH_THRESHOLD`] and above
+    /// so that the lobe is glossy everywhere, as the BSDF's flags say.
+    Textured {
+        distribution: Distribution,
+        alpha_x: TexturedFloat,
+        alpha_y: TexturedFloat,
+        sampling: NormalSampling,
+    },
+}
+
+/// A fixed lobe; a delta if it is smooth.
+impl From<Microfacet> for Roughness {
+    fn from(mf: Microfacet) -> Self {
+        Roughness::Fixed((!mf.is_smooth()).then_some(mf))
+    }
+}
+
+impl Roughness {
+    /// The lobe at the hit `query` looks up; `None` for a delta.
+    #[inline]
+    pub fn at(&self, query: &TextureQuery) -> Option<Microfacet> {
+        match self {
+            Roughness::Fixed(mf) => *mf,
+            Roughness::Textured {
+                distribution,
+                alpha_x,
+                alpha_y,
+                sampling,
+            } => {
+                let alpha = |t: &TexturedFloat| t.eval(query).clamp(SMOOTH_THRESHOLD, 1.0);
+                Some(
+                    Microfacet::new(*distribution, alpha(alpha_x), alpha(alpha_y))
+                        .with_sampling(*sampling),
+                )
+            }
+        }
+    }
+
+    /// The lobe if it is the same everywhere and not a delta: what the
+    /// batched methods work on lanes with.
+    #[inline]
+    pub fn fixed(&self) -> Option<&Microfacet> {
+        match self {
+            Roughness::Fixed(mf) => mf.as_ref(),
+            Roughness::Textured { .. } => None,
+        }
+    }
+
+    /// Whether the lobe is a delta (everywhere).
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Roughness::Fixed(None))
+    }
+
+    /// How its normals are drawn; a delta has none to draw.
+    pub fn with_sampling(self, with: NormalSampling) -> Self {
+        match self {
+            Roughness::Fixed(mf) => Roughness::Fixed(mf.map(|mf| mf.with_sampling(with))),
+            Roughness::Textured {
+                distribution,
+                alpha_x,
+                alpha_y,
+                ..
+            } => Roughness::Textured {
+                distribution,
+                alpha_x,
+                alpha_y,
+                sampling: with,
+            },
+        }
     }
 }
 

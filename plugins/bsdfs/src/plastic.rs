@@ -31,7 +31,7 @@ use lumis_core::{
 use lumis_sampling::warp;
 
 use crate::fresnel::{self, reflect};
-use crate::microfacet::{half_vector, Microfacet, MicrofacetParams};
+use crate::microfacet::{half_vector, Microfacet, MicrofacetParams, Roughness};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
@@ -63,7 +63,8 @@ pub struct PlasticParams {
     pub nonlinear: bool,
 }
 
-/// The base as one hit sees it: its albedo, constant or textured.
+/// The layers as one hit sees them: the base's albedo and the coat's
+/// roughness, each constant or textured.
 #[derive(Debug, Clone, Copy)]
 struct Base {
     /// `rho'`, the base's albedo including the internal reflections, over
@@ -71,6 +72,8 @@ struct Base {
     f: Rgb,
     /// Luminance of `rho`, for the lobe choice.
     weight: f32,
+    /// The coat's lobe; `None`: smooth.
+    coat: Option<Microfacet>,
 }
 
 #[derive(Debug, Clone)]
@@ -86,8 +89,8 @@ pub struct Plastic {
     specular: Rgb,
     specular_weight: f32,
     eta: f32,
-    /// `None`: a smooth coat.
-    coat: Option<Microfacet>,
+    /// The coat's lobe, fixed or textured; a fixed delta is smooth.
+    coat: Roughness,
 }
 
 impl Plastic {
@@ -95,22 +98,23 @@ impl Plastic {
         diffuse: impl Into<TexturedRgb>,
         specular: Rgb,
         eta: f32,
-        coat: Microfacet,
+        coat: impl Into<Roughness>,
         nonlinear: bool,
     ) -> Self {
         let diffuse = diffuse.into();
+        let coat = coat.into();
         // Light inside the coat meets it from the side of index 1/eta.
         let fdr_int = fresnel::diffuse_reflectance(1.0 / eta);
         let constant = diffuse.constant().unwrap_or(Rgb::WHITE);
         Self {
-            untextured: Self::base_of(constant, fdr_int, eta, nonlinear),
+            untextured: Self::base_of(constant, fdr_int, eta, nonlinear, coat.fixed().copied()),
             diffuse,
             fdr_int,
             nonlinear,
             specular,
             specular_weight: specular.luminance(),
             eta,
-            coat: (!coat.is_smooth()).then_some(coat),
+            coat,
         }
     }
 
@@ -130,13 +134,19 @@ impl Plastic {
             p.diffuse_reflectance,
             p.specular_reflectance,
             p.int_ior / p.ext_ior,
-            p.coat.microfacet(),
+            p.coat.roughness(),
             p.nonlinear,
         ))
     }
 
     #[inline]
-    fn base_of(diffuse: Rgb, fdr_int: f32, eta: f32, nonlinear: bool) -> Base {
+    fn base_of(
+        diffuse: Rgb,
+        fdr_int: f32,
+        eta: f32,
+        nonlinear: bool,
+        coat: Option<Microfacet>,
+    ) -> Base {
         let rho = if nonlinear {
             diffuse.map(|r| r / (1.0 - r * fdr_int))
         } else {
@@ -145,21 +155,28 @@ impl Plastic {
         Base {
             f: rho * (FRAC_1_PI / (eta * eta)),
             weight: diffuse.luminance(),
+            coat,
         }
     }
 
-    /// The base at this hit: the precomputed one, or the texture's value
-    /// there (clamped to [0, 1], where the internal reflections' series
-    /// converges).
+    /// The layers at this hit: the precomputed ones, or the textures'
+    /// values there (an albedo clamped to [0, 1], where the internal
+    /// reflections' series converges).
     #[inline]
     fn base(&self, ctx: &BsdfContext) -> Base {
-        match &self.diffuse {
-            lumis_core::params::Textured::Constant(_) => self.untextured,
-            textured => Self::base_of(
+        let coat = || self.coat.at(&ctx.texture);
+        match (&self.diffuse, &self.coat) {
+            (lumis_core::params::Textured::Constant(_), Roughness::Fixed(_)) => self.untextured,
+            (lumis_core::params::Textured::Constant(_), _) => Base {
+                coat: coat(),
+                ..self.untextured
+            },
+            (textured, _) => Self::base_of(
                 textured.eval(&ctx.texture).map(|r| r.clamp(0.0, 1.0)),
                 self.fdr_int,
                 self.eta,
                 self.nonlinear,
+                coat(),
             ),
         }
     }
@@ -202,10 +219,10 @@ impl Plastic {
     /// term at `wo`, `half` the half vector (if any) for a rough coat.
     #[inline]
     fn f_above(&self, base: &Base, fo: f32, half: Option<(Vec3, f32)>, wo: Vec3, wi: Vec3) -> Rgb {
-        let base = self.base_f(base, fo, wi);
-        match (&self.coat, half) {
-            (Some(mf), Some(half)) => base + self.coat_f(mf, half, wo, wi),
-            _ => base,
+        let f = self.base_f(base, fo, wi);
+        match (&base.coat, half) {
+            (Some(mf), Some(half)) => f + self.coat_f(mf, half, wo, wi),
+            _ => f,
         }
     }
 
@@ -220,28 +237,28 @@ impl Plastic {
         wi: Vec3,
     ) -> f32 {
         let p = self.coat_probability(base, fo);
-        let base = (1.0 - p) * warp::cosine_hemisphere_pdf(wi.z);
-        match (&self.coat, half) {
-            (Some(mf), Some(half)) => base + p * Self::coat_pdf(mf, half, wo),
-            _ => base,
+        let diffuse = (1.0 - p) * warp::cosine_hemisphere_pdf(wi.z);
+        match (&base.coat, half) {
+            (Some(mf), Some(half)) => diffuse + p * Self::coat_pdf(mf, half, wo),
+            _ => diffuse,
         }
     }
 
     /// What `f` and `pdf` share: `None` below the surface, else the Fresnel
     /// term at `wo` and the rough coat's half vector.
     #[inline]
-    fn geometry(&self, wo: Vec3, wi: Vec3) -> Option<(f32, Option<(Vec3, f32)>)> {
+    fn geometry(&self, base: &Base, wo: Vec3, wi: Vec3) -> Option<(f32, Option<(Vec3, f32)>)> {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return None;
         }
         let fo = fresnel::dielectric(wo.z, self.eta);
-        let half = self.coat.as_ref().and_then(|_| half_vector(wo, wi));
+        let half = base.coat.as_ref().and_then(|_| half_vector(wo, wi));
         Some((fo, half))
     }
 
     #[inline]
     fn eval_f(&self, base: &Base, wo: Vec3, wi: Vec3) -> Rgb {
-        match self.geometry(wo, wi) {
+        match self.geometry(base, wo, wi) {
             Some((fo, half)) => self.f_above(base, fo, half, wo, wi),
             None => Rgb::BLACK,
         }
@@ -249,7 +266,7 @@ impl Plastic {
 
     #[inline]
     fn eval_pdf(&self, base: &Base, wo: Vec3, wi: Vec3) -> f32 {
-        match self.geometry(wo, wi) {
+        match self.geometry(base, wo, wi) {
             Some((fo, half)) => self.pdf_above(base, fo, half, wo, wi),
             None => 0.0,
         }
@@ -259,9 +276,10 @@ impl Plastic {
 impl Bsdf for Plastic {
     fn flags(&self) -> BsdfFlags {
         let base = BsdfFlags::DIFFUSE_REFLECTION;
-        match self.coat {
-            Some(_) => base | BsdfFlags::GLOSSY,
-            None => base | BsdfFlags::SPECULAR,
+        if self.coat.is_delta() {
+            base | BsdfFlags::SPECULAR
+        } else {
+            base | BsdfFlags::GLOSSY
         }
     }
 
@@ -278,7 +296,7 @@ impl Bsdf for Plastic {
         let fo = fresnel::dielectric(wo.z, self.eta);
         let p = self.coat_probability(&base, fo);
         let wi = if u1 < p {
-            let Some(mf) = &self.coat else {
+            let Some(mf) = &base.coat else {
                 let wi = Vec3::new(-wo.x, -wo.y, wo.z);
                 return Some(BsdfSample {
                     f: self.specular * (fo / wi.z),
@@ -296,7 +314,7 @@ impl Bsdf for Plastic {
         } else {
             warp::square_to_cosine_hemisphere(u2)
         };
-        let flags = if self.coat.is_some() && u1 < p {
+        let flags = if base.coat.is_some() && u1 < p {
             BsdfFlags::GLOSSY | BsdfFlags::REFLECTION
         } else {
             BsdfFlags::DIFFUSE_REFLECTION
@@ -317,10 +335,10 @@ impl Bsdf for Plastic {
     /// One base (texture), one Fresnel term at `wo`, one half vector.
     #[inline]
     fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        let Some((fo, half)) = self.geometry(wo, wi) else {
+        let base = self.base(ctx);
+        let Some((fo, half)) = self.geometry(&base, wo, wi) else {
             return (Rgb::BLACK, 0.0);
         };
-        let base = self.base(ctx);
         (
             self.f_above(&base, fo, half, wo, wi),
             self.pdf_above(&base, fo, half, wo, wi),

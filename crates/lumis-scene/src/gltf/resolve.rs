@@ -234,9 +234,18 @@ fn texture_of(
         gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
         gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
     };
-    let filter = match sampler.mag_filter() {
-        Some(gltf::texture::MagFilter::Nearest) => ImageFilter::Nearest,
-        _ => ImageFilter::Bilinear,
+    // Mip-mapped minification, as the sampler asks or by default (the
+    // specification leaves an absent filter to the renderer), is the
+    // trilinear lookup over the pixel footprint.
+    let filter = {
+        use gltf::texture::{MagFilter, MinFilter};
+        match (sampler.min_filter(), sampler.mag_filter()) {
+            (Some(MinFilter::Nearest), _) | (None, Some(MagFilter::Nearest)) => {
+                ImageFilter::Nearest
+            }
+            (Some(MinFilter::Linear), _) => ImageFilter::Bilinear,
+            _ => ImageFilter::Trilinear,
+        }
     };
     // glTF colour textures are sRGB (the specification, 3.9.6).
     let texture = ImageTexture::new(
