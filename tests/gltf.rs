@@ -595,6 +595,74 @@ fn metals_render_as_the_conductor_they_map_to() {
     assert_eq!(a, b, "same image bit for bit");
 }
 
+/// A metallic-roughness texture gives the roughness per texel: GGX alpha
+/// `(roughnessFactor x green)^2`, the glTF remapping. Each half of a 2x1
+/// texture renders as the untextured metal of that roughness.
+#[test]
+fn a_metallic_roughness_texture_gives_the_roughness_per_texel() {
+    let tmp = test_dir("roughness-texture");
+    let dir = tmp.path();
+    let metal = |name: &str, roughness: f32, texture: Option<usize>| Material {
+        metallic: 1.0,
+        roughness,
+        metallic_roughness_texture: texture,
+        ..Material::dielectric(name, [0.9, 0.8, 0.7])
+    };
+    let asset_of = |material: Material, images: Vec<Vec<u8>>| {
+        let mut tri = triangle();
+        tri.material = Some(0);
+        tri.uvs = Some(vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        Asset {
+            materials: vec![material],
+            images,
+            ..one_mesh(tri, vec![mesh_node(0)], vec![0])
+        }
+    };
+    // Green 51 (0.2) on the left, 255 on the right; factor 1.
+    let png = gltf_writer::png_rgb8(2, 1, &[[0, 51, 0], [0, 255, 0]]);
+    let textured = gltf_writer::write(
+        dir,
+        "textured",
+        &asset_of(metal("m", 1.0, Some(0)), vec![png]),
+        Container::Glb,
+    );
+    let f_at = |file: &str, x: f32| {
+        let scene = load(
+            dir,
+            &lit_scene(&format!("[[shape]]\ntype = \"gltf\"\nfile = \"{file}\"\n")),
+        );
+        let hit = scene
+            .scene
+            .intersect(&Ray::new(Vec3::new(x, 0.1, 1.0), Vec3::NEG_Z))
+            .expect("hit");
+        // At the texel's centre, without the camera's footprint: the
+        // texel's own value.
+        let ctx = BsdfContext {
+            texture: lumis_core::TextureQuery::at(hit.texture.uv),
+            ..BsdfContext::default()
+        };
+        let (wo, wi) = (
+            Vec3::new(0.3, 0.0, 0.95).normalize(),
+            Vec3::new(-0.25, 0.05, 0.96).normalize(),
+        );
+        hit.bsdf.f(&ctx, wo, wi).g
+    };
+    for (x, roughness) in [(0.25, 0.2), (0.75, 1.0)] {
+        let plain = gltf_writer::write(
+            dir,
+            &format!("plain{x}"),
+            &asset_of(metal("m", roughness, None), Vec::new()),
+            Container::Glb,
+        );
+        let (got, want) = (f_at(&textured, x), f_at(&plain, x));
+        assert!(
+            want > 0.0 && (got - want).abs() <= 1e-4 * want,
+            "x = {x}: {got} against {want}"
+        );
+    }
+    assert!(f_at(&textured, 0.25) > 2.0 * f_at(&textured, 0.75));
+}
+
 #[test]
 fn a_textured_dielectric_tints_its_base_and_not_its_coat() {
     // A smooth (roughness 0) white dielectric with a pure red base colour

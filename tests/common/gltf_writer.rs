@@ -49,6 +49,8 @@ pub struct Material {
     /// Index into [`Asset::images`] (one texture per image).
     pub base_color_texture: Option<usize>,
     pub emissive_texture: Option<usize>,
+    /// Index into [`Asset::images`]: roughness in green, metallic in blue.
+    pub metallic_roughness_texture: Option<usize>,
     /// `KHR_texture_transform` of the base colour texture: offset,
     /// rotation (radians), scale.
     pub base_color_transform: Option<([f32; 2], f32, [f32; 2])>,
@@ -66,6 +68,7 @@ impl Material {
             double_sided: false,
             base_color_texture: None,
             emissive_texture: None,
+            metallic_roughness_texture: None,
             base_color_transform: None,
         }
     }
@@ -237,11 +240,14 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             let texture = m.base_color_texture.map_or(String::new(), |t| {
                 format!(",\"baseColorTexture\":{{\"index\":{t}{transform}}}")
             });
+            let metallic_roughness = m.metallic_roughness_texture.map_or(String::new(), |t| {
+                format!(",\"metallicRoughnessTexture\":{{\"index\":{t}}}")
+            });
             let emissive_texture = m
                 .emissive_texture
                 .map_or(String::new(), |t| format!(",\"emissiveTexture\":{{\"index\":{t}}}"));
             format!(
-                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}}},\"emissiveFactor\":[{}],\"doubleSided\":{}{emissive_texture}}}",
+                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}{metallic_roughness}}},\"emissiveFactor\":[{}],\"doubleSided\":{}{emissive_texture}}}",
                 m.name,
                 floats(&m.base_color),
                 m.metallic,

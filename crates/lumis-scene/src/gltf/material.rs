@@ -15,6 +15,18 @@ const METALLIC_THRESHOLD: f32 = 0.5;
 /// texture (already multiplied by `baseColorFactor`).
 pub(crate) const BASE_COLOR: &str = "baseColorTexture";
 
+/// The name under which they find its roughness texture: GGX alpha, the
+/// square of `roughnessFactor` times the metallic-roughness texture's
+/// green channel.
+pub(crate) const ROUGHNESS: &str = "metallicRoughnessTexture";
+
+/// Which of a material's parameters its textures give.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Textured {
+    pub base_color: bool,
+    pub roughness: bool,
+}
+
 /// The glTF dielectric's coat: IOR 1.5 (its specular F0 of 0.04).
 const DIELECTRIC_IOR: f32 = 1.5;
 
@@ -31,17 +43,17 @@ const DIELECTRIC_IOR: f32 = 1.5;
 ///   colour is the base's albedo seen through the coat at normal incidence
 ///   (plastic's linear mode), where glTF mixes the two by Schlick's Fresnel.
 ///
-/// `doubleSided` wraps either in the `twosided` BSDF plugin. With
-/// `base_color_textured`, the conductor's reflectance or the plastic's
-/// base is `{ texture = BASE_COLOR }` (the texture carries the factor),
-/// which the caller creates the BSDF with. What is approximated is said in
-/// the warnings.
+/// `doubleSided` wraps either in the `twosided` BSDF plugin. Where
+/// `textured` says so, the conductor's reflectance or the plastic's base is
+/// `{ texture = BASE_COLOR }`, and the roughness `{ texture = ROUGHNESS }`
+/// (the textures carry the factors), which the caller creates the BSDF
+/// with. What is approximated is said in the warnings.
 pub(crate) fn bsdf_entity(
     material: &gltf::Material,
     label: &str,
     owner: String,
     at: &Location,
-    base_color_textured: bool,
+    textured: Textured,
 ) -> Result<(PluginEntity, Vec<String>), String> {
     let pbr = material.pbr_metallic_roughness();
     let [r, g, b, _alpha] = pbr.base_color_factor();
@@ -52,7 +64,7 @@ pub(crate) fn bsdf_entity(
         ));
     }
     let base_color = || -> Value {
-        if base_color_textured {
+        if textured.base_color {
             Value::Table(Table::built(at, [("texture", BASE_COLOR.into())]))
         } else {
             rgb.into()
@@ -76,7 +88,7 @@ pub(crate) fn bsdf_entity(
     let roughness = pbr.roughness_factor();
     if pbr.metallic_roughness_texture().is_some() {
         warnings.push(format!(
-            "material {label}: metallicRoughnessTexture not modelled; metallic {metallic} and roughness {roughness} used everywhere"
+            "material {label}: metallicRoughnessTexture's metallic channel not modelled; metallic {metallic} used everywhere"
         ));
     }
     if metallic > 0.0 && metallic < 1.0 {
@@ -85,13 +97,19 @@ pub(crate) fn bsdf_entity(
             if metallic >= METALLIC_THRESHOLD { "metal" } else { "dielectric" }
         ));
     }
-    let alpha = (roughness * roughness).clamp(0.0, 1.0);
+    let alpha = || -> Value {
+        if textured.roughness {
+            Value::Table(Table::built(at, [("texture", ROUGHNESS.into())]))
+        } else {
+            (roughness * roughness).clamp(0.0, 1.0).into()
+        }
+    };
     let bsdf = if metallic >= METALLIC_THRESHOLD {
         entity(
             "conductor",
             vec![
                 ("distribution", "ggx".into()),
-                ("roughness", alpha.into()),
+                ("roughness", alpha()),
                 ("specular_reflectance", base_color()),
             ],
         )
@@ -103,7 +121,7 @@ pub(crate) fn bsdf_entity(
                 ("int_ior", DIELECTRIC_IOR.into()),
                 ("ext_ior", 1.0f32.into()),
                 ("distribution", "ggx".into()),
-                ("roughness", alpha.into()),
+                ("roughness", alpha()),
             ],
         )
     };

@@ -129,7 +129,8 @@ pub(crate) fn resolve_materials(
                 let mut textures = Textures::new();
                 if let Some(info) = pbr.base_color_texture() {
                     let [r, g, b, _] = pbr.base_color_factor();
-                    match texture_of(asset, &info, &request.path, Rgb::new(r, g, b)) {
+                    let base_color = TextureUse::Colour(Rgb::new(r, g, b));
+                    match texture_of(asset, &info, &request.path, base_color) {
                         Ok((t, set)) => {
                             out.texture_bytes += t.byte_size();
                             textures.insert(material::BASE_COLOR, Arc::new(t));
@@ -140,12 +141,36 @@ pub(crate) fn resolve_materials(
                         )),
                     }
                 }
+                let base_color_textured = !textures.is_empty();
+                if let Some(info) = pbr.metallic_roughness_texture() {
+                    let roughness = TextureUse::Roughness(pbr.roughness_factor());
+                    let loaded = match (texture_of(asset, &info, &request.path, roughness), uv_set)
+                    {
+                        (Ok((_, set)), Some(base)) if base != set => Err(format!(
+                            "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
+                        )),
+                        (loaded, _) => loaded,
+                    };
+                    match loaded {
+                        Ok((t, set)) => {
+                            out.texture_bytes += t.byte_size();
+                            textures.insert(material::ROUGHNESS, Arc::new(t));
+                            uv_set = Some(set);
+                        }
+                        Err(why) => out.warnings.push(format!(
+                            "'{label}': material {material_label}: metallicRoughnessTexture ignored ({why}); using roughnessFactor"
+                        )),
+                    }
+                }
                 let (entity, warnings) = material::bsdf_entity(
                     &material,
                     &material_label,
                     format!("{owner} '{label}' material {material_label}"),
                     at,
-                    !textures.is_empty(),
+                    material::Textured {
+                        base_color: base_color_textured,
+                        roughness: textures.get(material::ROUGHNESS).is_some(),
+                    },
                 )
                 .map_err(err)?;
                 out.warnings
@@ -160,7 +185,8 @@ pub(crate) fn resolve_materials(
         let radiance = material::emission(&material, &material_label).map_err(err)?;
         let mut emission_texture = None;
         if let (Some(_), Some(info)) = (radiance, material.emissive_texture()) {
-            let loaded = match (texture_of(asset, &info, &request.path, Rgb::WHITE), uv_set) {
+            let emissive = TextureUse::Colour(Rgb::WHITE);
+            let loaded = match (texture_of(asset, &info, &request.path, emissive), uv_set) {
                 (Ok((_, set)), Some(base)) if base != set => Err(format!(
                     "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
                 )),
@@ -198,14 +224,27 @@ pub(crate) fn resolve_materials(
     Ok(out)
 }
 
-/// A material's texture, its texels times `factor`, with its sampler and
+/// What a material reads a texture as.
+#[derive(Debug, Clone, Copy)]
+enum TextureUse {
+    /// An sRGB colour (base colour, emission) times a factor (the
+    /// specification, 3.9.6).
+    Colour(Rgb),
+    /// The green channel of a linear metallic-roughness texture times
+    /// `roughnessFactor`: the perceptual roughness, stored squared as
+    /// the GGX alpha that [`material::bsdf_entity`]'s lobes take (alpha is
+    /// then what the mip map averages).
+    Roughness(f32),
+}
+
+/// A material's texture as `usage` reads it, with its sampler and
 /// `KHR_texture_transform`, as the `image` texture plugin; and the TEXCOORD
 /// set it reads (the transform's `texCoord` overrides the texture info's).
 fn texture_of(
     asset: &buffers::Asset,
     info: &gltf::texture::Info,
     asset_path: &Path,
-    factor: Rgb,
+    usage: TextureUse,
 ) -> std::result::Result<(ImageTexture, u32), String> {
     let (transform, set) = match info.texture_transform() {
         Some(x) => (
@@ -217,7 +256,7 @@ fn texture_of(
     let texture = info.texture();
     let image = texture.source();
     let bytes = image_bytes(asset, &image, asset_path)?;
-    let stored = image_texture::decode(&bytes).map_err(|e| {
+    let mut stored = image_texture::decode(&bytes).map_err(|e| {
         let mime = match image.source() {
             gltf::image::Source::View { mime_type, .. } => Some(mime_type),
             gltf::image::Source::Uri { mime_type, .. } => mime_type,
@@ -247,14 +286,22 @@ fn texture_of(
             _ => ImageFilter::Trilinear,
         }
     };
-    // glTF colour textures are sRGB (the specification, 3.9.6).
+    let (encoding, scale) = match usage {
+        TextureUse::Colour(factor) => (Encoding::Srgb, factor),
+        TextureUse::Roughness(factor) => {
+            for v in &mut stored.values {
+                *v = Rgb::splat((factor * v.g).clamp(0.0, 1.0).powi(2));
+            }
+            (Encoding::Linear, Rgb::WHITE)
+        }
+    };
     let texture = ImageTexture::new(
         stored,
-        Encoding::Srgb,
+        encoding,
         [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
         filter,
         transform,
-        factor,
+        scale,
     );
     Ok((texture, set))
 }
