@@ -157,8 +157,10 @@ pub struct LightCaseResult {
     pub point: String,
     /// `None` when the case was not chi-square tested.
     pub chi_square: Option<ChiSquareReport>,
-    /// Why the chi-square test cannot apply, as established from the
-    /// light (a delta light); the other checks ran.
+    /// Why the chi-square test cannot apply or cannot decide, as the kit
+    /// established it: a delta light, or a failed test whose quadrature
+    /// did not converge (see [`ChiSquareReport::unresolved`]); the other
+    /// checks ran, and still fail the case.
     pub not_testable: Option<String>,
     pub power: Rgb,
     /// Everything that failed besides the chi-square statistic itself.
@@ -344,7 +346,11 @@ pub fn check_light_variants(
                     seed: chi_cfg.seed.wrapping_add(case as u64),
                     ..chi_cfg
                 };
-                result.chi_square = Some(chi_square(sample, pdf, &case_cfg));
+                let report = chi_square(sample, pdf, &case_cfg);
+                if !report.passed && report.defect.is_none() {
+                    result.not_testable = report.unresolved();
+                }
+                result.chi_square = Some(report);
                 result.problems.extend(check_values(
                     light.as_ref(),
                     &ctx,

@@ -379,7 +379,7 @@ fn check_bsdf_plugin(
     for (i, r) in results
         .iter()
         .enumerate()
-        .filter(|(_, r)| !r.chi_square.passed && !r.chi_square.observed.is_empty())
+        .filter(|(_, r)| !r.passed() && !r.chi_square.passed && !r.chi_square.observed.is_empty())
     {
         let path = out.join(format!("check-{name}-{i}.png"));
         write_histogram_png(&r.chi_square, &cfg.chi_square, &path)?;
