@@ -43,7 +43,7 @@ fn every_builtin_light_passes_the_check_suite() {
 /// What `lumis check-plugin --light NAME` runs.
 /// `cargo test -p lumis-tests --test light_checks -- --ignored`
 #[test]
-#[ignore = "check-plugin's configuration, about a minute"]
+#[ignore = "check-plugin's configuration, about 20 s"]
 fn every_builtin_light_passes_the_full_check_suite() {
     every_builtin_light_passes(&LightCheckConfig::default());
 }
