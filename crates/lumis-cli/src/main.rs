@@ -51,7 +51,7 @@ enum Command {
     /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
     /// around and inside them, consistency and finiteness; for light
     /// samplers, the pmf against the draws. Exits non-zero on any failure
-    /// and writes observed-vs-expected PNGs for failed BSDF cases.
+    /// and writes observed-vs-expected PNGs for failed chi-square cases.
     CheckPlugin {
         /// A plugin library: checks every plugin of these kinds it registers.
         library: Option<PathBuf>,
@@ -353,7 +353,7 @@ fn check_plugin(
         all_passed &= check_bsdf_plugin(&registry, name, &fixed, samples, bins, out)?;
     }
     for name in &names.light {
-        all_passed &= check_light_plugin(&registry, name, &fixed)?;
+        all_passed &= check_light_plugin(&registry, name, &fixed, out)?;
     }
     for name in &names.light_sampler {
         all_passed &= check_light_sampler_plugin(&registry, name, &fixed)?;
@@ -391,9 +391,27 @@ fn check_bsdf_plugin(
     Ok(results.iter().all(|r| r.passed()))
 }
 
-fn check_light_plugin(registry: &Registry, name: &str, fixed: &[(String, String)]) -> Result<bool> {
-    let results = check_light_with(registry, name, fixed, &LightCheckConfig::default())?;
+/// Checks the light `name`, writing a picture of each failed chi-square.
+fn check_light_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+    out: &std::path::Path,
+) -> Result<bool> {
+    let cfg = LightCheckConfig::default();
+    let results = check_light_with(registry, name, fixed, &cfg)?;
     print!("{}", format_light_results(&results));
+    for (i, r) in results.iter().enumerate().filter(|(_, r)| !r.passed()) {
+        let Some(report) = r.chi_square.as_ref().filter(|c| !c.passed) else {
+            continue;
+        };
+        let path = out.join(format!("check-{name}-{i}.png"));
+        write_histogram_png(report, &cfg.chi_square, &path)?;
+        println!(
+            "observed | expected histograms of failed case {i}: {}",
+            path.display()
+        );
+    }
     Ok(results.iter().all(|r| r.passed()))
 }
 
