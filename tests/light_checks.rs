@@ -105,7 +105,7 @@ fn delta_lights_are_not_testable() {
 
 /// An environment of cosine-weighted radiance about +y, sampled by its
 /// cosine, whose pdf (both `pdf_li` and the pdf `sample_li` returns, so
-/// the two agree) is scaled by `SCALE`.
+/// the two agree) is scaled by `PERCENT` / 100.
 struct Cosine<const PERCENT: u32>;
 
 impl<const PERCENT: u32> Cosine<PERCENT> {
