@@ -48,6 +48,12 @@ impl Default for ChiSquareConfig {
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChiSquareReport {
     pub statistic: f64,
+    /// The statistic that the quadrature's own error estimate (the last
+    /// refinement's change in each bin) could account for, with no defect
+    /// in the sampler: expected counts are only as good as the quadrature.
+    pub quadrature_statistic: f64,
+    /// The quadrature's error estimate of the pdf's whole integral.
+    pub quadrature_error: f64,
     pub degrees_of_freedom: usize,
     pub p_value: f64,
     /// Integral of the pdf over the sphere (must not exceed 1).
@@ -62,6 +68,28 @@ pub struct ChiSquareReport {
     pub observed: Vec<f64>,
     /// Expected samples per bin.
     pub expected: Vec<f64>,
+}
+
+impl ChiSquareReport {
+    /// Why this test cannot decide, if it cannot: the expected counts are
+    /// less certain than the counts themselves. The quadrature's error
+    /// estimate alone accounts for a statistic of `quadrature_statistic`;
+    /// above one standard deviation of the statistic under the null
+    /// hypothesis, `sqrt(2 dof)`, a failure may be the quadrature's, not
+    /// the sampler's. That happens where the pdf does not converge under
+    /// refinement even on the lobe zoom's magnified image: a lobe a few f32
+    /// ulps wide, whose pdf jumps between neighbouring representable
+    /// directions. A wrong sampler at any resolvable setting leaves the
+    /// quadrature converged and still fails.
+    pub fn unresolved(&self) -> Option<String> {
+        let noise = (2.0 * self.degrees_of_freedom as f64).sqrt();
+        (self.quadrature_statistic > noise).then(|| {
+            format!(
+                "the pdf's quadrature does not converge (its error alone accounts for a statistic of {:.1}, above the noise {noise:.1} of {} degrees of freedom): the lobe is narrower than the bins and f32 directions resolve",
+                self.quadrature_statistic, self.degrees_of_freedom
+            )
+        })
+    }
 }
 
 fn bin_of(d: Vec3, cfg: &ChiSquareConfig) -> usize {
@@ -135,7 +163,7 @@ fn adaptive_integral(
     tolerance: Tolerance,
     depth: u32,
     forced: u32,
-) -> f64 {
+) -> (f64, f64) {
     let (qz, qphi) = (0.5 * hz, 0.5 * hphi);
     let quarters = [
         (z0, phi0),
@@ -152,7 +180,7 @@ fn adaptive_integral(
         tolerance.smooth
     };
     if depth == 0 || (forced == 0 && (refined - whole).abs() <= allowed) {
-        return refined;
+        return (refined, (refined - whole).abs());
     }
     let half = Tolerance {
         smooth: 0.5 * tolerance.smooth,
@@ -170,7 +198,7 @@ fn adaptive_integral(
                 forced.saturating_sub(1),
             )
         })
-        .sum()
+        .fold((0.0, 0.0), |(v, e), (part, error)| (v + part, e + error))
 }
 
 /// Bins whose first-pass mass is below this many expected samples, but
@@ -183,7 +211,11 @@ const MISSED_FEATURE: f64 = 1e-2;
 /// quadrature found (almost) no mass are integrated again with full
 /// refinement: a feature as thin as the corner of an area light seen at a
 /// grazing angle can fall between the nodes of the first pass.
-fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareConfig) -> Vec<f64> {
+fn expected_mass(
+    pdf: &dyn Fn(Vec3) -> f32,
+    observed: &[u64],
+    cfg: &ChiSquareConfig,
+) -> (Vec<f64>, Vec<f64>) {
     let dz = 2.0 / cfg.z_bins as f64;
     let dphi = 2.0 * PI / cfg.phi_bins as f64;
     // Each bin's quadrature error must be small against its Poisson noise:
@@ -201,6 +233,7 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
         edge: floor,
     };
     let mut mass = vec![0.0; cfg.z_bins * cfg.phi_bins];
+    let mut error = vec![0.0; cfg.z_bins * cfg.phi_bins];
     for zi in 0..cfg.z_bins {
         for pi in 0..cfg.phi_bins {
             let cell = (-1.0 + zi as f64 * dz, dz, pi as f64 * dphi, dphi);
@@ -208,9 +241,10 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
             let i = zi * cfg.phi_bins + pi;
             // The first levels are always refined: a feature narrower than
             // the coarse nodes' spacing would otherwise go unseen.
-            mass[i] = adaptive_integral(pdf, cell, whole, tolerance(whole), cfg.max_refinement, 2);
+            (mass[i], error[i]) =
+                adaptive_integral(pdf, cell, whole, tolerance(whole), cfg.max_refinement, 2);
             if observed[i] > 0 && mass[i] * (cfg.samples as f64) < MISSED_FEATURE {
-                mass[i] = adaptive_integral(
+                (mass[i], error[i]) = adaptive_integral(
                     pdf,
                     cell,
                     whole,
@@ -221,7 +255,7 @@ fn expected_mass(pdf: &dyn Fn(Vec3) -> f32, observed: &[u64], cfg: &ChiSquareCon
             }
         }
     }
-    mass
+    (mass, error)
 }
 
 /// Tests that `sample(u)` draws unit directions with density `pdf` (w.r.t.
@@ -247,10 +281,14 @@ pub fn chi_square(
         produced += 1;
         observed[bin_of(d, cfg)] += 1;
     }
-    let mass = expected_mass(&pdf, &observed, cfg);
+    let (mass, error) = expected_mass(&pdf, &observed, cfg);
     let pdf_integral: f64 = mass.iter().sum();
+    let quadrature_error: f64 = error.iter().sum();
     let sampled_fraction = produced as f64 / cfg.samples as f64;
-    if pdf_integral > 1.0 + cfg.integral_tolerance {
+    // Over 1 by more than the tolerance and than the quadrature's own
+    // error estimate: an integral the quadrature cannot pin down is left
+    // to `unresolved`.
+    if pdf_integral - quadrature_error > 1.0 + cfg.integral_tolerance {
         defect.get_or_insert(format!("the pdf integrates to {pdf_integral:.5} > 1"));
     }
 
@@ -259,6 +297,8 @@ pub fn chi_square(
     let mut order: Vec<usize> = (0..expected.len()).collect();
     order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
     let (mut pool_obs, mut pool_exp, mut statistic, mut dof) = (0.0, 0.0, 0.0, 0usize);
+    let n = cfg.samples as f64;
+    let (mut quadrature_statistic, mut pool_error) = (0.0, 0.0);
     for &i in order.iter() {
         let (o, e) = (observed[i] as f64, expected[i]);
         if e <= 0.0 && o > 0.0 {
@@ -269,8 +309,10 @@ pub fn chi_square(
         if e < cfg.min_expected {
             pool_obs += o;
             pool_exp += e;
+            pool_error += n * error[i];
         } else {
             statistic += (o - e).powi(2) / e;
+            quadrature_statistic += (n * error[i]).powi(2) / e;
             dof += 1;
         }
     }
@@ -282,6 +324,7 @@ pub fn chi_square(
     pool_exp += missing_exp;
     if pool_exp >= cfg.min_expected {
         statistic += (pool_obs - pool_exp).powi(2) / pool_exp;
+        quadrature_statistic += pool_error.powi(2) / pool_exp;
         dof += 1;
     } else if pool_obs > pool_exp + 5.0 * pool_exp.max(1.0).sqrt() + 5.0 {
         defect.get_or_insert(format!(
@@ -295,6 +338,8 @@ pub fn chi_square(
             .unwrap_or(0.0);
     ChiSquareReport {
         statistic,
+        quadrature_statistic,
+        quadrature_error,
         degrees_of_freedom: dof,
         p_value,
         pdf_integral,
@@ -360,6 +405,8 @@ mod tests {
             &ChiSquareConfig::default(),
         );
         assert!(!r.passed, "{r:?}");
+        // A smooth pdf's quadrature converges: the failure is the sampler's.
+        assert_eq!(r.unresolved(), None);
     }
 
     #[test]

@@ -353,6 +353,8 @@ mod tests {
             &cfg,
         );
         assert!(!bad.passed, "p {}", bad.p_value);
+        // A lobe of 1e-3 rad is resolved: the kit does not excuse it.
+        assert_eq!((good.unresolved(), bad.unresolved()), (None, None));
     }
 
     #[test]
@@ -396,5 +398,6 @@ mod tests {
         );
         let (bad, _) = chi_square_zoomed(sample(0.105), pdf, &cfg);
         assert!(!bad.passed, "p {}", bad.p_value);
+        assert_eq!(bad.unresolved(), None);
     }
 }

@@ -7,6 +7,10 @@ use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use lumis_check::bsdf_suite::{
     check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
 };
+use lumis_check::light_sampler_suite::{
+    check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
+};
+use lumis_check::light_suite::{check_light_with, format_light_results, LightCheckConfig};
 use lumis_cli::{
     analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
     registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
@@ -40,17 +44,26 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Statistically check BSDF plugins: chi-square of sample_f against pdf,
-    /// pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
-    /// reciprocity and finiteness, over a sweep of the plugin's parameters
-    /// and of incident angles down to cos theta = 1e-4. Exits non-zero on
-    /// any failure and writes observed-vs-expected PNGs for failed cases.
+    /// Statistically check BSDF, light and light-sampler plugins over a
+    /// sweep of their parameters: for BSDFs, chi-square of sample_f against
+    /// pdf, pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
+    /// reciprocity and finiteness, at incident angles down to cos theta =
+    /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
+    /// around and inside them, consistency and finiteness; for light
+    /// samplers, the pmf against the draws. Exits non-zero on any failure
+    /// and writes observed-vs-expected PNGs for failed chi-square cases.
     CheckPlugin {
-        /// A plugin library: checks every BSDF it registers.
+        /// A plugin library: checks every plugin of these kinds it registers.
         library: Option<PathBuf>,
         /// Check this BSDF (built-in or from the library); repeatable.
         #[arg(long)]
         bsdf: Vec<String>,
+        /// Check this light (built-in or from the library); repeatable.
+        #[arg(long)]
+        light: Vec<String>,
+        /// Check this light sampler (built-in or from the library); repeatable.
+        #[arg(long)]
+        light_sampler: Vec<String>,
         /// Samples per chi-square test.
         #[arg(long, default_value_t = 1_000_000)]
         samples: usize,
@@ -162,11 +175,20 @@ fn main() -> ExitCode {
         Command::CheckPlugin {
             library,
             bsdf,
+            light,
+            light_sampler,
             samples,
             bins,
             out,
             set,
-        } => plain(|| check_plugin(library, bsdf, samples, bins, &out, &set).map(Outcome::passed)),
+        } => plain(|| {
+            let names = PluginNames {
+                bsdf,
+                light,
+                light_sampler,
+            };
+            check_plugin(library, names, samples, bins, &out, &set).map(Outcome::passed)
+        }),
         Command::Converge(args) => plain(|| {
             registry_with_search_path()
                 .and_then(|registry| converge(&args, &registry, &*stop_on_interrupt()?))
@@ -268,10 +290,41 @@ fn interruptible(
     }
 }
 
+/// The plugins `lumis check-plugin` checks, by kind.
+#[derive(Default)]
+struct PluginNames {
+    bsdf: Vec<String>,
+    light: Vec<String>,
+    light_sampler: Vec<String>,
+}
+
+impl PluginNames {
+    fn is_empty(&self) -> bool {
+        self.bsdf.is_empty() && self.light.is_empty() && self.light_sampler.is_empty()
+    }
+
+    /// Adds the plugins of the checked kinds that `registry` has and
+    /// `before` did not (a library's, as it registered them).
+    fn extend_added(&mut self, before: &[(PluginKind, &str)], registry: &Registry) {
+        for p in registry.plugins() {
+            if before.contains(&(p.spec.kind, p.spec.name)) {
+                continue;
+            }
+            let name = p.spec.name.to_string();
+            match p.spec.kind {
+                PluginKind::Bsdf => self.bsdf.push(name),
+                PluginKind::Light => self.light.push(name),
+                PluginKind::LightSampler => self.light_sampler.push(name),
+                _ => {}
+            }
+        }
+    }
+}
+
 /// `lumis check-plugin`: returns whether every case passed.
 fn check_plugin(
     library: Option<PathBuf>,
-    mut names: Vec<String>,
+    mut names: PluginNames,
     samples: usize,
     bins: usize,
     out: &std::path::Path,
@@ -280,46 +333,95 @@ fn check_plugin(
     let fixed = lumis_cli::fixed_parameters(set)?;
     let mut registry = registry_with_search_path()?;
     if let Some(library) = &library {
-        // The library's BSDFs are the ones it added (its path as the
+        // The library's plugins are the ones it added (its path as the
         // registry labels them is the resolved one, not the one given).
-        let bsdfs = |registry: &Registry| -> Vec<String> {
-            registry
-                .plugins()
-                .into_iter()
-                .filter(|p| p.spec.kind == PluginKind::Bsdf)
-                .map(|p| p.spec.name.to_string())
-                .collect()
-        };
-        let before = bsdfs(&registry);
+        let before: Vec<(PluginKind, &str)> = registry
+            .plugins()
+            .into_iter()
+            .map(|p| (p.spec.kind, p.spec.name))
+            .collect();
         lumis_loader::load_library(library, &mut registry)?;
-        names.extend(bsdfs(&registry).into_iter().filter(|n| !before.contains(n)));
+        names.extend_added(&before, &registry);
     }
     if names.is_empty() {
         return Err(Error::msg(
-            "nothing to check: give a plugin library that registers BSDFs, or --bsdf NAME",
+            "nothing to check: give a plugin library that registers BSDFs, lights or light samplers, or --bsdf, --light or --light-sampler NAME",
         ));
     }
+    let mut all_passed = true;
+    for name in &names.bsdf {
+        all_passed &= check_bsdf_plugin(&registry, name, &fixed, samples, bins, out)?;
+    }
+    for name in &names.light {
+        all_passed &= check_light_plugin(&registry, name, &fixed, out)?;
+    }
+    for name in &names.light_sampler {
+        all_passed &= check_light_sampler_plugin(&registry, name, &fixed)?;
+    }
+    Ok(all_passed)
+}
+
+/// Checks the BSDF `name`, writing a picture of each failed chi-square.
+fn check_bsdf_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+    samples: usize,
+    bins: usize,
+    out: &std::path::Path,
+) -> Result<bool> {
     let mut cfg = BsdfCheckConfig::default();
     cfg.chi_square.samples = samples;
     cfg.chi_square.z_bins = bins;
     cfg.chi_square.phi_bins = bins;
-    let mut all_passed = true;
-    for name in &names {
-        let results = check_bsdf_with(&registry, name, &fixed, &cfg)?;
-        print!("{}", format_results(&results));
-        for (i, r) in results
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| !r.chi_square.passed && !r.chi_square.observed.is_empty())
-        {
-            let path = out.join(format!("check-{name}-{i}.png"));
-            write_histogram_png(&r.chi_square, &cfg.chi_square, &path)?;
-            println!(
-                "observed | expected histograms of failed case {i}: {}",
-                path.display()
-            );
-        }
-        all_passed &= results.iter().all(|r| r.passed());
+    let results = check_bsdf_with(registry, name, fixed, &cfg)?;
+    print!("{}", format_results(&results));
+    for (i, r) in results
+        .iter()
+        .enumerate()
+        .filter(|(_, r)| !r.passed() && !r.chi_square.passed && !r.chi_square.observed.is_empty())
+    {
+        let path = out.join(format!("check-{name}-{i}.png"));
+        write_histogram_png(&r.chi_square, &cfg.chi_square, &path)?;
+        println!(
+            "observed | expected histograms of failed case {i}: {}",
+            path.display()
+        );
     }
-    Ok(all_passed)
+    Ok(results.iter().all(|r| r.passed()))
+}
+
+/// Checks the light `name`, writing a picture of each failed chi-square.
+fn check_light_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+    out: &std::path::Path,
+) -> Result<bool> {
+    let cfg = LightCheckConfig::default();
+    let results = check_light_with(registry, name, fixed, &cfg)?;
+    print!("{}", format_light_results(&results));
+    for (i, r) in results.iter().enumerate().filter(|(_, r)| !r.passed()) {
+        let Some(report) = r.chi_square.as_ref().filter(|c| !c.passed) else {
+            continue;
+        };
+        let path = out.join(format!("check-{name}-{i}.png"));
+        write_histogram_png(report, &cfg.chi_square, &path)?;
+        println!(
+            "observed | expected histograms of failed case {i}: {}",
+            path.display()
+        );
+    }
+    Ok(results.iter().all(|r| r.passed()))
+}
+
+fn check_light_sampler_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+) -> Result<bool> {
+    let cfg = LightSamplerCheckConfig::default();
+    let results = check_light_sampler_with(registry, name, fixed, &cfg)?;
+    print!("{}", format_light_sampler_results(&results));
+    Ok(results.iter().all(|r| r.passed()))
 }

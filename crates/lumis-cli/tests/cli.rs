@@ -274,6 +274,33 @@ fn check_plugin_checks_a_builtin_bsdf_and_reports_a_table() {
     );
 }
 
+/// Delta lights are not testable, and say so, without failing the run.
+#[test]
+fn check_plugin_checks_builtin_lights_and_light_samplers() {
+    let result = lumis(&[
+        "check-plugin",
+        "--light",
+        "spot",
+        "--light-sampler",
+        "uniform",
+    ]);
+    let stdout = String::from_utf8(result.stdout).unwrap();
+    assert!(
+        result.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(
+        stdout.contains("not testable: delta light") && !stdout.contains("FAILED"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("8 passed, 0 failed"), "{stdout}");
+    let missing = lumis(&["check-plugin", "--light", "no-such-light"]);
+    assert!(!missing.status.success());
+    assert!(String::from_utf8_lossy(&missing.stderr)
+        .contains("no light plugin named \"no-such-light\""));
+}
+
 #[test]
 fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
     let tmp = scratch("analyze");

@@ -1,0 +1,648 @@
+//! The full check of a light plugin, as `lumis check-plugin` and the test
+//! suite run it: over a sweep of the plugin's own parameters, for each
+//! shape the plugin accepts (none, a quad, a triangle, a sphere: area
+//! lights are the emission of a shape) and from reference points below,
+//! beside, far from, behind and (spheres) on and inside the light, check
+//!
+//! - chi-square goodness of fit of `sample_li` against `pdf_li` (a
+//!   one-sided emitter seen from behind must give pdf 0 and no samples);
+//! - `sample_li` returns the pdf `pdf_li` gives for its direction and the
+//!   radiance `l()` gives at its point, and `sample_li_batch` returns what
+//!   `sample_li` does;
+//! - `power()` is finite and non-negative;
+//! - no NaN, infinite or negative radiance or pdf anywhere.
+//!
+//! A delta light (`LightKind::DeltaPosition`) has no density to test: its
+//! cases are reported as not testable, after checking what it does
+//! promise, that `sample_li` is deterministic and `pdf_li` is zero.
+
+use std::fmt::Write;
+
+use lumis_core::params::ParamDefault;
+use lumis_core::ray::SurfacePoint;
+use lumis_core::{
+    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, Location, ParamType,
+    PluginEntity, PluginKind, Registry, Result, Rgb, Vec2, Vec3,
+};
+use lumis_sampling::{warp, Pcg32};
+use rayon::prelude::*;
+
+use crate::adapters::light_pair;
+use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
+use crate::corrected_significance;
+use crate::sweep::{parameter_sweep_with, Variant};
+
+/// How thoroughly to check.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightCheckConfig {
+    /// Bins, samples and quadrature of each chi-square test; its
+    /// significance is replaced by the Sidak-corrected one for the sweep.
+    pub chi_square: ChiSquareConfig,
+    /// Overall false-alarm rate of the whole sweep.
+    pub alpha: f64,
+    /// Samples for the consistency and finiteness checks of each case.
+    pub samples: usize,
+}
+
+impl Default for LightCheckConfig {
+    fn default() -> Self {
+        Self {
+            chi_square: ChiSquareConfig {
+                z_bins: 40,
+                phi_bins: 80,
+                samples: 50_000,
+                // A uniform solid-angle pdf is an indicator of the light's
+                // outline, and an area-sampling pdf peaks toward grazing
+                // directions: the bins those cross need deeper quadrature,
+                // and the integral is only good to a few 1e-3.
+                max_refinement: 8,
+                integral_tolerance: 5e-3,
+                ..Default::default()
+            },
+            alpha: 0.01,
+            samples: 4_000,
+        }
+    }
+}
+
+/// The scene bound handed to `preprocess` (environment lights need one):
+/// a sphere holding every light and reference point below.
+pub const SCENE_CENTER: Vec3 = Vec3::new(0.0, 0.5, 0.0);
+pub const SCENE_RADIUS: f32 = 4.0;
+
+/// Where required position parameters put the light: the first at
+/// [`LIGHT_POSITION`], the next at the origin (a spot light's target).
+const LIGHT_POSITION: [f32; 3] = [0.0, 1.0, 0.0];
+const SECOND_POSITION: [f32; 3] = [0.0, 0.0, 0.0];
+
+/// A shape a light can be the emission of, with the reference points that
+/// see it from every side that matters.
+struct Placement {
+    label: &'static str,
+    shape: LightShape,
+    points: Vec<(&'static str, Vec3)>,
+}
+
+/// Every shape is centred near [`LIGHT_POSITION`]; planar ones face -y
+/// (their front normal is `edge_u x edge_v`), so "behind" sees their back.
+fn placements() -> Vec<Placement> {
+    let planar_points = || {
+        vec![
+            ("below", Vec3::new(0.1, 0.0, 0.1)),
+            ("close", Vec3::new(0.2, 0.9, 0.0)),
+            // 9.5 degrees above the plane: grazing, yet wide enough (0.03
+            // sr) for the quadrature to resolve the outline.
+            ("grazing", Vec3::new(1.5, 0.8, 0.3)),
+            ("far", Vec3::new(0.0, -2.0, 0.0)),
+            ("behind", Vec3::new(0.0, 1.5, 0.0)),
+        ]
+    };
+    vec![
+        Placement {
+            label: "none",
+            shape: LightShape::None,
+            points: vec![
+                ("below", Vec3::new(0.1, 0.0, 0.1)),
+                ("beside", Vec3::new(1.5, 0.8, 0.3)),
+                ("far", Vec3::new(0.0, -2.0, 0.0)),
+                ("above", Vec3::new(0.0, 1.5, 0.0)),
+            ],
+        },
+        Placement {
+            label: "quad",
+            shape: LightShape::Quad {
+                corner: Vec3::new(-0.3, 1.0, -0.2),
+                edge_u: Vec3::X,
+                edge_v: Vec3::new(0.0, 0.0, 0.5),
+            },
+            points: planar_points(),
+        },
+        Placement {
+            label: "triangle",
+            shape: LightShape::Triangle {
+                p: [
+                    Vec3::new(-0.5, 1.0, -0.5),
+                    Vec3::new(0.8, 1.0, -0.3),
+                    Vec3::new(0.0, 1.0, 0.7),
+                ],
+            },
+            points: planar_points(),
+        },
+        Placement {
+            label: "sphere",
+            shape: LightShape::Sphere {
+                center: Vec3::new(0.0, 1.0, 0.0),
+                radius: 0.3,
+                inward: false,
+            },
+            points: vec![
+                ("near", Vec3::new(0.2, 0.5, 0.1)),
+                ("far", Vec3::new(0.0, -3.0, 1.0)),
+                ("just outside", Vec3::new(0.0, 0.69, 0.0)),
+                ("on it", Vec3::new(0.0, 0.7, 0.0)),
+                ("inside", Vec3::new(0.1, 1.1, 0.0)),
+            ],
+        },
+    ]
+}
+
+/// The outcome of one (variant, shape, reference point) case.
+#[derive(Debug, Clone)]
+pub struct LightCaseResult {
+    pub light: String,
+    pub variant: String,
+    /// The shape the light is the emission of (`none` for `[[light]]`).
+    pub shape: String,
+    /// Where the reference point is, e.g. `behind`.
+    pub point: String,
+    /// `None` when the case was not chi-square tested.
+    pub chi_square: Option<ChiSquareReport>,
+    /// Why the chi-square test cannot apply or cannot decide, as the kit
+    /// established it: a delta light, or a failed test whose quadrature
+    /// did not converge (see [`ChiSquareReport::unresolved`]); the other
+    /// checks ran, and still fail the case.
+    pub not_testable: Option<String>,
+    pub power: Rgb,
+    /// Everything that failed besides the chi-square statistic itself.
+    pub problems: Vec<String>,
+    /// Why the plugin refused this parameter setting (its factory's error).
+    pub refused: Option<String>,
+}
+
+impl LightCaseResult {
+    pub fn passed(&self) -> bool {
+        self.refused.is_some()
+            || self.problems.is_empty()
+                && (self.not_testable.is_some()
+                    || self.chi_square.as_ref().is_some_and(|c| c.passed))
+    }
+}
+
+/// How the light made for `variant` on `shape` is named, in messages and
+/// in the registry's record of faults.
+fn owner(name: &str, variant: &Variant, shape: &str) -> String {
+    format!("light \"{name}\" [{}] on shape {shape}", variant.label)
+}
+
+/// The light plugin `name` with the parameters of `variant`, as the
+/// emission of `shape`, preprocessed with the kit's scene bound.
+pub fn instantiate(
+    registry: &Registry,
+    name: &str,
+    variant: &Variant,
+    shape: (&str, &LightShape),
+) -> Result<Box<dyn Light>> {
+    let entity = PluginEntity::new(
+        PluginKind::Light,
+        owner(name, variant, shape.0),
+        name,
+        variant.table.clone(),
+        Location::Builtin,
+    );
+    let mut light = registry.create::<dyn Light>(&entity, shape.1)?;
+    light.preprocess(SCENE_CENTER, SCENE_RADIUS);
+    Ok(light)
+}
+
+/// `fixed` with the kit's positions for the required `vec3` parameters
+/// that it does not hold (a sweep cannot invent where a light is).
+fn with_positions(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+) -> Result<Vec<(String, String)>> {
+    let plugin = registry
+        .find(PluginKind::Light, name)
+        .ok_or_else(|| Error::msg(format!("no light plugin named \"{name}\"")))?;
+    let mut out = fixed.to_vec();
+    let mut places = [LIGHT_POSITION, SECOND_POSITION].into_iter();
+    for p in plugin.spec.params {
+        if p.ty == ParamType::Vec3
+            && p.default == ParamDefault::Required
+            && !fixed.iter().any(|(k, _)| k == p.name)
+        {
+            let [x, y, z] = places.next().unwrap_or(SECOND_POSITION);
+            out.push((p.name.to_string(), format!("[{x:?}, {y:?}, {z:?}]")));
+        }
+    }
+    Ok(out)
+}
+
+/// Runs every check over the sweep of the light plugin `name`'s declared
+/// parameters, with parameters in `fixed` held at the given values (see
+/// [`parameter_sweep_with`]).
+pub fn check_light_with(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+    cfg: &LightCheckConfig,
+) -> Result<Vec<LightCaseResult>> {
+    let fixed = with_positions(registry, name, fixed)?;
+    let plugin = registry
+        .find(PluginKind::Light, name)
+        .ok_or_else(|| Error::msg(format!("no light plugin named \"{name}\"")))?;
+    let variants = parameter_sweep_with(&plugin.spec, &fixed)?;
+    check_light_variants(registry, name, &variants, cfg)
+}
+
+/// Runs every check for each of `variants` of the light plugin `name`, on
+/// each shape whose emission its default setting accepts to be, from each
+/// reference point; the cases run in parallel and the chi-square
+/// significance is corrected for the number of them.
+pub fn check_light_variants(
+    registry: &Registry,
+    name: &str,
+    variants: &[Variant],
+    cfg: &LightCheckConfig,
+) -> Result<Vec<LightCaseResult>> {
+    let base = variants
+        .first()
+        .ok_or_else(|| Error::msg("no parameter setting to check"))?;
+    let mut refusals = Vec::new();
+    let placements: Vec<Placement> = placements()
+        .into_iter()
+        .filter(
+            |p| match instantiate(registry, name, base, (p.label, &p.shape)) {
+                Ok(_) => true,
+                Err(e) => {
+                    refusals.push(format!("{}: {e}", p.label));
+                    false
+                }
+            },
+        )
+        .collect();
+    if placements.is_empty() {
+        return Err(Error::msg(format!(
+            "light \"{name}\" with its default parameters is made on no shape (none, quad, triangle, sphere): {}",
+            refusals.join("; ")
+        )));
+    }
+    let mut work = Vec::new();
+    for variant in variants {
+        for placement in &placements {
+            let light = instantiate(registry, name, variant, (placement.label, &placement.shape));
+            let light = std::sync::Arc::new(light);
+            for &(point, p) in &placement.points {
+                work.push((variant, placement.label, light.clone(), point, p));
+            }
+        }
+    }
+    let tests = work
+        .iter()
+        .filter(|w| matches!(w.2.as_ref(), Ok(l) if l.kind() != LightKind::DeltaPosition))
+        .count();
+    let chi_cfg = ChiSquareConfig {
+        significance: corrected_significance(cfg.alpha, tests),
+        ..cfg.chi_square
+    };
+    let mut results: Vec<LightCaseResult> = work
+        .par_iter()
+        .enumerate()
+        .map(|(case, (variant, shape, light, point, p))| {
+            let mut result = LightCaseResult {
+                light: name.to_string(),
+                variant: variant.label.clone(),
+                shape: shape.to_string(),
+                point: point.to_string(),
+                chi_square: None,
+                not_testable: None,
+                power: Rgb::splat(f32::NAN),
+                problems: Vec::new(),
+                refused: None,
+            };
+            let light = match light.as_ref() {
+                Ok(light) => light,
+                Err(e) => {
+                    let panicked = !registry
+                        .faults()
+                        .faults_of(&owner(name, variant, shape))
+                        .is_empty();
+                    if panicked {
+                        result.problems.push(e.to_string());
+                    } else {
+                        result.refused = Some(e.to_string());
+                    }
+                    return result;
+                }
+            };
+            let ctx = LightSampleContext::at(*p);
+            result.power = light.power();
+            if !result.power.is_finite() || result.power.min_component() < 0.0 {
+                result
+                    .problems
+                    .push(format!("power() = {:?}", result.power));
+            }
+            if light.kind() == LightKind::DeltaPosition {
+                result
+                    .problems
+                    .extend(check_delta(light.as_ref(), &ctx, cfg.samples, case as u64));
+                result.not_testable = Some(
+                    "delta light: no density to test (sample_li deterministic, pdf_li = 0 checked)"
+                        .into(),
+                );
+            } else {
+                let (sample, pdf) = light_pair(light.as_ref(), ctx);
+                let case_cfg = ChiSquareConfig {
+                    seed: chi_cfg.seed.wrapping_add(case as u64),
+                    ..chi_cfg
+                };
+                let report = chi_square(sample, pdf, &case_cfg);
+                if !report.passed && report.defect.is_none() {
+                    result.not_testable = report.unresolved();
+                }
+                result.chi_square = Some(report);
+                result.problems.extend(check_values(
+                    light.as_ref(),
+                    &ctx,
+                    cfg.samples,
+                    case as u64,
+                ));
+            }
+            result
+        })
+        .collect();
+    // A loaded plugin that panicked answered with neutral values (see
+    // lumis_core::guard); every case of its setting fails with the panic.
+    for result in &mut results {
+        let variant = variants
+            .iter()
+            .find(|v| v.label == result.variant)
+            .expect("results come from the variants");
+        for fault in registry
+            .faults()
+            .faults_of(&owner(name, variant, &result.shape))
+        {
+            if !result.problems.iter().any(|p| p.contains(&fault.message)) {
+                result.problems.push(fault.to_string());
+            }
+        }
+    }
+    Ok(results)
+}
+
+/// Whether a returned value is usable: finite and non-negative.
+fn bad(v: f32) -> bool {
+    !v.is_finite() || v < 0.0
+}
+
+fn bad_rgb(c: Rgb) -> bool {
+    bad(c.r) || bad(c.g) || bad(c.b)
+}
+
+/// Within a relative 1e-3 of each other, or bit for bit the same (so that
+/// a NaN in both is reported once, as a NaN, not as a mismatch).
+fn close(a: f32, b: f32) -> bool {
+    a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-3 * a.abs().max(b.abs())
+}
+
+fn close_rgb(a: Rgb, b: Rgb) -> bool {
+    close(a.r, b.r) && close(a.g, b.g) && close(a.b, b.b)
+}
+
+/// The radiance `l()` gives for a sample: leaving the light's point
+/// toward the reference point, or (infinite lights) arriving along `-wi`.
+fn radiance_of(light: &dyn Light, ctx: &LightSampleContext, s: &LightSample) -> Rgb {
+    match light.kind() {
+        LightKind::Infinite => light.l(ctx.p(), Vec3::ZERO, Vec2::ZERO, s.wi),
+        _ => light.l(s.p.p, s.p.n, Vec2::ZERO, -s.wi),
+    }
+}
+
+/// Finiteness, and `sample_li` against `pdf_li`, `l` and `sample_li_batch`.
+fn check_values(
+    light: &dyn Light,
+    ctx: &LightSampleContext,
+    samples: usize,
+    seed: u64,
+) -> Vec<String> {
+    let mut rng = Pcg32::new(seed, 0x119e);
+    let mut problems = Vec::new();
+    let mut note = |p: String| {
+        if problems.len() < 5 {
+            problems.push(p);
+        }
+    };
+    let mut lanes = Vec::new();
+    for _ in 0..samples {
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        if lanes.len() < BATCH_LANES {
+            lanes.push(u);
+        }
+        if let Some(s) = light.sample_li(ctx, u) {
+            if bad(s.pdf) || bad_rgb(s.l) || !s.wi.is_finite() || !s.p.p.is_finite() {
+                note(format!(
+                    "sample_li returned l = {:?}, pdf = {}, wi = {:?}, p = {:?}",
+                    s.l, s.pdf, s.wi, s.p.p
+                ));
+                continue;
+            }
+            if s.pdf > 0.0 {
+                let pdf = light.pdf_li(ctx, s.wi);
+                if !close(pdf, s.pdf) && !within_spread(light, ctx, s.wi, s.pdf) {
+                    note(format!(
+                        "sample_li pdf {} but pdf_li() = {pdf} at wi = {:?}",
+                        s.pdf, s.wi
+                    ));
+                }
+                let l = radiance_of(light, ctx, &s);
+                if !close_rgb(l, s.l) {
+                    note(format!(
+                        "sample_li radiance {:?} but l() = {l:?} at p = {:?}",
+                        s.l, s.p.p
+                    ));
+                }
+            }
+        }
+        // The density anywhere on the sphere must be finite and non-negative.
+        let wi = warp::square_to_uniform_sphere(u);
+        let pdf = light.pdf_li(ctx, wi);
+        if bad(pdf) {
+            note(format!("pdf_li() = {pdf} at wi = {wi:?}"));
+        }
+    }
+    for p in check_batch(light, ctx, &lanes) {
+        note(p);
+    }
+    problems
+}
+
+/// How far from a sampled direction [`within_spread`] looks (radians).
+const DIRECTION_SPREAD: f32 = 1e-6;
+
+/// Whether `pdf` differs from `pdf_li(wi)` by no more than `pdf_li`
+/// itself varies over directions within [`DIRECTION_SPREAD`] of `wi` (a
+/// few f32 ulps of a direction). An area-sampling pdf grows as `1 / cos`
+/// toward a light's silhouette, and jumps to 0 across it: there the pdf of
+/// the sampled point and the pdf of the ray's hit agree only as well as
+/// f32 resolves the direction, and a comparison says nothing.
+fn within_spread(light: &dyn Light, ctx: &LightSampleContext, wi: Vec3, pdf: f32) -> bool {
+    let e1 = wi.any_orthonormal_vector();
+    let e2 = wi.cross(e1);
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for t in [e1, -e1, e2, -e2] {
+        let v = light.pdf_li(ctx, (wi + DIRECTION_SPREAD * t).normalize());
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    (pdf - light.pdf_li(ctx, wi)).abs() <= hi - lo
+}
+
+/// Enough lanes for every SIMD width and a partial last chunk.
+const BATCH_LANES: usize = 1021;
+
+/// `sample_li_batch` against `sample_li`, lane by lane, up to rounding (a
+/// relative 1e-4, and `None` exactly where the scalar method gives it).
+fn check_batch(light: &dyn Light, ctx: &LightSampleContext, u: &[Vec2]) -> Vec<String> {
+    let ctxs = vec![*ctx; u.len()];
+    let mut out = vec![None; u.len()];
+    light.sample_li_batch(&ctxs, u, &mut out);
+    let near =
+        |a: f32, b: f32| a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
+    let lanes = u.len();
+    for (i, (&u, batch)) in u.iter().zip(&out).enumerate() {
+        let scalar = light.sample_li(ctx, u);
+        let agree = match (&scalar, batch) {
+            (None, None) => true,
+            (Some(a), Some(b)) => {
+                near(a.pdf, b.pdf)
+                    && near(a.l.r, b.l.r)
+                    && near(a.l.g, b.l.g)
+                    && near(a.l.b, b.l.b)
+                    && (a.wi - b.wi).abs().max_element() <= 1e-4
+            }
+            _ => false,
+        };
+        if !agree {
+            return vec![format!(
+                "sample_li_batch lane {i} of {lanes} gave {batch:?} but sample_li gave {scalar:?} (u = {u:?})"
+            )];
+        }
+    }
+    Vec::new()
+}
+
+/// A delta light: `sample_li` returns the same sample whatever `u` (bit
+/// for bit), finite and non-negative, and `pdf_li` is zero everywhere.
+fn check_delta(
+    light: &dyn Light,
+    ctx: &LightSampleContext,
+    samples: usize,
+    seed: u64,
+) -> Vec<String> {
+    let mut rng = Pcg32::new(seed, 0xde17a);
+    let mut problems = Vec::new();
+    let key = |s: &Option<LightSample>| {
+        s.map(|s| {
+            let SurfacePoint { p, .. } = s.p;
+            [
+                s.l.r, s.l.g, s.l.b, s.pdf, s.wi.x, s.wi.y, s.wi.z, p.x, p.y, p.z,
+            ]
+            .map(f32::to_bits)
+        })
+    };
+    let first = light.sample_li(ctx, Vec2::new(0.5, 0.5));
+    if let Some(s) = first {
+        if bad(s.pdf) || bad_rgb(s.l) || !s.wi.is_finite() {
+            problems.push(format!(
+                "sample_li returned l = {:?}, pdf = {}, wi = {:?}",
+                s.l, s.pdf, s.wi
+            ));
+        }
+        let pdf = light.pdf_li(ctx, s.wi);
+        if pdf != 0.0 {
+            problems.push(format!(
+                "a delta light's pdf_li() = {pdf} (not 0) at its own wi"
+            ));
+        }
+    }
+    for _ in 0..samples {
+        let u = Vec2::new(rng.next_f32(), rng.next_f32());
+        let s = light.sample_li(ctx, u);
+        if key(&s) != key(&first) {
+            problems.push(format!(
+                "a delta light's sample_li depends on u: {s:?} at u = {u:?}, {first:?} at u = (0.5, 0.5)"
+            ));
+            break;
+        }
+        let wi = warp::square_to_uniform_sphere(u);
+        let pdf = light.pdf_li(ctx, wi);
+        if pdf != 0.0 {
+            problems.push(format!(
+                "a delta light's pdf_li() = {pdf} (not 0) at wi = {wi:?}"
+            ));
+            break;
+        }
+    }
+    problems
+}
+
+/// A readable table of results, one line per case, failures explained.
+pub fn format_light_results(results: &[LightCaseResult]) -> String {
+    let mut out = String::new();
+    // The case number is the one failure pictures carry
+    // (`check-NAME-CASE.png`).
+    let _ = writeln!(
+        out,
+        "{:>4} {:<10} {:<36} {:<8} {:<12} {:>10} {:>9} {:>9} {:>10}  result",
+        "case", "light", "parameters", "shape", "from", "p-value", "pdf int", "sampled", "power"
+    );
+    for (case, r) in results.iter().enumerate() {
+        let (p, integral, sampled) = r
+            .chi_square
+            .as_ref()
+            .map_or((f64::NAN, f64::NAN, f64::NAN), |c| {
+                (c.p_value, c.pdf_integral, c.sampled_fraction)
+            });
+        let verdict = match (&r.refused, &r.not_testable, r.passed()) {
+            (Some(_), ..) => "refused",
+            (None, _, false) => "FAILED",
+            (None, Some(_), true) => "not testable",
+            (None, None, true) => "ok",
+        };
+        let _ = writeln!(
+            out,
+            "{case:>4} {:<10} {:<36} {:<8} {:<12} {p:>10.3e} {integral:>9.5} {sampled:>9.5} {:>10.4e}  {verdict}",
+            r.light,
+            r.variant,
+            r.shape,
+            r.point,
+            r.power.luminance(),
+        );
+        if let Some(why) = &r.refused {
+            let _ = writeln!(
+                out,
+                "    not tested: the plugin refuses these parameters: {why}"
+            );
+            continue;
+        }
+        if let Some(why) = &r.not_testable {
+            let _ = writeln!(out, "    not testable: {why}");
+        }
+        if let Some(c) = &r.chi_square {
+            if let Some(d) = &c.defect {
+                let _ = writeln!(out, "    chi-square: {d}");
+            } else if !c.passed {
+                let _ = writeln!(
+                    out,
+                    "    chi-square: statistic {:.1} with {} degrees of freedom",
+                    c.statistic, c.degrees_of_freedom
+                );
+            }
+        }
+        for p in &r.problems {
+            let _ = writeln!(out, "    {p}");
+        }
+    }
+    let failed = results.iter().filter(|r| !r.passed()).count();
+    let refused = results.iter().filter(|r| r.refused.is_some()).count();
+    let untestable = results
+        .iter()
+        .filter(|r| r.refused.is_none() && r.not_testable.is_some() && r.passed())
+        .count();
+    let _ = writeln!(
+        out,
+        "{} passed, {failed} failed, {untestable} not testable, {refused} refused by the plugin",
+        results.len() - failed - refused - untestable
+    );
+    out
+}
