@@ -273,3 +273,27 @@ fn every_microfacet_bsdf_takes_a_roughness_texture() {
         assert_ne!(plain.image.pixels, checked.image.pixels, "{bsdf}");
     }
 }
+
+/// The other textured parameters: a constant texture renders the constant
+/// to the bit.
+#[test]
+fn colour_and_exponent_parameters_take_textures() {
+    for (bsdf, key, value) in [
+        ("blinn", "reflectance", "0.7"),
+        ("blinn", "exponent", "40.0"),
+        ("plastic", "specular_reflectance", "0.6"),
+    ] {
+        let floor = |textures: &str, value: &str| {
+            scene(textures, "0.5").replacen(
+                "type = \"diffuse\"\nreflectance = 0.5",
+                &format!("type = \"{bsdf}\"\n{key} = {value}"),
+                1,
+            )
+        };
+        let constant = format!("[[texture]]\nname = \"t\"\ntype = \"constant\"\nvalue = {value}\n");
+        let plain = render_toml(&floor("", value), &[], 2);
+        let textured = render_toml(&floor(&constant, "{ texture = \"t\" }"), &[], 2);
+        assert!(plain.image.mean().iter().any(|&c| c > 0.0), "{bsdf} {key}");
+        assert_eq!(plain.image.pixels, textured.image.pixels, "{bsdf} {key}");
+    }
+}

@@ -16,7 +16,7 @@ use std::f32::consts::PI;
 
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
-    PluginSpec, Result, Rgb, Vec2, Vec3,
+    PluginSpec, Result, Rgb, TexturedFloat, TexturedRgb, Vec2, Vec3,
 };
 
 use crate::fresnel::reflect;
@@ -30,14 +30,15 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: BlinnParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct BlinnParams {
-    /// scale R of the lobe, each channel in [0, 1]
+    /// scale R of the lobe, each channel in [0, 1] (a texture's values
+    /// are clamped to it)
     #[param(default = 1.0)]
-    pub reflectance: Rgb,
+    pub reflectance: TexturedRgb,
     /// Blinn exponent n in [0, 1e6]; 0 is a uniform distribution of normals
     #[param(default = 100.0, range = (0.0, 1e6))]
-    pub exponent: f32,
+    pub exponent: TexturedFloat,
     /// blinn: half vectors from cos^n (the model's own); cosine or uniform
     /// hemisphere, for comparison
     #[param(default = Blinn)]
@@ -66,32 +67,66 @@ impl From<BlinnSampling> for LobeSampling {
 
 #[derive(Debug, Clone)]
 pub struct Blinn {
+    reflectance: TexturedRgb,
+    exponent: TexturedFloat,
+    sampling: LobeSampling,
+}
+
+/// The lobe at one hit: [`Blinn`]'s parameters read there.
+#[derive(Debug, Clone, Copy)]
+struct Lobe {
     reflectance: Rgb,
     exponent: f32,
     sampling: LobeSampling,
 }
 
 impl Blinn {
-    pub fn new(reflectance: Rgb, exponent: f32, sampling: LobeSampling) -> Self {
+    pub fn new(
+        reflectance: impl Into<TexturedRgb>,
+        exponent: impl Into<TexturedFloat>,
+        sampling: LobeSampling,
+    ) -> Self {
         Self {
-            reflectance,
-            exponent,
+            reflectance: reflectance.into(),
+            exponent: exponent.into(),
             sampling,
         }
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
         let p = BlinnParams::read(params)?;
-        let reflectance = p.reflectance;
-        if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
-            return Err(params.error(
-                BlinnParams::KEYS.reflectance,
-                format!("each channel must be in [0, 1], got {reflectance:?}"),
-            ));
+        if let Some(reflectance) = p.reflectance.constant() {
+            if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
+                return Err(params.error(
+                    BlinnParams::KEYS.reflectance,
+                    format!("each channel must be in [0, 1], got {reflectance:?}"),
+                ));
+            }
         }
-        Ok(Self::new(reflectance, p.exponent, p.sampling.into()))
+        Ok(Self::new(p.reflectance, p.exponent, p.sampling.into()))
     }
 
+    /// The lobe at this hit; textures' values clamped to the declared
+    /// ranges.
+    #[inline]
+    fn lobe(&self, ctx: &BsdfContext) -> Lobe {
+        let reflectance = match &self.reflectance {
+            lumis_core::params::Textured::Constant(r) => *r,
+            textured => textured.eval(&ctx.texture).map(|c| c.clamp(0.0, 1.0)),
+        };
+        let exponent = match &self.exponent {
+            lumis_core::params::Textured::Constant(n) => *n,
+            textured => textured.eval(&ctx.texture).clamp(0.0, 1e6),
+        };
+        Lobe {
+            reflectance,
+            exponent,
+            sampling: self.sampling,
+        }
+    }
+}
+
+impl Lobe {
     /// `cos^n theta_h` of the unnormalised half vector `h`, as `exp(n/2
     /// ln(1 - sin^2))` with `sin^2` from the tangential components: exact
     /// near the peak, where `cos theta_h` itself rounds to 1 in f32 long
@@ -164,17 +199,18 @@ impl Bsdf for Blinn {
     }
 
     #[inline]
-    fn f(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        self.eval(wo, wi)
+    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
+        self.lobe(ctx).eval(wo, wi)
     }
 
-    fn sample_f(&self, _ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
-        let wi = match self.sampling {
+        let lobe = self.lobe(ctx);
+        let wi = match lobe.sampling {
             LobeSampling::Model(_) => {
-                let h = self.sample_half_vector(u2);
+                let h = lobe.sample_half_vector(u2);
                 if wo.dot(h) <= 0.0 {
                     return None;
                 }
@@ -185,14 +221,14 @@ impl Bsdf for Blinn {
         BsdfSample::reflection(
             wi,
             BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-            |wi| self.eval_pdf(wo, wi),
-            |wi| self.eval(wo, wi),
+            |wi| lobe.eval_pdf(wo, wi),
+            |wi| lobe.eval(wo, wi),
         )
     }
 
     #[inline]
-    fn pdf(&self, _ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        self.eval_pdf(wo, wi)
+    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
+        self.lobe(ctx).eval_pdf(wo, wi)
     }
 }
 

@@ -47,7 +47,7 @@ pub struct PlasticParams {
     pub diffuse_reflectance: TexturedRgb,
     /// scale of the coat's reflection (1 is physical), in [0, 1]
     #[param(default = 1.0)]
-    pub specular_reflectance: Rgb,
+    pub specular_reflectance: TexturedRgb,
     /// index of refraction of the coat (polypropylene 1.49)
     #[param(default = 1.49, range = (1.0, 5.0))]
     pub int_ior: f32,
@@ -63,8 +63,8 @@ pub struct PlasticParams {
     pub nonlinear: bool,
 }
 
-/// The layers as one hit sees them: the base's albedo and the coat's
-/// roughness, each constant or textured.
+/// The layers as one hit sees them: the base's albedo, the coat's
+/// roughness and its scale, each constant or textured.
 #[derive(Debug, Clone, Copy)]
 struct Base {
     /// `rho'`, the base's albedo including the internal reflections, over
@@ -74,20 +74,22 @@ struct Base {
     weight: f32,
     /// The coat's lobe; `None`: smooth.
     coat: Option<Microfacet>,
+    /// The coat's scale, and its luminance for the lobe choice.
+    specular: Rgb,
+    specular_weight: f32,
 }
 
 #[derive(Debug, Clone)]
 pub struct Plastic {
-    /// The untextured base, precomputed (`diffuse` is a constant), or the
-    /// base of a white albedo (unused).
-    untextured: Base,
+    /// The layers, precomputed, where no parameter is textured.
+    constant: Option<Base>,
     /// `rho`, a constant or a texture.
     diffuse: TexturedRgb,
+    /// The coat's scale, a constant or a texture.
+    specular: TexturedRgb,
     /// The coat's internal diffuse reflectance `F_dr,int`.
     fdr_int: f32,
     nonlinear: bool,
-    specular: Rgb,
-    specular_weight: f32,
     eta: f32,
     /// The coat's lobe, fixed or textured; a fixed delta is smooth.
     coat: Roughness,
@@ -96,26 +98,29 @@ pub struct Plastic {
 impl Plastic {
     pub fn new(
         diffuse: impl Into<TexturedRgb>,
-        specular: Rgb,
+        specular: impl Into<TexturedRgb>,
         eta: f32,
         coat: impl Into<Roughness>,
         nonlinear: bool,
     ) -> Self {
-        let diffuse = diffuse.into();
-        let coat = coat.into();
-        // Light inside the coat meets it from the side of index 1/eta.
-        let fdr_int = fresnel::diffuse_reflectance(1.0 / eta);
-        let constant = diffuse.constant().unwrap_or(Rgb::WHITE);
-        Self {
-            untextured: Self::base_of(constant, fdr_int, eta, nonlinear, coat.fixed().copied()),
-            diffuse,
-            fdr_int,
+        let mut plastic = Self {
+            constant: None,
+            diffuse: diffuse.into(),
+            specular: specular.into(),
+            // Light inside the coat meets it from the side of index 1/eta.
+            fdr_int: fresnel::diffuse_reflectance(1.0 / eta),
             nonlinear,
-            specular,
-            specular_weight: specular.luminance(),
             eta,
-            coat,
+            coat: coat.into(),
+        };
+        if let (Some(diffuse), Some(specular), Roughness::Fixed(coat)) = (
+            plastic.diffuse.constant(),
+            plastic.specular.constant(),
+            &plastic.coat,
+        ) {
+            plastic.constant = Some(plastic.base_of(diffuse, specular, *coat));
         }
+        plastic
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
@@ -123,7 +128,7 @@ impl Plastic {
         let keys = PlasticParams::KEYS;
         for (key, v) in [
             (keys.diffuse_reflectance, p.diffuse_reflectance.constant()),
-            (keys.specular_reflectance, Some(p.specular_reflectance)),
+            (keys.specular_reflectance, p.specular_reflectance.constant()),
         ] {
             let Some(v) = v else { continue };
             if !(v.min_component() >= 0.0 && v.max_component() <= 1.0) {
@@ -139,52 +144,45 @@ impl Plastic {
         ))
     }
 
+    /// The layers of base albedo `diffuse`, coat scale `specular` and coat
+    /// lobe `coat`.
     #[inline]
-    fn base_of(
-        diffuse: Rgb,
-        fdr_int: f32,
-        eta: f32,
-        nonlinear: bool,
-        coat: Option<Microfacet>,
-    ) -> Base {
-        let rho = if nonlinear {
-            diffuse.map(|r| r / (1.0 - r * fdr_int))
+    fn base_of(&self, diffuse: Rgb, specular: Rgb, coat: Option<Microfacet>) -> Base {
+        let rho = if self.nonlinear {
+            diffuse.map(|r| r / (1.0 - r * self.fdr_int))
         } else {
-            diffuse / (1.0 - fdr_int)
+            diffuse / (1.0 - self.fdr_int)
         };
         Base {
-            f: rho * (FRAC_1_PI / (eta * eta)),
+            f: rho * (FRAC_1_PI / (self.eta * self.eta)),
             weight: diffuse.luminance(),
             coat,
+            specular,
+            specular_weight: specular.luminance(),
         }
     }
 
     /// The layers at this hit: the precomputed ones, or the textures'
-    /// values there (an albedo clamped to [0, 1], where the internal
+    /// values there (colours clamped to [0, 1], where the internal
     /// reflections' series converges).
     #[inline]
     fn base(&self, ctx: &BsdfContext) -> Base {
-        let coat = || self.coat.at(&ctx.texture);
-        match (&self.diffuse, &self.coat) {
-            (lumis_core::params::Textured::Constant(_), Roughness::Fixed(_)) => self.untextured,
-            (lumis_core::params::Textured::Constant(_), _) => Base {
-                coat: coat(),
-                ..self.untextured
-            },
-            (textured, _) => Self::base_of(
-                textured.eval(&ctx.texture).map(|r| r.clamp(0.0, 1.0)),
-                self.fdr_int,
-                self.eta,
-                self.nonlinear,
-                coat(),
-            ),
+        if let Some(constant) = self.constant {
+            return constant;
         }
+        let q = &ctx.texture;
+        let unit = |c: Rgb| c.map(|v| v.clamp(0.0, 1.0));
+        self.base_of(
+            unit(self.diffuse.eval(q)),
+            unit(self.specular.eval(q)),
+            self.coat.at(q),
+        )
     }
 
     /// Probability of sampling the coat from `wo`, which has Fresnel `fo`.
     #[inline]
     fn coat_probability(&self, base: &Base, fo: f32) -> f32 {
-        let coat = fo * self.specular_weight;
+        let coat = fo * base.specular_weight;
         let base = (1.0 - fo) * base.weight;
         if coat + base > 0.0 {
             coat / (coat + base)
@@ -201,13 +199,20 @@ impl Plastic {
 
     /// The coat's value for the half vector `m` (with `<wo, m>`).
     #[inline]
-    fn coat_f(&self, mf: &Microfacet, (m, wo_m): (Vec3, f32), wo: Vec3, wi: Vec3) -> Rgb {
+    fn coat_f(
+        &self,
+        base: &Base,
+        mf: &Microfacet,
+        (m, wo_m): (Vec3, f32),
+        wo: Vec3,
+        wi: Vec3,
+    ) -> Rgb {
         let d = mf.d(m);
         if d == 0.0 {
             return Rgb::BLACK;
         }
         let f = fresnel::dielectric(wo_m, self.eta);
-        self.specular * (f * d * mf.g(wo, wi) / (4.0 * wo.z * wi.z))
+        base.specular * (f * d * mf.g(wo, wi) / (4.0 * wo.z * wi.z))
     }
 
     #[inline]
@@ -221,7 +226,7 @@ impl Plastic {
     fn f_above(&self, base: &Base, fo: f32, half: Option<(Vec3, f32)>, wo: Vec3, wi: Vec3) -> Rgb {
         let f = self.base_f(base, fo, wi);
         match (&base.coat, half) {
-            (Some(mf), Some(half)) => f + self.coat_f(mf, half, wo, wi),
+            (Some(mf), Some(half)) => f + self.coat_f(base, mf, half, wo, wi),
             _ => f,
         }
     }
@@ -299,7 +304,7 @@ impl Bsdf for Plastic {
             let Some(mf) = &base.coat else {
                 let wi = Vec3::new(-wo.x, -wo.y, wo.z);
                 return Some(BsdfSample {
-                    f: self.specular * (fo / wi.z),
+                    f: base.specular * (fo / wi.z),
                     wi,
                     pdf: p,
                     flags: BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
