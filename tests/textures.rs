@@ -131,11 +131,23 @@ fn bad_texture_references_are_located_errors() {
             && err.contains("cannot read the file"),
         "{err}"
     );
-    // A light's radiance takes no texture.
+    // An emission names the scene's textures like a BSDF...
     let err = load_error(&scene("", "0.5").replace(
         "emission = { radiance = 5.0 }",
         "emission = { radiance = { texture = \"c\" } }",
     ));
+    assert!(
+        err.contains("emission (type = \"quad\") key 'radiance'")
+            && err.contains("unknown texture \"c\""),
+        "{err}"
+    );
+    // ... and an environment's radiance takes no texture.
+    let err = load_error(
+        &(scene(
+            "[[texture]]\nname = \"c\"\ntype = \"constant\"\nvalue = 1\n",
+            "0.5",
+        ) + "[[light]]\ntype = \"constant\"\nradiance = { texture = \"c\" }\n"),
+    );
     assert!(
         err.contains("'radiance'") && err.contains("this parameter takes no texture"),
         "{err}"
@@ -296,4 +308,38 @@ fn colour_and_exponent_parameters_take_textures() {
         assert!(plain.image.mean().iter().any(|&c| c > 0.0), "{bsdf} {key}");
         assert_eq!(plain.image.pixels, textured.image.pixels, "{bsdf} {key}");
     }
+}
+
+/// A shape's emission takes a texture too: a constant one renders the
+/// constant radiance to the bit, and a sphere light, which has no texture
+/// coordinates of its own to offer, refuses one by name.
+#[test]
+fn an_emitting_quad_takes_a_radiance_texture() {
+    let emitting = |textures: &str, radiance: &str| {
+        scene(textures, "0.5").replace(
+            "emission = { radiance = 5.0 }",
+            &format!("emission = {{ radiance = {radiance} }}"),
+        )
+    };
+    let constant = "[[texture]]\nname = \"glow\"\ntype = \"constant\"\nvalue = 5.0\n";
+    let plain = render_toml(&emitting("", "5.0"), &[], 2);
+    let textured = render_toml(&emitting(constant, "{ texture = \"glow\" }"), &[], 2);
+    assert!(plain.image.mean()[0] > 0.0);
+    assert_eq!(plain.image.pixels, textured.image.pixels);
+    // Half the panel dark: less light on the floor.
+    let checks = "[[texture]]\nname = \"glow\"\ntype = \"checkerboard\"\ncolor0 = 5.0\ncolor1 = 0.0\nuv_scale = [2.0, 1.0]\n";
+    let half = render_toml(&emitting(checks, "{ texture = \"glow\" }"), &[], 2);
+    let (full, part) = (plain.image.mean()[1], half.image.mean()[1]);
+    assert!(
+        part < 0.75 * full && part > 0.25 * full,
+        "{part} against {full}"
+    );
+
+    let sphere = scene(constant, "0.5")
+        + "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 1.0, 0.0]\nradius = 0.2\nbsdf = \"black\"\nemission = { radiance = { texture = \"glow\" } }\n";
+    let err = load_error(&sphere);
+    assert!(
+        err.contains("radiance") && err.contains("quads and triangles"),
+        "{err}"
+    );
 }

@@ -13,8 +13,8 @@ use std::fmt::Write;
 
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    doc, Error, Light, LightSampleContext, LightSampler, LightShape, Location, PluginEntity,
-    PluginKind, Registry, Result, Vec2, Vec3,
+    doc, Error, Light, LightInput, LightSampleContext, LightSampler, LightShape, Location,
+    PluginEntity, PluginKind, Registry, Result, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -119,7 +119,8 @@ pub fn stand_in_lights(registry: &Registry) -> Result<Vec<Box<dyn Light>>> {
                 doc::parse(params, "<stand-in>")?,
                 Location::Builtin,
             );
-            let mut light = registry.create::<dyn Light>(&entity, &shape.shape())?;
+            let mut light =
+                registry.create::<dyn Light>(&entity, LightInput::untextured(&shape.shape()))?;
             light.preprocess(SCENE_CENTER, SCENE_RADIUS);
             Ok(light)
         })

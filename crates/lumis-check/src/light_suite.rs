@@ -21,8 +21,8 @@ use std::fmt::Write;
 use lumis_core::params::ParamDefault;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, Location, ParamType,
-    PluginEntity, PluginKind, Registry, Result, Rgb, Vec2, Vec3,
+    Error, Light, LightInput, LightKind, LightSample, LightSampleContext, LightShape, Location,
+    ParamType, PluginEntity, PluginKind, Registry, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -125,6 +125,7 @@ fn placements() -> Vec<Placement> {
                     Vec3::new(0.8, 1.0, -0.3),
                     Vec3::new(0.0, 1.0, 0.7),
                 ],
+                uv: LightShape::BARYCENTRIC_UVS,
             },
             points: planar_points(),
         },
@@ -199,7 +200,7 @@ pub fn instantiate(
         variant.table.clone(),
         Location::Builtin,
     );
-    let mut light = registry.create::<dyn Light>(&entity, shape.1)?;
+    let mut light = registry.create::<dyn Light>(&entity, LightInput::untextured(shape.1))?;
     light.preprocess(SCENE_CENTER, SCENE_RADIUS);
     Ok(light)
 }

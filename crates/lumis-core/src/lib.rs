@@ -37,7 +37,7 @@ pub use error::{Error, Location, Result};
 pub use footprint::{PackedFootprint, PixelFootprint};
 pub use integrator::Integrator;
 pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
-pub use light::{Light, LightKind, LightSample, LightShape};
+pub use light::{Light, LightInput, LightKind, LightSample, LightShape};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;
 pub use params::{

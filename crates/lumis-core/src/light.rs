@@ -43,13 +43,40 @@ pub enum LightShape {
         edge_v: Vec3,
     },
     /// A triangle; the front side faces `normalize((p1 - p0) x (p2 - p0))`.
-    Triangle { p: [Vec3; 3] },
+    /// `uv` are its vertices' texture coordinates, which a textured
+    /// radiance is looked up by ([`LightShape::BARYCENTRIC_UVS`] where the
+    /// mesh has none, as its hits see them).
+    Triangle { p: [Vec3; 3], uv: [Vec2; 3] },
     /// A sphere; the front side faces outward unless `inward`.
     Sphere {
         center: Vec3,
         radius: f32,
         inward: bool,
     },
+}
+
+impl LightShape {
+    /// The texture coordinates of a triangle's vertices where its mesh has
+    /// none: the barycentric coordinates `(b1, b2)` of each point.
+    pub const BARYCENTRIC_UVS: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+}
+
+/// What a light is made with: the geometry it is attached to, and the
+/// scene's textures, which its parameters may name (a textured radiance).
+#[derive(Clone, Copy)]
+pub struct LightInput<'a> {
+    pub shape: &'a LightShape,
+    pub textures: &'a crate::texture::Textures,
+}
+
+impl<'a> LightInput<'a> {
+    /// A light on `shape` that can name no texture (made outside a scene).
+    pub fn untextured(shape: &'a LightShape) -> Self {
+        Self {
+            shape,
+            textures: &crate::texture::NO_TEXTURES,
+        }
+    }
 }
 
 /// A light source. Each shape brings its own sampling and density.

@@ -13,7 +13,7 @@ use crate::entity::PluginEntity;
 use crate::error::{Error, Result};
 use crate::guard::{FaultSink, Guarded, PluginGuard};
 use crate::integrator::Integrator;
-use crate::light::{Light, LightShape};
+use crate::light::{Light, LightInput, LightShape};
 use crate::light_sampler::LightSampler;
 use crate::params::{ParamSpec, Params};
 use crate::sampler::Sampler;
@@ -436,15 +436,20 @@ impl PluginInterface for dyn Bsdf {
     }
 }
 
+/// A light is made with its shape and the textures its parameters may
+/// name.
 impl PluginInterface for dyn Light {
     const KIND: PluginKind = PluginKind::Light;
     type Made = Box<dyn Light>;
-    type Input<'i> = &'i LightShape;
-    fn call(factory: &Factory, params: &Params, shape: &LightShape) -> Result<Self::Made> {
+    type Input<'i> = LightInput<'i>;
+    fn scope<'i>(input: &Self::Input<'i>) -> Option<BsdfScope<'i>> {
+        Some(BsdfScope::textures(input.textures))
+    }
+    fn call(factory: &Factory, params: &Params, input: LightInput<'_>) -> Result<Self::Made> {
         let Factory::Light(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
-        f(params, shape)
+        f(params, input.shape)
     }
 }
 

@@ -94,6 +94,7 @@ pub fn load_str(
 
     let assembled = assemble(
         registry,
+        &plugins.textures,
         description.shapes,
         plugins.bsdfs,
         plugins.lights,

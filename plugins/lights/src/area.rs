@@ -3,15 +3,20 @@
 
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
+use std::sync::Arc;
+
+use lumis_core::params::Textured;
 use lumis_core::{
-    Light, LightKind, LightSample, ParamChoice, Params, PluginParams, Result, Rgb, Vec2, Vec3,
+    Light, LightKind, LightSample, ParamChoice, Params, PluginParams, Result, Rgb, Texture,
+    TexturedRgb, Vec2, Vec3,
 };
 
 /// The keys of every `emission = { ... }` table.
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct EmissionParams {
-    /// emitted radiance in linear RGB
-    pub radiance: Rgb,
+    /// emitted radiance in linear RGB, or a texture of it over the
+    /// surface's uv (quads and triangles)
+    pub radiance: TexturedRgb,
     /// emit from the back side too
     #[param(default = false)]
     pub two_sided: bool,
@@ -44,9 +49,10 @@ pub struct Emission {
 }
 
 impl Emission {
-    /// The emission `p` describes, its radiance checked.
+    /// The emission `p` describes, its radiance checked; a textured
+    /// radiance is white here, and [`EmissionParams::texture`] scales it.
     pub fn from_params(p: &EmissionParams, params: &Params) -> Result<Self> {
-        let radiance = p.radiance;
+        let radiance = p.radiance.constant().unwrap_or(Rgb::WHITE);
         if !(radiance.min_component() >= 0.0 && radiance.is_finite()) {
             return Err(params.error(
                 EmissionParams::KEYS.radiance,
@@ -80,6 +86,16 @@ impl Emission {
     pub fn power(&self, area: f32) -> Rgb {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
         self.radiance * (std::f32::consts::PI * area * sides)
+    }
+}
+
+impl EmissionParams {
+    /// The texture of a textured radiance.
+    pub fn texture(&self) -> Option<Arc<dyn Texture>> {
+        match &self.radiance {
+            Textured::Constant(_) => None,
+            Textured::Texture(t) => Some(t.clone()),
+        }
     }
 }
 
@@ -174,6 +190,10 @@ pub trait PlanarShape: Send + Sync {
 
     /// The `t > 0` at which `o + t w` (unit `w`) crosses the shape.
     fn intersect(&self, o: Vec3, w: Vec3) -> Option<f32>;
+
+    /// The texture coordinates of the point `p` on the shape: those a hit
+    /// there gets.
+    fn uv_at(&self, p: Vec3) -> Vec2;
 
     /// The solid angle (sr) the shape subtends from `p`, when it samples
     /// that solid angle uniformly from there; `None` where it falls back to

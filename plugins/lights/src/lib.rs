@@ -8,6 +8,7 @@ mod point;
 mod quad;
 mod sphere;
 mod spot;
+mod textured;
 mod triangle;
 
 pub use area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling};
@@ -16,6 +17,7 @@ pub use point::PointLight;
 pub use quad::{Quad, QuadLight};
 pub use sphere::SphereLight;
 pub use spot::SpotLight;
+pub use textured::TexturedAreaLight;
 pub use triangle::{Triangle, TriangleLight};
 
 use lumis_core::{Registry, Result};
@@ -25,12 +27,8 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     registry.add_light(point::SPEC, |p, shape| {
         Ok(Box::new(PointLight::from_params(p, shape)?))
     })?;
-    registry.add_light(quad::SPEC, |p, shape| {
-        Ok(Box::new(QuadLight::from_params(p, shape)?))
-    })?;
-    registry.add_light(triangle::SPEC, |p, shape| {
-        Ok(Box::new(TriangleLight::from_params(p, shape)?))
-    })?;
+    registry.add_light(quad::SPEC, QuadLight::make)?;
+    registry.add_light(triangle::SPEC, TriangleLight::make)?;
     registry.add_light(sphere::SPEC, |p, shape| {
         Ok(Box::new(SphereLight::from_params(p, shape)?))
     })?;

@@ -5,12 +5,13 @@
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+    Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
 };
 
 use lumis_sampling::{SphericalRectangle, MIN_SPHERICAL_SAMPLE_AREA};
 
 use crate::area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling, SolidAngleSample};
+use crate::textured::boxed;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -46,6 +47,21 @@ impl Quad {
     }
 }
 
+impl Quad {
+    /// The coordinates `(s, t)` along the (possibly non-orthogonal) edges
+    /// of the offset `d = s edge_u + t edge_v` in the quad's plane.
+    #[inline]
+    fn coordinates(&self, d: Vec3) -> Vec2 {
+        let uu = self.edge_u.length_squared();
+        let vv = self.edge_v.length_squared();
+        let uv = self.edge_u.dot(self.edge_v);
+        let du = d.dot(self.edge_u);
+        let dv = d.dot(self.edge_v);
+        let det = uu * vv - uv * uv;
+        Vec2::new((du * vv - dv * uv) / det, (dv * uu - du * uv) / det)
+    }
+}
+
 impl QuadLight {
     pub fn new(corner: Vec3, edge_u: Vec3, edge_v: Vec3, emission: Emission) -> Result<Self> {
         let cross = edge_u.cross(edge_v);
@@ -69,12 +85,15 @@ impl QuadLight {
         })
     }
 
-    pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
+    /// The light plugin: textured where its radiance is a texture.
+    pub fn make(params: &Params, shape: &LightShape) -> Result<Box<dyn Light>> {
         let p = EmissionParams::read(params)?;
         let emission = Emission::from_params(&p, params)?;
         match *shape {
-            LightShape::Quad { corner, edge_u, edge_v } => Ok(Self::new(corner, edge_u, edge_v, emission)?
-                .with_sampling(p.sampling)),
+            LightShape::Quad { corner, edge_u, edge_v } => Ok(boxed(
+                Self::new(corner, edge_u, edge_v, emission)?.with_sampling(p.sampling),
+                p.texture(),
+            )),
             _ => Err(Error::msg(format!(
                 "{}: the quad light is the emission of a quad shape; use [[shape]] type = \"quad\" with emission = {{ ... }}",
                 params.owner()
@@ -102,6 +121,12 @@ impl PlanarShape for Quad {
         }
     }
 
+    /// `(s, t)` of `p = corner + s edge_u + t edge_v`, as the quad shape's
+    /// hits get them.
+    fn uv_at(&self, p: Vec3) -> Vec2 {
+        self.coordinates(p - self.corner)
+    }
+
     fn intersect(&self, o: Vec3, w: Vec3) -> Option<f32> {
         let denom = self.normal.dot(w);
         if denom == 0.0 {
@@ -111,17 +136,8 @@ impl PlanarShape for Quad {
         if t.is_nan() || t <= 0.0 {
             return None;
         }
-        let d = o + w * t - self.corner;
-        // Coordinates along the (possibly non-orthogonal) edges.
-        let uu = self.edge_u.length_squared();
-        let vv = self.edge_v.length_squared();
-        let uv = self.edge_u.dot(self.edge_v);
-        let du = d.dot(self.edge_u);
-        let dv = d.dot(self.edge_v);
-        let det = uu * vv - uv * uv;
-        let s = (du * vv - dv * uv) / det;
-        let r = (dv * uu - du * uv) / det;
-        ((0.0..=1.0).contains(&s) && (0.0..=1.0).contains(&r)).then_some(t)
+        let st = self.coordinates(o + w * t - self.corner);
+        ((0.0..=1.0).contains(&st.x) && (0.0..=1.0).contains(&st.y)).then_some(t)
     }
 
     fn solid_angle(&self, p: Vec3) -> Option<f32> {

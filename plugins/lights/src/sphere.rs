@@ -24,7 +24,7 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: SphereLightParams::SPECS,
 };
 
-#[derive(Debug, Clone, Copy, PluginParams)]
+#[derive(Debug, Clone, PluginParams)]
 pub struct SphereLightParams {
     /// A sphere is sampled by solid angle unless asked otherwise.
     #[param(flatten, default(sampling = Sampling::SolidAngle))]
@@ -71,6 +71,12 @@ impl SphereLight {
 
     pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
         let p = SphereLightParams::read(params)?.emission;
+        if p.texture().is_some() {
+            return Err(params.error(
+                EmissionParams::KEYS.radiance,
+                "a sphere light's radiance is a colour: textured radiance is for quads and triangles",
+            ));
+        }
         let emission = Emission::from_params(&p, params)?;
         let sampling = p.sampling;
         match *shape {

@@ -4,13 +4,14 @@
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+    Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
 };
 use lumis_sampling::{
     warp, SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
 };
 
 use crate::area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling, SolidAngleSample};
+use crate::textured::boxed;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -23,6 +24,8 @@ pub const SPEC: PluginSpec = PluginSpec {
 #[derive(Debug, Clone)]
 pub struct Triangle {
     p: [Vec3; 3],
+    /// The vertices' texture coordinates.
+    uv: [Vec2; 3],
     normal: Vec3,
     area: f32,
 }
@@ -32,6 +35,11 @@ pub type TriangleLight = AreaLight<Triangle>;
 
 impl TriangleLight {
     pub fn new(p: [Vec3; 3], emission: Emission) -> Result<Self> {
+        Self::with_uvs(p, LightShape::BARYCENTRIC_UVS, emission)
+    }
+
+    /// A triangle light whose vertices have texture coordinates `uv`.
+    pub fn with_uvs(p: [Vec3; 3], uv: [Vec2; 3], emission: Emission) -> Result<Self> {
         let cross = (p[1] - p[0]).cross(p[2] - p[0]);
         let len = cross.length();
         if !(len > 0.0 && len.is_finite()) {
@@ -41,6 +49,7 @@ impl TriangleLight {
         }
         let shape = Triangle {
             p,
+            uv,
             normal: cross / len,
             area: 0.5 * len,
         };
@@ -51,11 +60,15 @@ impl TriangleLight {
         })
     }
 
-    pub fn from_params(params: &Params, shape: &LightShape) -> Result<Self> {
+    /// The light plugin: textured where its radiance is a texture.
+    pub fn make(params: &Params, shape: &LightShape) -> Result<Box<dyn Light>> {
         let read = EmissionParams::read(params)?;
         let emission = Emission::from_params(&read, params)?;
         match *shape {
-            LightShape::Triangle { p } => Ok(Self::new(p, emission)?.with_sampling(read.sampling)),
+            LightShape::Triangle { p, uv } => Ok(boxed(
+                Self::with_uvs(p, uv, emission)?.with_sampling(read.sampling),
+                read.texture(),
+            )),
             _ => Err(Error::msg(format!(
                 "{}: the triangle light is the emission of a mesh shape; give the mesh an emission = {{ ... }}",
                 params.owner()
@@ -105,6 +118,19 @@ impl PlanarShape for Triangle {
     fn sample_point(&self, u: Vec2) -> SurfacePoint {
         let b = warp::square_to_uniform_triangle(u);
         self.point_at([b.x, b.y, 1.0 - b.x - b.y])
+    }
+
+    /// By the barycentrics of `p` projected onto the triangle's plane.
+    fn uv_at(&self, q: Vec3) -> Vec2 {
+        let [p0, p1, p2] = self.p;
+        let (e1, e2, d) = (p1 - p0, p2 - p0, q - p0);
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d1, d2) = (d.dot(e1), d.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        let b1 = (d22 * d1 - d12 * d2) / det;
+        let b2 = (d11 * d2 - d12 * d1) / det;
+        let [t0, t1, t2] = self.uv;
+        t0 * (1.0 - b1 - b2) + t1 * b1 + t2 * b2
     }
 
     fn solid_angle(&self, p: Vec3) -> Option<f32> {

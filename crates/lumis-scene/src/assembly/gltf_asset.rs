@@ -9,15 +9,13 @@ use lumis_core::doc::Table;
 use lumis_core::glam::{Mat3, Mat4};
 use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfScope, Error, Light, LightShape, Location, PluginEntity, PluginKind, Result, Vec2,
-    Vec3,
+    Bsdf, BsdfScope, Error, LightShape, Location, PluginEntity, PluginKind, Result, Vec2, Vec3,
 };
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 
 use super::bvh::{PendingInstance, PendingPrototype};
 use super::has_area;
 use super::state::Assembly;
-use crate::gltf::emitter::TexturedEmitter;
 use crate::gltf::{AssetEmission, GltfImport, ImportedMaterial, MaterialBsdf};
 use crate::render_scene::{Geometry, MeshData, Placement, NO_LIGHT};
 
@@ -189,27 +187,19 @@ fn triangle_lights(
     uvs: Option<&[Vec2]>,
     asm: &mut Assembly,
 ) -> Result<Vec<u32>> {
-    let texture = emission.texture.as_ref().zip(uvs);
     let mut out = Vec::new();
     for (p, vertices) in triangles {
-        let [a, b, c] = p;
-        if !has_area([a, b, c]) {
+        if !has_area(p) {
             out.push(NO_LIGHT);
             continue;
         }
-        let light = asm
-            .registry
-            .create::<dyn Light>(&emission.entity, &LightShape::Triangle { p })?;
-        let light: Box<dyn Light> = match texture {
-            Some((texture, uvs)) => Box::new(TexturedEmitter {
-                inner: light,
-                texture: texture.clone(),
-                p,
-                uv: vertices.map(|i| uvs[i as usize]),
-            }),
-            None => light,
-        };
-        out.push(asm.push_area_light(light));
+        // A textured emission has uvs (the importer requires them); an
+        // untextured one reads none.
+        let uv = uvs.map_or(LightShape::BARYCENTRIC_UVS, |uvs| {
+            vertices.map(|i| uvs[i as usize])
+        });
+        let textures = &emission.textures;
+        out.push(asm.add_area_light(&emission.entity, LightShape::Triangle { p, uv }, textures)?);
     }
     Ok(out)
 }

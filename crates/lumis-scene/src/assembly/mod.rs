@@ -13,7 +13,7 @@ mod surfaces;
 
 use std::sync::Arc;
 
-use lumis_core::{Bsdf, Error, Light, LightKind, Registry, Result, Vec3};
+use lumis_core::{Bsdf, Error, Light, LightKind, Registry, Result, Textures, Vec3};
 use lumis_embree::{Device, SceneBuilder};
 
 use crate::description::{AccelOptions, ShapeEntity, ShapeSource};
@@ -41,6 +41,7 @@ pub(crate) struct Assembled {
 /// shapes (`scene_lights`), and builds the BVHs.
 pub(crate) fn assemble(
     registry: &Registry,
+    textures: &Textures,
     shapes: Vec<ShapeEntity>,
     bsdfs: BsdfTable,
     scene_lights: Vec<Box<dyn Light>>,
@@ -50,6 +51,7 @@ pub(crate) fn assemble(
     let device = Device::new().map_err(embree_error)?;
     let mut asm = Assembly {
         registry,
+        textures,
         builder: SceneBuilder::new(&device, accel.embree).map_err(embree_error)?,
         device,
         options: accel.embree,

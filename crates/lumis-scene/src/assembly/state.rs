@@ -1,7 +1,7 @@
 //! A scene under construction: the Embree builder and everything shading
 //! will index by the geometry ids Embree hands out.
 
-use lumis_core::{Light, LightShape, PluginEntity, Registry, Result};
+use lumis_core::{Light, LightInput, LightShape, PluginEntity, Registry, Result, Textures};
 use lumis_embree::{Device, SceneBuilder, SceneOptions};
 
 use super::bvh::PendingPrototype;
@@ -12,6 +12,8 @@ use crate::report::LoadReport;
 pub(crate) struct Assembly<'r> {
     /// Creates area lights and imported materials' BSDFs.
     pub registry: &'r Registry,
+    /// The scene's `[[texture]]`s, which a shape's emission may name.
+    pub textures: &'r Textures,
     pub device: Device,
     /// Quality and robustness of every BVH; compaction is decided once
     /// every shape is counted.
@@ -29,10 +31,19 @@ pub(crate) struct Assembly<'r> {
 }
 
 impl Assembly<'_> {
-    /// Creates the area light `entity` describes on `shape`; returns its
-    /// index.
-    pub fn add_area_light(&mut self, entity: &PluginEntity, shape: LightShape) -> Result<u32> {
-        let light = self.registry.create::<dyn Light>(entity, &shape)?;
+    /// Creates the area light `entity` describes on `shape`, its
+    /// parameters naming `textures`; returns its index.
+    pub fn add_area_light(
+        &mut self,
+        entity: &PluginEntity,
+        shape: LightShape,
+        textures: &Textures,
+    ) -> Result<u32> {
+        let input = LightInput {
+            shape: &shape,
+            textures,
+        };
+        let light = self.registry.create::<dyn Light>(entity, input)?;
         Ok(self.push_area_light(light))
     }
 

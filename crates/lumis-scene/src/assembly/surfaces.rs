@@ -47,7 +47,8 @@ pub(crate) fn add_surface(owner: &str, surface: Surface, asm: &mut Assembly) -> 
                         edge_u,
                         edge_v,
                     };
-                    vec![asm.add_area_light(entity, quad)?; mesh.indices.len()]
+                    let textures = asm.textures;
+                    vec![asm.add_area_light(entity, quad, textures)?; mesh.indices.len()]
                 }
                 None => Vec::new(),
             };
@@ -80,7 +81,8 @@ pub(crate) fn add_surface(owner: &str, surface: Surface, asm: &mut Assembly) -> 
                         radius,
                         inward: flip,
                     };
-                    Some(asm.add_area_light(entity, sphere)?)
+                    let textures = asm.textures;
+                    Some(asm.add_area_light(entity, sphere, textures)?)
                 }
                 None => None,
             };
@@ -122,8 +124,15 @@ fn triangle_lights(
             per_triangle.push(NO_LIGHT);
             continue;
         }
-        let p = if flip { [a, c, b] } else { [a, b, c] };
-        per_triangle.push(asm.add_area_light(entity, LightShape::Triangle { p })?);
+        // The uvs a hit gets, its barycentrics in the mesh's own order.
+        let [ua, ub, uc] = LightShape::BARYCENTRIC_UVS;
+        let (p, uv) = if flip {
+            ([a, c, b], [ua, uc, ub])
+        } else {
+            ([a, b, c], [ua, ub, uc])
+        };
+        let textures = asm.textures;
+        per_triangle.push(asm.add_area_light(entity, LightShape::Triangle { p, uv }, textures)?);
     }
     Ok(per_triangle)
 }

@@ -128,9 +128,13 @@ pub(crate) fn bsdf_entity(
     Ok((bsdf, warnings))
 }
 
+/// The name under which its emission finds its `emissiveTexture`,
+/// already multiplied by the emitted radiance.
+pub(crate) const EMISSIVE: &str = "emissiveTexture";
+
 /// Emitted radiance of `material`: `emissiveFactor` times
 /// `KHR_materials_emissive_strength`, or `None` for a black emitter.
-/// An `emissiveTexture` scales this per point (the caller wraps the lights).
+/// An `emissiveTexture` scales this per point.
 pub(crate) fn emission(material: &gltf::Material, label: &str) -> Result<Option<Rgb>, String> {
     let [r, g, b] = material.emissive_factor();
     let strength = material.emissive_strength().unwrap_or(1.0);
@@ -145,17 +149,21 @@ pub(crate) fn emission(material: &gltf::Material, label: &str) -> Result<Option<
 }
 
 /// The light plugin every triangle of an emissive material gets (its
-/// parameters located at `at`, named `owner` in messages).
+/// parameters located at `at`, named `owner` in messages): `radiance`, or
+/// with `textured` the `{ texture = EMISSIVE }` that carries it.
 pub(crate) fn emission_entity(
     radiance: Rgb,
+    textured: bool,
     two_sided: bool,
     owner: String,
     at: &Location,
 ) -> PluginEntity {
-    let params = vec![
-        ("radiance", [radiance.r, radiance.g, radiance.b].into()),
-        ("two_sided", two_sided.into()),
-    ];
+    let radiance = if textured {
+        Value::Table(Table::built(at, [("texture", EMISSIVE.into())]))
+    } else {
+        [radiance.r, radiance.g, radiance.b].into()
+    };
+    let params = vec![("radiance", radiance), ("two_sided", two_sided.into())];
     let table = Table::built(at, params);
     PluginEntity::new(PluginKind::Light, owner, "triangle", table, at.clone())
 }

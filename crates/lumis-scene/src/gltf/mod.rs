@@ -14,7 +14,6 @@
 mod buffers;
 pub(crate) mod camera;
 mod decode;
-pub(crate) mod emitter;
 mod material;
 mod normals;
 mod resolve;

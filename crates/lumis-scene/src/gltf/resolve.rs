@@ -8,7 +8,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use lumis_core::files::IMAGE_FILE;
-use lumis_core::{Error, PluginEntity, Result, Rgb, Texture, Textures, UvTransform};
+use lumis_core::{Error, PluginEntity, Result, Rgb, Textures, UvTransform};
 use lumis_textures::image::{self as image_texture, Encoding, ImageFilter, ImageTexture, Wrap};
 
 use super::{buffers, material, ImportRequest};
@@ -43,8 +43,9 @@ pub(crate) struct AssetBsdf {
 /// The light plugin of an emissive material's triangles.
 pub(crate) struct AssetEmission {
     pub entity: PluginEntity,
-    /// `emissiveTexture`: scales the radiance, read at the material's uvs.
-    pub texture: Option<Arc<dyn Texture>>,
+    /// What its radiance names: the `emissiveTexture` (times the
+    /// emission) as [`material::EMISSIVE`].
+    pub textures: Textures,
 }
 
 /// Every material of an asset, and what mapping them left out.
@@ -183,9 +184,9 @@ pub(crate) fn resolve_materials(
             }
         };
         let radiance = material::emission(&material, &material_label).map_err(err)?;
-        let mut emission_texture = None;
-        if let (Some(_), Some(info)) = (radiance, material.emissive_texture()) {
-            let emissive = TextureUse::Colour(Rgb::WHITE);
+        let mut emission_textures = Textures::new();
+        if let (Some(radiance), Some(info)) = (radiance, material.emissive_texture()) {
+            let emissive = TextureUse::Colour(radiance);
             let loaded = match (texture_of(asset, &info, &request.path, emissive), uv_set) {
                 (Ok((_, set)), Some(base)) if base != set => Err(format!(
                     "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
@@ -195,7 +196,7 @@ pub(crate) fn resolve_materials(
             match loaded {
                 Ok((t, set)) => {
                     out.texture_bytes += t.byte_size();
-                    emission_texture = Some(Arc::new(t) as Arc<dyn Texture>);
+                    emission_textures.insert(material::EMISSIVE, Arc::new(t));
                     uv_set = Some(set);
                 }
                 Err(why) => out.warnings.push(format!(
@@ -206,11 +207,12 @@ pub(crate) fn resolve_materials(
         let emission = radiance.map(|radiance| AssetEmission {
             entity: material::emission_entity(
                 radiance,
+                !emission_textures.is_empty(),
                 material.double_sided(),
                 format!("{owner} '{label}' material {material_label} emission"),
                 at,
             ),
-            texture: emission_texture,
+            textures: emission_textures,
         });
         out.materials.insert(
             index,

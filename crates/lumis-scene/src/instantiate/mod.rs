@@ -9,8 +9,8 @@ mod bsdf_table;
 
 use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfScope, Error, Integrator, Light, LightShape, PluginEntity, Registry, Result, Sampler,
-    Texture, Textures,
+    Bsdf, BsdfScope, Error, Integrator, Light, LightInput, LightShape, PluginEntity, Registry,
+    Result, Sampler, Texture, Textures,
 };
 
 pub(crate) use bsdf_table::BsdfTable;
@@ -24,6 +24,8 @@ pub(crate) struct Plugins {
     pub bsdfs: BsdfTable,
     /// `[[light]]`s, in file order.
     pub lights: Vec<Box<dyn Light>>,
+    /// The `[[texture]]`s by name, which shapes' emission may name too.
+    pub textures: Textures,
 }
 
 /// Creates the `[[texture]]`s, `[[bsdf]]`s (whose parameters may name the
@@ -60,13 +62,20 @@ pub(crate) fn instantiate(
     }
     let lights = lights
         .iter()
-        .map(|l| registry.create::<dyn Light>(l, &LightShape::None))
+        .map(|l| {
+            let input = LightInput {
+                shape: &LightShape::None,
+                textures: &by_name,
+            };
+            registry.create::<dyn Light>(l, input)
+        })
         .collect::<Result<Vec<_>>>()?;
     Ok(Plugins {
         sampler: registry.create::<dyn Sampler>(sampler, ())?,
         integrator: registry.create::<dyn Integrator>(integrator, ())?,
         bsdfs: BsdfTable::named(named),
         lights,
+        textures: by_name,
     })
 }
 
