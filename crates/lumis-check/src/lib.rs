@@ -14,6 +14,7 @@ pub mod light_sampler_suite;
 pub mod light_suite;
 pub mod lobe_zoom;
 pub mod quadrature;
+pub mod sampler_suite;
 pub mod sweep;
 pub mod uniformity;
 

@@ -11,6 +11,7 @@ use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
 };
 use lumis_check::light_suite::{check_light_with, format_light_results, LightCheckConfig};
+use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
     analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
     registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
@@ -50,7 +51,9 @@ enum Command {
     /// reciprocity and finiteness, at incident angles down to cos theta =
     /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
     /// around and inside them, consistency and finiteness; for light
-    /// samplers, the pmf against the draws. Exits non-zero on any failure
+    /// samplers, the pmf against the draws; for samplers, the range [0, 1),
+    /// determinism, the declared film pattern (exactly) and uniformity.
+    /// Exits non-zero on any failure
     /// and writes observed-vs-expected PNGs for failed chi-square cases.
     CheckPlugin {
         /// A plugin library: checks every plugin of these kinds it registers.
@@ -64,6 +67,9 @@ enum Command {
         /// Check this light sampler (built-in or from the library); repeatable.
         #[arg(long)]
         light_sampler: Vec<String>,
+        /// Check this sampler (built-in or from the library); repeatable.
+        #[arg(long)]
+        sampler: Vec<String>,
         /// Samples per chi-square test.
         #[arg(long, default_value_t = 1_000_000)]
         samples: usize,
@@ -177,6 +183,7 @@ fn main() -> ExitCode {
             bsdf,
             light,
             light_sampler,
+            sampler,
             samples,
             bins,
             out,
@@ -186,6 +193,7 @@ fn main() -> ExitCode {
                 bsdf,
                 light,
                 light_sampler,
+                sampler,
             };
             check_plugin(library, names, samples, bins, &out, &set).map(Outcome::passed)
         }),
@@ -296,11 +304,15 @@ struct PluginNames {
     bsdf: Vec<String>,
     light: Vec<String>,
     light_sampler: Vec<String>,
+    sampler: Vec<String>,
 }
 
 impl PluginNames {
     fn is_empty(&self) -> bool {
-        self.bsdf.is_empty() && self.light.is_empty() && self.light_sampler.is_empty()
+        self.bsdf.is_empty()
+            && self.light.is_empty()
+            && self.light_sampler.is_empty()
+            && self.sampler.is_empty()
     }
 
     /// Adds the plugins of the checked kinds that `registry` has and
@@ -315,6 +327,7 @@ impl PluginNames {
                 PluginKind::Bsdf => self.bsdf.push(name),
                 PluginKind::Light => self.light.push(name),
                 PluginKind::LightSampler => self.light_sampler.push(name),
+                PluginKind::Sampler => self.sampler.push(name),
                 _ => {}
             }
         }
@@ -345,7 +358,7 @@ fn check_plugin(
     }
     if names.is_empty() {
         return Err(Error::msg(
-            "nothing to check: give a plugin library that registers BSDFs, lights or light samplers, or --bsdf, --light or --light-sampler NAME",
+            "nothing to check: give a plugin library that registers BSDFs, lights, light samplers or samplers, or --bsdf, --light, --light-sampler or --sampler NAME",
         ));
     }
     let mut all_passed = true;
@@ -357,6 +370,9 @@ fn check_plugin(
     }
     for name in &names.light_sampler {
         all_passed &= check_light_sampler_plugin(&registry, name, &fixed)?;
+    }
+    for name in &names.sampler {
+        all_passed &= check_sampler_plugin(&registry, name, &fixed)?;
     }
     Ok(all_passed)
 }
@@ -423,5 +439,15 @@ fn check_light_sampler_plugin(
     let cfg = LightSamplerCheckConfig::default();
     let results = check_light_sampler_with(registry, name, fixed, &cfg)?;
     print!("{}", format_light_sampler_results(&results));
+    Ok(results.iter().all(|r| r.passed()))
+}
+
+fn check_sampler_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+) -> Result<bool> {
+    let results = check_sampler_with(registry, name, fixed, &SamplerCheckConfig::default())?;
+    print!("{}", format_sampler_results(&results));
     Ok(results.iter().all(|r| r.passed()))
 }

@@ -301,6 +301,35 @@ fn check_plugin_checks_builtin_lights_and_light_samplers() {
         .contains("no light plugin named \"no-such-light\""));
 }
 
+/// Every built-in sampler passes, the deterministic settings (strata
+/// centres, unscrambled sequences) reported as not testable for uniformity.
+#[test]
+fn check_plugin_checks_builtin_samplers() {
+    let mut args = vec!["check-plugin"];
+    for name in [
+        "independent",
+        "stratified",
+        "halton",
+        "hammersley",
+        "sobol",
+        "zsobol",
+        "poisson-disk",
+    ] {
+        args.extend(["--sampler", name]);
+    }
+    let result = lumis(&args);
+    let stdout = String::from_utf8(result.stdout).unwrap();
+    assert!(
+        result.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(
+        stdout.contains("not testable: uniformity") && !stdout.contains("FAILED"),
+        "{stdout}"
+    );
+}
+
 #[test]
 fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
     let tmp = scratch("analyze");

@@ -33,6 +33,23 @@ pub trait Sampler: Send + Sync {
     /// An independent copy for another thread.
     fn clone_sampler(&self) -> Box<dyn Sampler>;
 
+    /// What the film positions ([`Sampler::get_pixel_2d`]) of a pixel's
+    /// `samples_per_pixel()` samples guarantee, for any pixel and seed:
+    /// what `lumis check-plugin` verifies exactly. The default promises
+    /// nothing beyond uniformity.
+    fn pixel_pattern(&self) -> PixelPattern {
+        PixelPattern::Random
+    }
+
+    /// Whether every number, over seeds and pixels, is uniform in [0, 1)
+    /// (jittered, scrambled: randomised quasi-Monte Carlo), so that
+    /// estimates are unbiased. `false` declares a deterministic point set
+    /// (strata centres, an unscrambled sequence): `lumis check-plugin`
+    /// does not hold it to uniformity, and says so.
+    fn randomized(&self) -> bool {
+        true
+    }
+
     /// `n` independent copies, one per lane of a batch of paths. The
     /// default boxes `n` clones and asks them one virtual call at a time;
     /// a `Clone` sampler returns [`ConcreteLanes`] instead, whose batched requests
@@ -40,6 +57,23 @@ pub trait Sampler: Send + Sync {
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
         Box::new(BoxedLanes((0..n).map(|_| self.clone_sampler()).collect()))
     }
+}
+
+/// A structure that the film positions of one pixel's samples have.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PixelPattern {
+    /// Uniform and nothing more (independent samples).
+    Random,
+    /// One position in each cell of an `nx x ny` grid over the pixel
+    /// (jittered or centred strata; `ny = 1`: one per column).
+    Grid { nx: u32, ny: u32 },
+    /// A (0, m, 2)-net in base 2 (`2^m` samples): every elementary
+    /// interval of area `2^-m`, `2^a x 2^(m-a)` cells for every `a`, holds
+    /// exactly one position (Sobol', Niederreiter and Xing 1996).
+    Net02,
+    /// Positions at least this far apart on the torus of the pixel
+    /// (a Poisson disk pattern), in pixels.
+    MinDistance(f32),
 }
 
 /// The samplers of a batch of paths, one per lane, each drawing its own

@@ -1,8 +1,8 @@
 //! `halton`: the Halton sequence over the whole image, scrambled.
 
 use lumis_core::{
-    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
-    SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
+    Sampler, SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
@@ -163,6 +163,23 @@ impl Sampler for HaltonSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    /// The first coordinate of consecutive Halton points in base 2: one
+    /// per column of a power-of-two count.
+    fn pixel_pattern(&self) -> PixelPattern {
+        if self.spp.is_power_of_two() {
+            PixelPattern::Grid {
+                nx: self.spp,
+                ny: 1,
+            }
+        } else {
+            PixelPattern::Random
+        }
+    }
+
+    fn randomized(&self) -> bool {
+        self.scramble != DigitScramble::None
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

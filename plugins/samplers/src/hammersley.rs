@@ -2,8 +2,8 @@
 //! Owen-scrambled per pixel.
 
 use lumis_core::{
-    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
-    UVec2, Vec2,
+    ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::primes::{PRIMES, PRIME_TABLE_SIZE};
 use lumis_sampling::{
@@ -104,6 +104,15 @@ impl Sampler for HammersleySampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    /// The scrambled Hammersley set of a power-of-two count is a net.
+    fn pixel_pattern(&self) -> PixelPattern {
+        if self.spp.is_power_of_two() {
+            PixelPattern::Net02
+        } else {
+            PixelPattern::Random
+        }
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

@@ -1,8 +1,8 @@
 //! `poisson-disk`: Poisson disk patterns for the film plane.
 
 use lumis_core::{
-    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
-    UVec2, Vec2,
+    ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::poisson_disk::{max_packing_distance, poisson_disk_pattern};
 use lumis_sampling::{hash_u64, pixel_key, Pcg32};
@@ -129,6 +129,10 @@ impl Sampler for PoissonDiskSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn pixel_pattern(&self) -> PixelPattern {
+        PixelPattern::MinDistance(self.min_distance)
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

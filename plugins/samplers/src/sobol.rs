@@ -4,8 +4,8 @@ use std::fmt;
 use std::marker::PhantomData;
 
 use lumis_core::{
-    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
-    SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
+    Sampler, SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_with, laine_karras_permutation, owen_scramble, pixel_key, reversed_to_unit_f32,
@@ -414,6 +414,19 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    /// A pixel's first power-of-two points of a (0, 2)-sequence are a net.
+    fn pixel_pattern(&self) -> PixelPattern {
+        if self.spp.is_power_of_two() {
+            PixelPattern::Net02
+        } else {
+            PixelPattern::Random
+        }
+    }
+
+    fn randomized(&self) -> bool {
+        R::SEEDED
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

@@ -2,8 +2,8 @@
 //! across dimensions by per-pixel random permutations (padding).
 
 use lumis_core::{
-    ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
-    UVec2, Vec2,
+    ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
+    SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, permutation_element, pixel_key, Pcg32, ONE_MINUS_EPSILON,
@@ -137,6 +137,18 @@ impl Sampler for StratifiedSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    fn pixel_pattern(&self) -> PixelPattern {
+        PixelPattern::Grid {
+            nx: self.nx,
+            ny: self.ny,
+        }
+    }
+
+    /// Without jitter every sample sits at its stratum's centre.
+    fn randomized(&self) -> bool {
+        self.jitter
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

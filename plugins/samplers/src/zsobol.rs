@@ -2,8 +2,8 @@
 //! pixels, for blue-noise error between neighbouring pixels.
 
 use lumis_core::{
-    ConcreteLanes, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler,
-    SamplerLanes, UVec2, Vec2,
+    ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
+    Sampler, SamplerLanes, UVec2, Vec2,
 };
 use lumis_sampling::{
     hash_u64, hash_with, laine_karras_permutation, reversed_to_unit_f32, sobol_reversed_u32,
@@ -234,6 +234,19 @@ impl Sampler for ZSobolSampler {
 
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(self.clone())
+    }
+
+    /// Each pixel's power-of-two block of the sequence is a net.
+    fn pixel_pattern(&self) -> PixelPattern {
+        if self.spp.is_power_of_two() {
+            PixelPattern::Net02
+        } else {
+            PixelPattern::Random
+        }
+    }
+
+    fn randomized(&self) -> bool {
+        self.owen
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
