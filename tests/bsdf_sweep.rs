@@ -14,6 +14,7 @@
 use lumis_check::bsdf_suite::{
     check_bsdf_variants, format_results, variant, BsdfCheckConfig, CaseResult, Variant,
 };
+use lumis_check::outcome::Outcome;
 
 const ROUGHNESS: [f64; 6] = [1e-4, 1e-3, 0.01, 0.1, 0.5, 1.0];
 

@@ -8,6 +8,7 @@ use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
 };
 use lumis_check::light_suite::{check_light_with, format_light_results, LightCheckConfig};
+use lumis_check::outcome::Outcome;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
     Light, LightKind, LightSample, LightSampleContext, LightSampler, LightShape, Params,

@@ -10,6 +10,7 @@
 use lumis_check::bsdf_suite::{
     check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
 };
+use lumis_check::outcome::Outcome;
 use lumis_tests::tabulated;
 
 /// The three materials of the measured-results table.

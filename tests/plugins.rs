@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use lumis_check::bsdf_suite::{check_bsdf, format_results, BsdfCheckConfig};
+use lumis_check::outcome::Outcome;
 use lumis_tests::{assert_same_mean, bonferroni_z, render_toml_with, scenes_dir};
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.

@@ -3,6 +3,7 @@
 //! uniformity), and samplers with planted defects fail them: a 1.0, an
 //! order-dependent stream, a false net declaration, skewed numbers.
 
+use lumis_check::outcome::Outcome;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_core::{PixelPattern, PluginKind, PluginSpec, Registry, Result, Sampler, UVec2, Vec2};
 use lumis_sampling::{hash_u64, Pcg32};

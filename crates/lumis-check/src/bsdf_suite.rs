@@ -30,6 +30,7 @@ use crate::adapters::bsdf_pair;
 use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
 use crate::lobe_zoom::chi_square_zoomed;
+use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
 pub use crate::sweep::{
     parameter_sweep, parameter_sweep_with, variant, Variant, INTERIOR_VALUES, STAND_IN_BSDFS,
 };
@@ -90,10 +91,16 @@ pub struct CaseResult {
     pub refused: Option<String>,
 }
 
-impl CaseResult {
-    pub fn passed(&self) -> bool {
+impl Outcome for CaseResult {
+    fn passed(&self) -> bool {
         self.refused.is_some()
             || (self.chi_square.passed || self.not_testable.is_some()) && self.problems.is_empty()
+    }
+    fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
+    }
+    fn not_testable(&self) -> Option<&str> {
+        self.not_testable.as_deref()
     }
 }
 
@@ -145,18 +152,15 @@ pub fn instantiate(registry: &Registry, name: &str, variant: &Variant) -> Result
 
 /// The case of a variant the plugin did not make: refused (its factory
 /// returned an error, untested) or failed (its factory panicked).
-fn unmade(
+fn unmade_case(
     name: &str,
     variant: &Variant,
     cos_theta_o: f32,
-    error: &Error,
-    panicked: bool,
+    unmade: std::result::Result<String, String>,
 ) -> CaseResult {
-    let why = error.to_string();
-    let (problems, refused) = if panicked {
-        (vec![why], None)
-    } else {
-        (Vec::new(), Some(why))
+    let (problems, refused) = match unmade {
+        Ok(refusal) => (Vec::new(), Some(refusal)),
+        Err(failure) => (vec![failure], None),
     };
     CaseResult {
         bsdf: name.to_string(),
@@ -462,11 +466,12 @@ pub fn check_bsdf_variants(
             let bsdf = match bsdf {
                 Ok(bsdf) => bsdf,
                 Err(e) => {
-                    let panicked = !registry
-                        .faults()
-                        .faults_of(&owner(name, variant))
-                        .is_empty();
-                    return unmade(name, variant, c, e, panicked);
+                    return unmade_case(
+                        name,
+                        variant,
+                        c,
+                        unmade(registry, &owner(name, variant), e),
+                    )
                 }
             };
             let wo = direction(c, 0.3 + i as f32);
@@ -517,11 +522,7 @@ pub fn check_bsdf_variants(
             .iter()
             .flat_map(|v| std::iter::repeat_n(v, cfg.cos_theta_o.len())),
     ) {
-        for fault in registry.faults().faults_of(&owner(name, variant)) {
-            if !result.problems.iter().any(|p| p.contains(&fault.message)) {
-                result.problems.push(fault.to_string());
-            }
-        }
+        add_faults(registry, &owner(name, variant), &mut result.problems);
     }
     Ok(results)
 }
@@ -584,12 +585,7 @@ pub fn format_results(results: &[CaseResult]) -> String {
             c.pdf_integral,
             c.sampled_fraction,
             r.albedo,
-            match (&r.refused, &r.not_testable, r.passed()) {
-                (Some(_), ..) => "refused",
-                (None, _, false) => "FAILED",
-                (None, Some(_), true) => "not testable",
-                (None, None, true) => "ok",
-            }
+            verdict(r)
         );
         if let Some(why) = &r.refused {
             let _ = writeln!(
@@ -615,17 +611,7 @@ pub fn format_results(results: &[CaseResult]) -> String {
             let _ = writeln!(out, "    {p}");
         }
     }
-    let failed = results.iter().filter(|r| !r.passed()).count();
-    let refused = results.iter().filter(|r| r.refused.is_some()).count();
-    let untestable = results
-        .iter()
-        .filter(|r| r.refused.is_none() && r.not_testable.is_some() && r.passed())
-        .count();
-    let _ = writeln!(
-        out,
-        "{} passed, {failed} failed, {untestable} not testable, {refused} refused by the plugin",
-        results.len() - failed - refused - untestable
-    );
+    let _ = writeln!(out, "{}", summary(results));
     out
 }
 

@@ -13,6 +13,7 @@ pub mod chi_square;
 pub mod light_sampler_suite;
 pub mod light_suite;
 pub mod lobe_zoom;
+pub mod outcome;
 pub mod quadrature;
 pub mod sampler_suite;
 pub mod sweep;

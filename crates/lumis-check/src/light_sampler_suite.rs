@@ -22,6 +22,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::corrected_significance;
 use crate::light_suite::{SCENE_CENTER, SCENE_RADIUS};
+use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
 use crate::sweep::{parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
@@ -146,9 +147,15 @@ pub struct LightSamplerCaseResult {
     pub refused: Option<String>,
 }
 
-impl LightSamplerCaseResult {
-    pub fn passed(&self) -> bool {
+impl Outcome for LightSamplerCaseResult {
+    fn passed(&self) -> bool {
         self.refused.is_some() || self.problems.is_empty() && self.p_value >= self.significance
+    }
+    fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
+    }
+    fn not_testable(&self) -> Option<&str> {
+        None
     }
 }
 
@@ -210,23 +217,12 @@ pub fn check_light_sampler_with(
                     let seed = cfg.seed.wrapping_add(i as u64);
                     check_case(sampler.as_ref(), lights.len(), &ctx, cfg, seed, &mut result);
                 }
-                Err(e) => {
-                    if registry
-                        .faults()
-                        .faults_of(&owner(name, variant))
-                        .is_empty()
-                    {
-                        result.refused = Some(e.to_string());
-                    } else {
-                        result.problems.push(e.to_string());
-                    }
-                }
+                Err(e) => match unmade(registry, &owner(name, variant), e) {
+                    Ok(refusal) => result.refused = Some(refusal),
+                    Err(failure) => result.problems.push(failure),
+                },
             }
-            for fault in registry.faults().faults_of(&owner(name, variant)) {
-                if !result.problems.iter().any(|p| p.contains(&fault.message)) {
-                    result.problems.push(fault.to_string());
-                }
-            }
+            add_faults(registry, &owner(name, variant), &mut result.problems);
             result
         })
         .collect();
@@ -392,11 +388,7 @@ pub fn format_light_sampler_results(results: &[LightSamplerCaseResult]) -> Strin
             r.variant,
             r.pmf_sum,
             r.p_value,
-            match (&r.refused, r.passed()) {
-                (Some(_), _) => "refused",
-                (None, true) => "ok",
-                (None, false) => "FAILED",
-            }
+            verdict(r)
         );
         if let Some(why) = &r.refused {
             let _ = writeln!(
@@ -416,12 +408,6 @@ pub fn format_light_sampler_results(results: &[LightSamplerCaseResult]) -> Strin
             let _ = writeln!(out, "    {p}");
         }
     }
-    let failed = results.iter().filter(|r| !r.passed()).count();
-    let refused = results.iter().filter(|r| r.refused.is_some()).count();
-    let _ = writeln!(
-        out,
-        "{} passed, {failed} failed, {refused} refused by the plugin",
-        results.len() - failed - refused
-    );
+    let _ = writeln!(out, "{}", summary(results));
     out
 }

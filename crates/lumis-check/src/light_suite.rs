@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use crate::adapters::light_pair;
 use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
+use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
 use crate::sweep::{parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
@@ -170,12 +171,18 @@ pub struct LightCaseResult {
     pub refused: Option<String>,
 }
 
-impl LightCaseResult {
-    pub fn passed(&self) -> bool {
+impl Outcome for LightCaseResult {
+    fn passed(&self) -> bool {
         self.refused.is_some()
             || self.problems.is_empty()
                 && (self.not_testable.is_some()
                     || self.chi_square.as_ref().is_some_and(|c| c.passed))
+    }
+    fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
+    }
+    fn not_testable(&self) -> Option<&str> {
+        self.not_testable.as_deref()
     }
 }
 
@@ -314,14 +321,9 @@ pub fn check_light_variants(
             let light = match light.as_ref() {
                 Ok(light) => light,
                 Err(e) => {
-                    let panicked = !registry
-                        .faults()
-                        .faults_of(&owner(name, variant, shape))
-                        .is_empty();
-                    if panicked {
-                        result.problems.push(e.to_string());
-                    } else {
-                        result.refused = Some(e.to_string());
+                    match unmade(registry, &owner(name, variant, shape), e) {
+                        Ok(refusal) => result.refused = Some(refusal),
+                        Err(failure) => result.problems.push(failure),
                     }
                     return result;
                 }
@@ -369,14 +371,11 @@ pub fn check_light_variants(
             .iter()
             .find(|v| v.label == result.variant)
             .expect("results come from the variants");
-        for fault in registry
-            .faults()
-            .faults_of(&owner(name, variant, &result.shape))
-        {
-            if !result.problems.iter().any(|p| p.contains(&fault.message)) {
-                result.problems.push(fault.to_string());
-            }
-        }
+        add_faults(
+            registry,
+            &owner(name, variant, &result.shape),
+            &mut result.problems,
+        );
     }
     Ok(results)
 }
@@ -594,12 +593,7 @@ pub fn format_light_results(results: &[LightCaseResult]) -> String {
             .map_or((f64::NAN, f64::NAN, f64::NAN), |c| {
                 (c.p_value, c.pdf_integral, c.sampled_fraction)
             });
-        let verdict = match (&r.refused, &r.not_testable, r.passed()) {
-            (Some(_), ..) => "refused",
-            (None, _, false) => "FAILED",
-            (None, Some(_), true) => "not testable",
-            (None, None, true) => "ok",
-        };
+        let verdict = verdict(r);
         let _ = writeln!(
             out,
             "{case:>4} {:<10} {:<36} {:<8} {:<12} {p:>10.3e} {integral:>9.5} {sampled:>9.5} {:>10.4e}  {verdict}",
@@ -634,16 +628,6 @@ pub fn format_light_results(results: &[LightCaseResult]) -> String {
             let _ = writeln!(out, "    {p}");
         }
     }
-    let failed = results.iter().filter(|r| !r.passed()).count();
-    let refused = results.iter().filter(|r| r.refused.is_some()).count();
-    let untestable = results
-        .iter()
-        .filter(|r| r.refused.is_none() && r.not_testable.is_some() && r.passed())
-        .count();
-    let _ = writeln!(
-        out,
-        "{} passed, {failed} failed, {untestable} not testable, {refused} refused by the plugin",
-        results.len() - failed - refused - untestable
-    );
+    let _ = writeln!(out, "{}", summary(results));
     out
 }

@@ -26,6 +26,7 @@ use lumis_sampling::hash_u64;
 use rayon::prelude::*;
 
 use crate::corrected_significance;
+use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
 use crate::sweep::{parameter_sweep_with, variant, Variant};
 use crate::uniformity::uniformity_2d;
 
@@ -90,9 +91,15 @@ pub struct SamplerCaseResult {
     pub refused: Option<String>,
 }
 
-impl SamplerCaseResult {
-    pub fn passed(&self) -> bool {
+impl Outcome for SamplerCaseResult {
+    fn passed(&self) -> bool {
         self.refused.is_some() || self.problems.is_empty()
+    }
+    fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
+    }
+    fn not_testable(&self) -> Option<&str> {
+        self.not_testable.as_deref()
     }
 }
 
@@ -148,19 +155,12 @@ pub fn check_sampler_with(
             );
             match registry.create::<dyn Sampler>(&entity, ()) {
                 Ok(mut sampler) => check_case(sampler.as_mut(), cfg, &mut result),
-                Err(e) => {
-                    if registry.faults().faults_of(&entity.owner).is_empty() {
-                        result.refused = Some(e.to_string());
-                    } else {
-                        result.problems.push(e.to_string());
-                    }
-                }
+                Err(e) => match unmade(registry, &entity.owner, &e) {
+                    Ok(refusal) => result.refused = Some(refusal),
+                    Err(failure) => result.problems.push(failure),
+                },
             }
-            for fault in registry.faults().faults_of(&entity.owner) {
-                if !result.problems.iter().any(|p| p.contains(&fault.message)) {
-                    result.problems.push(fault.to_string());
-                }
-            }
+            add_faults(registry, &entity.owner, &mut result.problems);
             result
         })
         .collect();
@@ -379,12 +379,7 @@ pub fn format_sampler_results(results: &[SamplerCaseResult]) -> String {
             r.sampler,
             r.variant,
             r.p_value,
-            match (&r.refused, r.passed(), &r.not_testable) {
-                (Some(_), _, _) => "refused",
-                (None, true, None) => "ok",
-                (None, true, Some(_)) => "ok, partly not testable",
-                (None, false, _) => "FAILED",
-            }
+            verdict(r)
         );
         if let Some(why) = &r.refused {
             let _ = writeln!(
@@ -400,13 +395,7 @@ pub fn format_sampler_results(results: &[SamplerCaseResult]) -> String {
             let _ = writeln!(out, "    {p}");
         }
     }
-    let failed = results.iter().filter(|r| !r.passed()).count();
-    let refused = results.iter().filter(|r| r.refused.is_some()).count();
-    let _ = writeln!(
-        out,
-        "{} passed, {failed} failed, {refused} refused by the plugin",
-        results.len() - failed - refused
-    );
+    let _ = writeln!(out, "{}", summary(results));
     out
 }
 

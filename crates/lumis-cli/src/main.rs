@@ -11,6 +11,7 @@ use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
 };
 use lumis_check::light_suite::{check_light_with, format_light_results, LightCheckConfig};
+use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
     analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,

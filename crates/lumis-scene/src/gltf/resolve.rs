@@ -122,59 +122,45 @@ pub(crate) fn resolve_materials(
                 .find(|(m, _)| Some(m.as_str()) == material.name())
                 .map(|(_, bsdf)| bsdf.clone()),
         };
-        let mut uv_set = None;
+        let mut loader = TextureLoader {
+            asset,
+            asset_path: &request.path,
+            material: format!("'{label}': material {material_label}"),
+            uv_set: None,
+            resolved: &mut out,
+        };
         let bsdf = match replacement {
             Some(bsdf) => MaterialBsdf::Scene(bsdf),
             None => {
                 let pbr = material.pbr_metallic_roughness();
                 let mut textures = Textures::new();
-                if let Some(info) = pbr.base_color_texture() {
-                    let [r, g, b, _] = pbr.base_color_factor();
-                    let base_color = TextureUse::Colour(Rgb::new(r, g, b));
-                    match texture_of(asset, &info, &request.path, base_color) {
-                        Ok((t, set)) => {
-                            out.texture_bytes += t.byte_size();
-                            textures.insert(material::BASE_COLOR, Arc::new(t));
-                            uv_set = Some(set);
-                        }
-                        Err(why) => out.warnings.push(format!(
-                            "'{label}': material {material_label}: baseColorTexture ignored ({why}); using baseColorFactor"
-                        )),
-                    }
-                }
-                let base_color_textured = !textures.is_empty();
-                if let Some(info) = pbr.metallic_roughness_texture() {
-                    let roughness = TextureUse::Roughness(pbr.roughness_factor());
-                    let loaded = match (texture_of(asset, &info, &request.path, roughness), uv_set)
-                    {
-                        (Ok((_, set)), Some(base)) if base != set => Err(format!(
-                            "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
-                        )),
-                        (loaded, _) => loaded,
-                    };
-                    match loaded {
-                        Ok((t, set)) => {
-                            out.texture_bytes += t.byte_size();
-                            textures.insert(material::ROUGHNESS, Arc::new(t));
-                            uv_set = Some(set);
-                        }
-                        Err(why) => out.warnings.push(format!(
-                            "'{label}': material {material_label}: metallicRoughnessTexture ignored ({why}); using roughnessFactor"
-                        )),
-                    }
-                }
+                let [r, g, b, _] = pbr.base_color_factor();
+                let base_color = loader.load(
+                    pbr.base_color_texture(),
+                    TextureUse::Colour(Rgb::new(r, g, b)),
+                    (material::BASE_COLOR, "baseColorFactor"),
+                    &mut textures,
+                );
+                let roughness = loader.load(
+                    pbr.metallic_roughness_texture(),
+                    TextureUse::Roughness(pbr.roughness_factor()),
+                    (material::ROUGHNESS, "roughnessFactor"),
+                    &mut textures,
+                );
                 let (entity, warnings) = material::bsdf_entity(
                     &material,
                     &material_label,
                     format!("{owner} '{label}' material {material_label}"),
                     at,
                     material::Textured {
-                        base_color: base_color_textured,
-                        roughness: textures.get(material::ROUGHNESS).is_some(),
+                        base_color,
+                        roughness,
                     },
                 )
                 .map_err(err)?;
-                out.warnings
+                loader
+                    .resolved
+                    .warnings
                     .extend(warnings.into_iter().map(|w| format!("'{label}': {w}")));
                 MaterialBsdf::Asset(AssetBsdf {
                     entity,
@@ -185,25 +171,15 @@ pub(crate) fn resolve_materials(
         };
         let radiance = material::emission(&material, &material_label).map_err(err)?;
         let mut emission_textures = Textures::new();
-        if let (Some(radiance), Some(info)) = (radiance, material.emissive_texture()) {
-            let emissive = TextureUse::Colour(radiance);
-            let loaded = match (texture_of(asset, &info, &request.path, emissive), uv_set) {
-                (Ok((_, set)), Some(base)) if base != set => Err(format!(
-                    "it reads TEXCOORD_{set} but the base colour texture TEXCOORD_{base}"
-                )),
-                (loaded, _) => loaded,
-            };
-            match loaded {
-                Ok((t, set)) => {
-                    out.texture_bytes += t.byte_size();
-                    emission_textures.insert(material::EMISSIVE, Arc::new(t));
-                    uv_set = Some(set);
-                }
-                Err(why) => out.warnings.push(format!(
-                    "'{label}': material {material_label}: emissiveTexture ignored ({why}); using emissiveFactor"
-                )),
-            }
+        if let Some(radiance) = radiance {
+            loader.load(
+                material.emissive_texture(),
+                TextureUse::Colour(radiance),
+                (material::EMISSIVE, "emissiveFactor"),
+                &mut emission_textures,
+            );
         }
+        let uv_set = loader.uv_set;
         let emission = radiance.map(|radiance| AssetEmission {
             entity: material::emission_entity(
                 radiance,
@@ -224,6 +200,58 @@ pub(crate) fn resolve_materials(
         );
     }
     Ok(out)
+}
+
+/// Loads a material's textures, all of which must read one TEXCOORD set.
+struct TextureLoader<'a> {
+    asset: &'a buffers::Asset,
+    asset_path: &'a Path,
+    /// The material, for warnings: `'file': material "name"`.
+    material: String,
+    /// The set the textures loaded so far read.
+    uv_set: Option<u32>,
+    resolved: &'a mut ResolvedMaterials,
+}
+
+impl TextureLoader<'_> {
+    /// Loads the texture `info` refers to, as `usage` reads it, into `into`
+    /// under `name`; whether it did. A texture that cannot be used is left
+    /// out with a warning, and the material keeps its `factor`.
+    fn load(
+        &mut self,
+        info: Option<gltf::texture::Info>,
+        usage: TextureUse,
+        (name, factor): (&'static str, &str),
+        into: &mut Textures,
+    ) -> bool {
+        let Some(info) = info else {
+            return false;
+        };
+        let loaded = match (
+            texture_of(self.asset, &info, self.asset_path, usage),
+            self.uv_set,
+        ) {
+            (Ok((_, set)), Some(other)) if other != set => Err(format!(
+                "it reads TEXCOORD_{set}, the material's other textures TEXCOORD_{other}"
+            )),
+            (loaded, _) => loaded,
+        };
+        match loaded {
+            Ok((texture, set)) => {
+                self.resolved.texture_bytes += texture.byte_size();
+                into.insert(name, Arc::new(texture));
+                self.uv_set = Some(set);
+                true
+            }
+            Err(why) => {
+                self.resolved.warnings.push(format!(
+                    "{}: {name} ignored ({why}); using {factor}",
+                    self.material
+                ));
+                false
+            }
+        }
+    }
 }
 
 /// What a material reads a texture as.

@@ -1,0 +1,61 @@
+//! What the cases of every plugin kind's suite share: how a case ended,
+//! the word its table row shows, the closing count, and how a plugin the
+//! sweep could not make, or one that panicked, counts.
+
+use lumis_core::{Error, Registry};
+
+/// How a case ended.
+pub trait Outcome {
+    /// Whether nothing failed (a refused case passes: it was not tested).
+    fn passed(&self) -> bool;
+    /// Why the plugin refused the case's parameters (its factory's error).
+    fn refused(&self) -> Option<&str>;
+    /// Why a test could not decide, as the kit established it.
+    fn not_testable(&self) -> Option<&str>;
+}
+
+/// The result column of a case's row.
+pub fn verdict(case: &impl Outcome) -> &'static str {
+    match (case.refused(), case.not_testable(), case.passed()) {
+        (Some(_), ..) => "refused",
+        (None, _, false) => "FAILED",
+        (None, Some(_), true) => "not testable",
+        (None, None, true) => "ok",
+    }
+}
+
+/// The table's last line: how many cases passed, failed, could not be
+/// tested, and were refused.
+pub fn summary<T: Outcome>(results: &[T]) -> String {
+    let count = |f: &dyn Fn(&T) -> bool| results.iter().filter(|r| f(r)).count();
+    let failed = count(&|r| !r.passed());
+    let refused = count(&|r| r.refused().is_some());
+    let untestable = count(&|r| r.refused().is_none() && r.not_testable().is_some() && r.passed());
+    format!(
+        "{} passed, {failed} failed, {untestable} not testable, {refused} refused by the plugin",
+        results.len() - failed - refused - untestable
+    )
+}
+
+/// A plugin the sweep could not make, named `owner` in the registry's
+/// record of faults: `Ok(why)` if its factory refused the parameters (a
+/// setting it declares invalid, left untested), `Err(why)` if it panicked
+/// (a failure).
+pub fn unmade(registry: &Registry, owner: &str, error: &Error) -> Result<String, String> {
+    if registry.faults().faults_of(owner).is_empty() {
+        Ok(error.to_string())
+    } else {
+        Err(error.to_string())
+    }
+}
+
+/// Adds to `problems` every panic recorded against `owner` that it does not
+/// mention yet. A loaded plugin that panicked answered with neutral values
+/// (see `lumis_core::guard`), so the panic is what fails its case.
+pub fn add_faults(registry: &Registry, owner: &str, problems: &mut Vec<String>) {
+    for fault in registry.faults().faults_of(owner) {
+        if !problems.iter().any(|p| p.contains(&fault.message)) {
+            problems.push(fault.to_string());
+        }
+    }
+}
