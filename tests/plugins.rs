@@ -7,7 +7,9 @@ use std::process::Command;
 
 use lumis_check::bsdf_suite::{check_bsdf, format_results, BsdfCheckConfig};
 use lumis_check::outcome::Outcome;
-use lumis_tests::{assert_same_mean, bonferroni_z, render_toml_with, scenes_dir};
+use lumis_tests::{
+    assert_same_mean, bonferroni_z, build_lumis, cargo_build, render_toml_with, scenes_dir,
+};
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
 fn build_example_plugin() -> PathBuf {
@@ -22,28 +24,6 @@ fn build_plugin(package: &str, lib: &str) -> PathBuf {
         std::env::consts::DLL_EXTENSION
     );
     cargo_build(package, &format!("/{name}"))
-}
-
-/// `cargo build -p PACKAGE`, returning the path of the file it wrote whose
-/// path ends with `suffix`.
-fn cargo_build(package: &str, suffix: &str) -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let out = Command::new(cargo)
-        .args(["build", "-p", package, "--message-format=json"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .expect("cargo runs");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    stdout
-        .split('"')
-        .find(|s| s.ends_with(suffix) && std::path::Path::new(s).is_file())
-        .map(PathBuf::from)
-        .unwrap_or_else(|| panic!("cargo reported no {suffix}:\n{stdout}"))
 }
 
 fn scene(plugins: &str, seed: u32) -> String {
@@ -253,11 +233,6 @@ fn a_truncated_library_is_an_error() {
         err.contains("cut short") && err.contains("not a loadable shared library"),
         "{err}"
     );
-}
-
-/// `cargo build -p lumis-cli`, returning the path of the `lumis` it wrote.
-fn build_lumis() -> PathBuf {
-    cargo_build("lumis-cli", "/lumis")
 }
 
 /// A panic in a loaded plugin, in `register`, its factory or any method,

@@ -3,7 +3,8 @@
 
 pub mod gltf_writer;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use lumis_core::{Light, LightSampler, Ray, Registry, Scene, SurfaceInteraction};
 use lumis_image::Image;
@@ -76,6 +77,37 @@ impl Scene for Opaque<'_> {
     fn light_sampler(&self) -> &dyn LightSampler {
         self.0.light_sampler()
     }
+}
+
+/// `cargo build -p PACKAGE`, returning the path of the file it wrote whose
+/// path ends with `suffix`.
+pub fn cargo_build(package: &str, suffix: &str) -> PathBuf {
+    let out = Command::new(cargo())
+        .args(["build", "-p", package, "--message-format=json"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    stdout
+        .split('"')
+        .find(|s| s.ends_with(suffix) && Path::new(s).is_file())
+        .map(PathBuf::from)
+        .unwrap_or_else(|| panic!("cargo reported no {suffix}:\n{stdout}"))
+}
+
+/// `cargo build -p lumis-cli`, returning the path of the `lumis` it wrote.
+pub fn build_lumis() -> PathBuf {
+    cargo_build("lumis-cli", "/lumis")
+}
+
+/// The `cargo` running the tests.
+pub fn cargo() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
 }
 
 /// The repository's `scenes/` directory.

@@ -10,6 +10,7 @@ mod diff;
 mod interrupt;
 mod listing;
 mod metadata;
+mod new_plugin;
 mod outputs;
 mod reference;
 mod render;
@@ -23,6 +24,7 @@ pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
 pub use metadata::ImageMetadata;
+pub use new_plugin::{new_plugin, NewPluginArgs, NewPluginKind};
 pub use reference::{render_reference, ReferenceArgs};
 pub use render::{
     output_paths, render_scene_file, RenderArgs, RenderReport, DEFAULT_CHECKPOINT_SECONDS,

@@ -14,10 +14,10 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
-    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
-    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs,
-    TabulateArgs, INTERRUPTED_EXIT_CODE,
+    analyze_samplers, converge, diff_images, new_plugin, plugin_listing, plugin_markdown,
+    precompute_table, registry_with_search_path, render_reference, render_scene_file,
+    stop_on_interrupt, tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, NewPluginArgs,
+    PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -85,6 +85,10 @@ enum Command {
         #[arg(long = "set", value_name = "key=value")]
         set: Vec<String>,
     },
+    /// Write a new plugin crate NAME/ of the given kind: a small working
+    /// example, its tests (with lumis-check) and a README, building against
+    /// this lumis.
+    NewPlugin(NewPluginArgs),
     /// Render a high-spp reference with the scene's own settings, saved
     /// after every pass with its metadata in the EXR header; rerun to
     /// resume. Refuses, without --force, to replace a reference that is
@@ -197,6 +201,15 @@ fn main() -> ExitCode {
                 sampler,
             };
             check_plugin(library, names, samples, bins, &out, &set).map(Outcome::passed)
+        }),
+        Command::NewPlugin(args) => plain(|| {
+            new_plugin(&args, std::path::Path::new(".")).map(|dir| {
+                println!(
+                    "wrote {}: cd there, then `cargo build --release` and `cargo test` (see its README.md)",
+                    dir.display()
+                );
+                Outcome::Done
+            })
         }),
         Command::Converge(args) => plain(|| {
             registry_with_search_path()
