@@ -11,7 +11,7 @@ use lumis_core::ray::SurfacePoint;
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, Integrator, Light, LightIndex, LightKind,
     LightSample, LightSampleContext, LightSampler, PluginKind, Ray, Registry, RenderStats, Rgb,
-    SampledLight, Sampler, Scene, SurfaceInteraction, UVec2, Vec2, Vec3,
+    SampledLight, Sampler, Scene, SurfaceInteraction, TextureQuery, UVec2, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 
@@ -122,8 +122,7 @@ impl Scene for Furnace {
                 n,
             },
             shading: Frame::from_z(n),
-            uv: Vec2::ZERO,
-            wo: -ray.d,
+            texture: TextureQuery::at(Vec2::ZERO),
             bsdf: &self.wall,
             bsdf_flags: self.wall.flags(),
             light: LightIndex::new(0),
