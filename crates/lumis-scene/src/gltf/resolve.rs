@@ -9,7 +9,9 @@ use std::sync::Arc;
 
 use lumis_core::files::IMAGE_FILE;
 use lumis_core::{Error, PluginEntity, Result, Rgb, Textures, UvTransform};
-use lumis_textures::image::{self as image_texture, Encoding, ImageFilter, ImageTexture, Wrap};
+use lumis_textures::image::{
+    self as image_texture, Encoding, ImageFilter, ImageTexture, StoredValues, Wrap,
+};
 
 use super::{buffers, material, ImportRequest};
 use crate::bsdf_ref::BsdfRef;
@@ -319,9 +321,11 @@ fn texture_of(
     let (encoding, scale) = match usage {
         TextureUse::Colour(factor) => (Encoding::Srgb, factor),
         TextureUse::Roughness(factor) => {
-            for v in &mut stored.values {
-                *v = Rgb::splat((factor * v.g).clamp(0.0, 1.0).powi(2));
-            }
+            let alpha = |v: Rgb| Rgb::splat((factor * v.g).clamp(0.0, 1.0).powi(2));
+            stored.values = StoredValues::Floats {
+                values: stored.floats().into_iter().map(alpha).collect(),
+                is_float: false,
+            };
             (Encoding::Linear, Rgb::WHITE)
         }
     };

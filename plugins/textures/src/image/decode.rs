@@ -8,13 +8,38 @@ use lumis_core::files::{read_bounded, IMAGE_FILE};
 use lumis_core::Rgb;
 
 /// An image as stored: its texel values before any decoding of their
-/// encoding, in `[0, 1]` for integer formats.
+/// encoding.
 pub struct Stored {
     pub width: usize,
     pub height: usize,
-    pub values: Vec<Rgb>,
+    pub values: StoredValues,
+}
+
+/// Texel values as the file stores them.
+pub enum StoredValues {
+    /// 8 bits per channel (PNG, JPEG): kept as bytes, a quarter of the
+    /// memory of float RGB, and decoded by a table at each lookup.
+    Bytes(Vec<[u8; 3]>),
+    /// 16-bit integers scaled to `[0, 1]`, or floating point (EXR, linear).
+    Floats { values: Vec<Rgb>, is_float: bool },
+}
+
+impl Stored {
     /// Whether the file stores floating-point values (EXR), which are linear.
-    pub is_float: bool,
+    pub fn is_float(&self) -> bool {
+        matches!(self.values, StoredValues::Floats { is_float: true, .. })
+    }
+
+    /// The values as floats in `[0, 1]` (or as stored, for floating point).
+    pub fn floats(&self) -> Vec<Rgb> {
+        match &self.values {
+            StoredValues::Bytes(b) => b
+                .iter()
+                .map(|p| Rgb::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0)
+                .collect(),
+            StoredValues::Floats { values, .. } => values.clone(),
+        }
+    }
 }
 
 const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
@@ -67,25 +92,37 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
     };
     let wide = info.bit_depth == png::BitDepth::Sixteen;
     let bytes_per_sample = if wide { 2 } else { 1 };
-    let sample = |s: &[u8]| -> f32 {
-        if wide {
-            u16::from_be_bytes([s[0], s[1]]) as f32 / 65535.0
+    let pixels = buf
+        .chunks_exact(info.line_size)
+        .take(height)
+        .flat_map(|row| row.chunks_exact(channels * bytes_per_sample).take(width));
+    // Grey expands to three equal channels; alpha is dropped.
+    let rgb = |c: &dyn Fn(usize) -> u16| {
+        if channels < 3 {
+            [c(0); 3]
         } else {
-            s[0] as f32 / 255.0
+            [c(0), c(1), c(2)]
         }
     };
-    let mut values = Vec::with_capacity(width * height);
-    for row in buf.chunks_exact(info.line_size).take(height) {
-        for px in row.chunks_exact(channels * bytes_per_sample).take(width) {
-            let c = |i: usize| sample(&px[i * bytes_per_sample..]);
-            values.push(if channels < 3 {
-                Rgb::splat(c(0))
-            } else {
-                Rgb::new(c(0), c(1), c(2))
-            });
-        }
-    }
-    if values.len() != width * height {
+    let values = if wide {
+        let values: Vec<Rgb> = pixels
+            .map(|px| rgb(&|i| u16::from_be_bytes([px[2 * i], px[2 * i + 1]])))
+            .map(|c| Rgb::new(c[0] as f32, c[1] as f32, c[2] as f32) / 65535.0)
+            .collect();
+        (
+            values.len(),
+            StoredValues::Floats {
+                values,
+                is_float: false,
+            },
+        )
+    } else {
+        let values: Vec<[u8; 3]> = pixels
+            .map(|px| rgb(&|i| px[i] as u16).map(|c| c as u8))
+            .collect();
+        (values.len(), StoredValues::Bytes(values))
+    };
+    if values.0 != width * height {
         return Err(format!(
             "bad PNG: {width}x{height} pixels could not be read"
         ));
@@ -93,8 +130,7 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
     Ok(Stored {
         width,
         height,
-        values,
-        is_float: false,
+        values: values.1,
     })
 }
 
@@ -103,20 +139,31 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
     let pixels = decoder.decode().map_err(|e| format!("bad JPEG: {e}"))?;
     let info = decoder.info().ok_or("bad JPEG: no frame")?;
     let (width, height) = (info.width as usize, info.height as usize);
-    let byte = |v: u8| v as f32 / 255.0;
-    let values: Vec<Rgb> = match info.pixel_format {
-        jpeg_decoder::PixelFormat::L8 => pixels.iter().map(|&l| Rgb::splat(byte(l))).collect(),
-        jpeg_decoder::PixelFormat::L16 => pixels
-            .chunks_exact(2)
-            .map(|l| Rgb::splat(u16::from_be_bytes([l[0], l[1]]) as f32 / 65535.0))
-            .collect(),
-        jpeg_decoder::PixelFormat::RGB24 => pixels
-            .chunks_exact(3)
-            .map(|p| Rgb::new(byte(p[0]), byte(p[1]), byte(p[2])))
-            .collect(),
+    let (count, values) = match info.pixel_format {
+        jpeg_decoder::PixelFormat::L8 => {
+            let v: Vec<[u8; 3]> = pixels.iter().map(|&l| [l; 3]).collect();
+            (v.len(), StoredValues::Bytes(v))
+        }
+        jpeg_decoder::PixelFormat::L16 => {
+            let v: Vec<Rgb> = pixels
+                .chunks_exact(2)
+                .map(|l| Rgb::splat(u16::from_be_bytes([l[0], l[1]]) as f32 / 65535.0))
+                .collect();
+            (
+                v.len(),
+                StoredValues::Floats {
+                    values: v,
+                    is_float: false,
+                },
+            )
+        }
+        jpeg_decoder::PixelFormat::RGB24 => {
+            let v: Vec<[u8; 3]> = pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+            (v.len(), StoredValues::Bytes(v))
+        }
         jpeg_decoder::PixelFormat::CMYK32 => return Err("CMYK JPEGs are not supported".into()),
     };
-    if values.len() != width * height {
+    if count != width * height {
         return Err(format!(
             "bad JPEG: {width}x{height} pixels could not be read"
         ));
@@ -125,7 +172,6 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
         width,
         height,
         values,
-        is_float: false,
     })
 }
 
@@ -146,8 +192,10 @@ fn exr(path: &Path) -> Result<Stored, String> {
     Ok(Stored {
         width: image.width,
         height: image.height,
-        values: image.pixels.into_iter().map(Rgb::from).collect(),
-        is_float: true,
+        values: StoredValues::Floats {
+            values: image.pixels.into_iter().map(Rgb::from).collect(),
+            is_float: true,
+        },
     })
 }
 

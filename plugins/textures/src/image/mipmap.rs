@@ -24,7 +24,7 @@ pub fn pyramid(base: Texels, wrap: [Wrap; 2]) -> Vec<Texels> {
             return levels;
         }
         let (width, height) = (last.width.div_ceil(2), last.height.div_ceil(2));
-        let values = (0..height)
+        let values: Vec<Rgb> = (0..height)
             .flat_map(|y| (0..width).map(move |x| (x as i64, y as i64)))
             .map(|(x, y)| {
                 // A dimension of size one is not halved: its texel counts
@@ -37,11 +37,7 @@ pub fn pyramid(base: Texels, wrap: [Wrap; 2]) -> Vec<Texels> {
                     + last.texel(2 * x + dx, 2 * y + dy, wrap))
             })
             .collect();
-        levels.push(Texels {
-            width,
-            height,
-            values,
-        });
+        levels.push(Texels::linear(width, height, values));
     }
 }
 
@@ -167,13 +163,13 @@ mod tests {
 
     /// A 16 x 8 image of stripes: texel (x, y) is x % 2 (0 or 1 in red).
     fn stripes() -> Texels {
-        Texels {
-            width: 16,
-            height: 8,
-            values: (0..8)
+        Texels::linear(
+            16,
+            8,
+            (0..8)
                 .flat_map(|_| (0..16).map(|x| Rgb::new((x % 2) as f32, 0.5, 1.0)))
                 .collect(),
-        }
+        )
     }
 
     const REPEAT: [Wrap; 2] = [Wrap::Repeat; 2];
@@ -191,8 +187,8 @@ mod tests {
         assert_eq!(levels[0], stripes());
         // Stripes of one texel average to their mean from level 1 on.
         for level in &levels[1..] {
-            for v in &level.values {
-                assert_eq!(*v, Rgb::new(0.5, 0.5, 1.0));
+            for v in level.iter() {
+                assert_eq!(v, Rgb::new(0.5, 0.5, 1.0));
             }
         }
     }
@@ -237,11 +233,7 @@ mod tests {
     #[test]
     fn a_constant_image_reads_its_value_through_every_filter() {
         let c = Rgb::new(0.2, 0.4, 0.8);
-        let base = Texels {
-            width: 13,
-            height: 7,
-            values: vec![c; 13 * 7],
-        };
+        let base = Texels::linear(13, 7, vec![c; 13 * 7]);
         for wrap in [
             [Wrap::Repeat; 2],
             [Wrap::Mirror; 2],

@@ -12,7 +12,7 @@ use lumis_core::{
     UvTransform,
 };
 
-pub use decode::{decode, srgb_to_linear, Stored};
+pub use decode::{decode, srgb_to_linear, Stored, StoredValues};
 pub use texels::{Texels, Wrap};
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -81,6 +81,8 @@ pub struct ImageTexture {
     wrap: [Wrap; 2],
     filter: ImageFilter,
     transform: UvTransform,
+    /// Multiplies every lookup (the `scale` parameter, a glTF factor).
+    scale: Rgb,
 }
 
 impl ImageTexture {
@@ -110,20 +112,21 @@ impl ImageTexture {
         scale: Rgb,
     ) -> Self {
         let srgb = match encoding {
-            Encoding::Auto => !stored.is_float,
+            Encoding::Auto => !stored.is_float(),
             Encoding::Srgb => true,
             Encoding::Linear => false,
         };
-        let values = stored
-            .values
-            .into_iter()
-            .map(|v| if srgb { v.map(srgb_to_linear) } else { v })
-            .map(|v| if scale == Rgb::WHITE { v } else { v * scale })
-            .collect();
-        let base = Texels {
-            width: stored.width,
-            height: stored.height,
-            values,
+        let decode = |v: f32| if srgb { srgb_to_linear(v) } else { v };
+        let (width, height) = (stored.width, stored.height);
+        let base = match stored.values {
+            StoredValues::Bytes(texels) => {
+                Texels::bytes(width, height, texels, |b| decode(b as f32 / 255.0))
+            }
+            StoredValues::Floats { values, .. } => Texels::linear(
+                width,
+                height,
+                values.into_iter().map(|v| v.map(decode)).collect(),
+            ),
         };
         let levels = match filter {
             ImageFilter::Trilinear | ImageFilter::Ewa => mipmap::pyramid(base, wrap),
@@ -134,6 +137,7 @@ impl ImageTexture {
             wrap,
             filter,
             transform,
+            scale,
         }
     }
 
@@ -144,10 +148,7 @@ impl ImageTexture {
 
     /// Bytes held by the texels and mip-map levels.
     pub fn byte_size(&self) -> usize {
-        self.levels
-            .iter()
-            .map(|l| l.values.capacity() * std::mem::size_of::<Rgb>())
-            .sum()
+        self.levels.iter().map(Texels::byte_size).sum()
     }
 }
 
@@ -162,11 +163,16 @@ impl Texture for ImageTexture {
         if !uv.is_finite() {
             return base.texel(0, 0, self.wrap);
         }
-        match self.filter {
+        let value = match self.filter {
             ImageFilter::Nearest => base.nearest(uv, self.wrap),
             ImageFilter::Bilinear => base.bilinear(uv, self.wrap),
             ImageFilter::Trilinear => mipmap::trilinear(&self.levels, &query, uv, self.wrap),
             ImageFilter::Ewa => mipmap::ewa(&self.levels, &query, uv, self.wrap),
+        };
+        if self.scale == Rgb::WHITE {
+            value
+        } else {
+            value * self.scale
         }
     }
 }

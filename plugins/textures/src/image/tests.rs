@@ -55,6 +55,55 @@ fn png_decodes_srgb_unless_told_linear() {
     assert_eq!(at(&*linear, 0.75, 0.5), Rgb::splat(188.0 / 255.0));
 }
 
+/// An 8-bit image keeps its bytes, 3 a texel (and a table of 256 linear
+/// values), and reads as the float decoding of each byte; an EXR keeps
+/// its floats.
+#[test]
+fn eight_bit_images_take_three_bytes_a_texel() {
+    use super::{ImageFilter, ImageTexture, Wrap};
+    use lumis_core::UvTransform;
+    let pixels: Vec<u8> = (0..64 * 32 * 3).map(|i| (i * 37 % 256) as u8).collect();
+    let png = {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("noise.png");
+        lumis_image::write_rgb8_png(&path, 64, 32, &pixels).unwrap();
+        std::fs::read(path).unwrap()
+    };
+    let texture = |filter| {
+        ImageTexture::new(
+            super::decode(&png).unwrap(),
+            super::Encoding::Srgb,
+            [Wrap::Repeat; 2],
+            filter,
+            UvTransform::default(),
+            Rgb::WHITE,
+        )
+    };
+    let bilinear = texture(ImageFilter::Bilinear);
+    assert_eq!(bilinear.byte_size(), 64 * 32 * 3 + 256 * 4);
+    let texel = |x: usize, y: usize| {
+        let byte = |c: usize| super::srgb_to_linear(pixels[(y * 64 + x) * 3 + c] as f32 / 255.0);
+        Rgb::new(byte(0), byte(1), byte(2))
+    };
+    for (x, y) in [(0, 0), (17, 5), (63, 31)] {
+        let uv = Vec2::new((x as f32 + 0.5) / 64.0, (y as f32 + 0.5) / 32.0);
+        assert_eq!(
+            bilinear
+                .texels()
+                .texel(x as i64, y as i64, [Wrap::Repeat; 2]),
+            texel(x, y)
+        );
+        let (got, want) = (at(&bilinear, uv.x, uv.y), texel(x, y));
+        assert!(
+            (got - want).max_component() < 1e-6 && (want - got).max_component() < 1e-6,
+            "{got:?} against {want:?}"
+        );
+    }
+    // The mip levels above the image are float, a third as many texels.
+    let mipmapped = texture(ImageFilter::Trilinear);
+    assert!(mipmapped.byte_size() < 64 * 32 * (3 + 12 / 3 + 1));
+}
+
 #[test]
 fn exr_is_linear_and_keeps_values_above_one() {
     let dir = tempfile::tempdir().unwrap();

@@ -35,22 +35,88 @@ impl Wrap {
     }
 }
 
-/// Linear RGB texels, row by row from the top (texture coordinate
-/// `(0, 0)` is the top-left corner of the image, as in glTF).
+/// Texels, row by row from the top (texture coordinate `(0, 0)` is the
+/// top-left corner of the image, as in glTF), read as linear RGB.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Texels {
     pub width: usize,
     pub height: usize,
-    pub values: Vec<Rgb>,
+    values: TexelValues,
+}
+
+/// How texels are held.
+#[derive(Debug, Clone, PartialEq)]
+enum TexelValues {
+    Linear(Vec<Rgb>),
+    /// The bytes of an 8-bit image, 3 bytes a texel instead of 12, and
+    /// the linear value of each byte (pbrt-v4 keeps 8-bit images so too):
+    /// a 4096 x 4096 texture takes 48 MiB instead of 192.
+    Bytes {
+        texels: Vec<[u8; 3]>,
+        decode: Box<[f32; 256]>,
+    },
 }
 
 impl Texels {
+    /// Linear texels.
+    pub fn linear(width: usize, height: usize, values: Vec<Rgb>) -> Self {
+        debug_assert_eq!(values.len(), width * height);
+        Self {
+            width,
+            height,
+            values: TexelValues::Linear(values),
+        }
+    }
+
+    /// 8-bit texels whose byte `b` stands for the linear value `decode(b)`.
+    pub fn bytes(
+        width: usize,
+        height: usize,
+        texels: Vec<[u8; 3]>,
+        decode: impl Fn(u8) -> f32,
+    ) -> Self {
+        debug_assert_eq!(texels.len(), width * height);
+        Self {
+            width,
+            height,
+            values: TexelValues::Bytes {
+                texels,
+                decode: Box::new(std::array::from_fn(|b| decode(b as u8))),
+            },
+        }
+    }
+
     /// The texel at integer coordinates `(x, y)`, wrapped in u and in v.
     #[inline]
     pub fn texel(&self, x: i64, y: i64, wrap: [Wrap; 2]) -> Rgb {
         let x = wrap[0].index(x, self.width);
         let y = wrap[1].index(y, self.height);
-        self.values[y * self.width + x]
+        let i = y * self.width + x;
+        match &self.values {
+            TexelValues::Linear(values) => values[i],
+            TexelValues::Bytes { texels, decode } => {
+                let [r, g, b] = texels[i];
+                Rgb::new(decode[r as usize], decode[g as usize], decode[b as usize])
+            }
+        }
+    }
+
+    /// Every texel, row by row.
+    pub fn iter(&self) -> impl Iterator<Item = Rgb> + '_ {
+        (0..self.height as i64).flat_map(move |y| {
+            (0..self.width as i64).map(move |x| self.texel(x, y, [Wrap::Clamp; 2]))
+        })
+    }
+
+    /// Bytes the texels take.
+    pub fn byte_size(&self) -> usize {
+        match &self.values {
+            TexelValues::Linear(values) => values.capacity() * std::mem::size_of::<Rgb>(),
+            TexelValues::Bytes { texels, decode } => {
+                texels.capacity() * std::mem::size_of::<[u8; 3]>()
+                    + std::mem::size_of_val(&**decode)
+            }
+        }
     }
 
     /// The texel that covers `uv`.
@@ -86,13 +152,13 @@ mod tests {
 
     /// A 3 x 2 image whose texel (x, y) has red x and green y.
     fn ramp() -> Texels {
-        Texels {
-            width: 3,
-            height: 2,
-            values: (0..2)
+        Texels::linear(
+            3,
+            2,
+            (0..2)
                 .flat_map(|y| (0..3).map(move |x| Rgb::new(x as f32, y as f32, 1.0)))
                 .collect(),
-        }
+        )
     }
 
     #[test]
@@ -112,7 +178,7 @@ mod tests {
                 for x in 0..3 {
                     let uv = Vec2::new((x as f32 + 0.5) / 3.0, (y as f32 + 0.5) / 2.0);
                     let got = t.bilinear(uv, [wrap; 2]);
-                    let want = t.values[y * 3 + x];
+                    let want = t.texel(x as i64, y as i64, [Wrap::Clamp; 2]);
                     assert!(close(got, want), "{wrap:?} {x} {y}: {got:?}");
                     assert_eq!(t.nearest(uv, [wrap; 2]), want);
                 }
@@ -137,16 +203,16 @@ mod tests {
     #[test]
     fn wrap_modes_apply_per_axis() {
         // 2 x 2: red, green / blue, white.
-        let t = Texels {
-            width: 2,
-            height: 2,
-            values: vec![
+        let t = Texels::linear(
+            2,
+            2,
+            vec![
                 Rgb::new(1.0, 0.0, 0.0),
                 Rgb::new(0.0, 1.0, 0.0),
                 Rgb::new(0.0, 0.0, 1.0),
                 Rgb::WHITE,
             ],
-        };
+        );
         let wrap = [Wrap::Clamp, Wrap::Mirror];
         // Clamped in u: far right is the right column; mirrored in v: v in
         // (1, 1.5) reflects to the bottom row, (1.5, 2) to the top.
@@ -176,11 +242,7 @@ mod tests {
     #[test]
     fn a_constant_image_reads_its_value_everywhere() {
         let c = Rgb::new(0.2, 0.4, 0.8);
-        let t = Texels {
-            width: 5,
-            height: 3,
-            values: vec![c; 15],
-        };
+        let t = Texels::linear(5, 3, vec![c; 15]);
         for i in 0..200 {
             let uv = Vec2::new(i as f32 * 0.173 - 7.0, i as f32 * -0.291 + 3.0);
             for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
