@@ -255,6 +255,9 @@ impl Texture for Guarded<Arc<dyn Texture>> {
     fn eval_float(&self, query: &TextureQuery) -> f32 {
         self.value("Texture::eval_float", 0.0, |t| t.eval_float(query))
     }
+    fn uses_footprint(&self) -> bool {
+        self.value("Texture::uses_footprint", false, |t| t.uses_footprint())
+    }
 }
 
 impl Light for Guarded<Box<dyn Light>> {

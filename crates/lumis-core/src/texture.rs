@@ -74,6 +74,13 @@ pub trait Texture: Send + Sync {
     fn eval_float(&self, query: &TextureQuery) -> f32 {
         self.eval(query).average()
     }
+
+    /// Whether lookups read the query's footprint (an image filtered over
+    /// it). A scene computes the pixel footprint at its hits only if one
+    /// of its textures does: the work is not free.
+    fn uses_footprint(&self) -> bool {
+        false
+    }
 }
 
 /// Plugins of a scene by the name its tables give them: the `[[texture]]`s
@@ -121,6 +128,11 @@ impl<T: ?Sized> Named<T> {
 
     pub fn get(&self, name: &str) -> Option<&Arc<T>> {
         self.by_name.get(name)
+    }
+
+    /// The plugins, in the order of their names.
+    pub fn values(&self) -> impl Iterator<Item = &Arc<T>> {
+        self.by_name.values()
     }
 
     /// The names, sorted, for messages.

@@ -104,7 +104,7 @@ pub fn load_str(
     let light_sampler =
         registry.create::<dyn LightSampler>(&description.light_sampler, &assembled.lights)?;
 
-    let textured = !description.textures.is_empty() || assembled.report.texture_bytes > 0;
+    let textured = assembled.footprint || plugins.textures.values().any(|t| t.uses_footprint());
     let scene = RenderScene {
         embree: assembled.embree,
         geometries: assembled.geometries,
@@ -116,8 +116,8 @@ pub fn load_str(
         counts: assembled.counts,
         report: assembled.report,
         packets: description.accel.packets,
-        // Only textures read the pixel footprint; a scene without them
-        // does no footprint work at its hits.
+        // Only filtered textures read the pixel footprint; a scene without
+        // them does no footprint work at its hits.
         footprint: textured.then(|| {
             description
                 .camera

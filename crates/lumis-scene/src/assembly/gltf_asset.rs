@@ -143,6 +143,7 @@ fn place_materials<'m>(
         let bsdf = match &material.bsdf {
             MaterialBsdf::Scene(reference) => asm.bsdfs.index_of(reference, owner)?,
             MaterialBsdf::Asset(asset) => {
+                asm.footprint |= asset.textures.values().any(|t| t.uses_footprint());
                 let scope = BsdfScope::textures(&asset.textures);
                 let mut bsdf = asm.registry.create::<dyn Bsdf>(&asset.entity, scope)?;
                 if asset.two_sided {

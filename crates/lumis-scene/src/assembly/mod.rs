@@ -35,6 +35,8 @@ pub(crate) struct Assembled {
     pub infinite_lights: Vec<u32>,
     pub counts: SceneCounts,
     pub report: LoadReport,
+    /// Whether an imported texture filters over the pixel footprint.
+    pub footprint: bool,
 }
 
 /// Adds `shapes` to a new Embree scene, then the lights not attached to
@@ -52,6 +54,7 @@ pub(crate) fn assemble(
     let mut asm = Assembly {
         registry,
         textures,
+        footprint: false,
         builder: SceneBuilder::new(&device, accel.embree).map_err(embree_error)?,
         device,
         options: accel.embree,
@@ -84,6 +87,7 @@ pub(crate) fn assemble(
         bsdfs,
         mut counts,
         mut report,
+        footprint,
         ..
     } = asm;
     lights.extend(scene_lights);
@@ -113,6 +117,7 @@ pub(crate) fn assemble(
         infinite_lights,
         counts,
         report,
+        footprint,
     })
 }
 

@@ -14,6 +14,9 @@ pub(crate) struct Assembly<'r> {
     pub registry: &'r Registry,
     /// The scene's `[[texture]]`s, which a shape's emission may name.
     pub textures: &'r Textures,
+    /// Whether an imported material's texture filters over the pixel
+    /// footprint.
+    pub footprint: bool,
     pub device: Device,
     /// Quality and robustness of every BVH; compaction is decided once
     /// every shape is counted.

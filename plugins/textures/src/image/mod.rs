@@ -153,6 +153,10 @@ impl ImageTexture {
 }
 
 impl Texture for ImageTexture {
+    fn uses_footprint(&self) -> bool {
+        matches!(self.filter, ImageFilter::Trilinear | ImageFilter::Ewa)
+    }
+
     #[inline]
     fn eval(&self, query: &TextureQuery) -> Rgb {
         let query = self.transform.apply(query);
