@@ -12,10 +12,11 @@ use lumis_check::light_sampler_suite::{
 };
 use lumis_check::light_suite::{check_light_with, format_light_results, LightCheckConfig};
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, plugin_listing, plugin_markdown, precompute_table,
-    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
-    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, PrecomputeArgs, ReferenceArgs, RenderArgs,
-    TabulateArgs, INTERRUPTED_EXIT_CODE,
+    analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
+    plugin_listing, plugin_markdown, precompute_table, registry_with_search_path, render_reference,
+    render_scene_file, stop_on_interrupt, tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs,
+    IntegratorCheckConfig, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs,
+    INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -44,13 +45,14 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Statistically check BSDF, light and light-sampler plugins over a
+    /// Statistically check BSDF, light, light-sampler and integrator plugins over a
     /// sweep of their parameters: for BSDFs, chi-square of sample_f against
     /// pdf, pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
     /// reciprocity and finiteness, at incident angles down to cos theta =
     /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
     /// around and inside them, consistency and finiteness; for light
-    /// samplers, the pmf against the draws. Exits non-zero on any failure
+    /// samplers, the pmf against the draws; for integrators, white furnaces
+    /// and agreement with the built-in path tracer. Exits non-zero on any failure
     /// and writes observed-vs-expected PNGs for failed chi-square cases.
     CheckPlugin {
         /// A plugin library: checks every plugin of these kinds it registers.
@@ -64,6 +66,9 @@ enum Command {
         /// Check this light sampler (built-in or from the library); repeatable.
         #[arg(long)]
         light_sampler: Vec<String>,
+        /// Check this integrator (built-in or from the library); repeatable.
+        #[arg(long)]
+        integrator: Vec<String>,
         /// Samples per chi-square test.
         #[arg(long, default_value_t = 1_000_000)]
         samples: usize,
@@ -177,6 +182,7 @@ fn main() -> ExitCode {
             bsdf,
             light,
             light_sampler,
+            integrator,
             samples,
             bins,
             out,
@@ -186,6 +192,7 @@ fn main() -> ExitCode {
                 bsdf,
                 light,
                 light_sampler,
+                integrator,
             };
             check_plugin(library, names, samples, bins, &out, &set).map(Outcome::passed)
         }),
@@ -296,11 +303,15 @@ struct PluginNames {
     bsdf: Vec<String>,
     light: Vec<String>,
     light_sampler: Vec<String>,
+    integrator: Vec<String>,
 }
 
 impl PluginNames {
     fn is_empty(&self) -> bool {
-        self.bsdf.is_empty() && self.light.is_empty() && self.light_sampler.is_empty()
+        self.bsdf.is_empty()
+            && self.light.is_empty()
+            && self.light_sampler.is_empty()
+            && self.integrator.is_empty()
     }
 
     /// Adds the plugins of the checked kinds that `registry` has and
@@ -315,6 +326,7 @@ impl PluginNames {
                 PluginKind::Bsdf => self.bsdf.push(name),
                 PluginKind::Light => self.light.push(name),
                 PluginKind::LightSampler => self.light_sampler.push(name),
+                PluginKind::Integrator => self.integrator.push(name),
                 _ => {}
             }
         }
@@ -345,7 +357,7 @@ fn check_plugin(
     }
     if names.is_empty() {
         return Err(Error::msg(
-            "nothing to check: give a plugin library that registers BSDFs, lights or light samplers, or --bsdf, --light or --light-sampler NAME",
+            "nothing to check: give a plugin library that registers BSDFs, lights, light samplers or integrators, or --bsdf, --light, --light-sampler or --integrator NAME",
         ));
     }
     let mut all_passed = true;
@@ -357,6 +369,9 @@ fn check_plugin(
     }
     for name in &names.light_sampler {
         all_passed &= check_light_sampler_plugin(&registry, name, &fixed)?;
+    }
+    for name in &names.integrator {
+        all_passed &= check_integrator_plugin(&registry, name, &fixed)?;
     }
     Ok(all_passed)
 }
@@ -423,5 +438,17 @@ fn check_light_sampler_plugin(
     let cfg = LightSamplerCheckConfig::default();
     let results = check_light_sampler_with(registry, name, fixed, &cfg)?;
     print!("{}", format_light_sampler_results(&results));
+    Ok(results.iter().all(|r| r.passed()))
+}
+
+/// Checks the integrator `name` on the kit's tiny scenes.
+fn check_integrator_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+) -> Result<bool> {
+    let cfg = IntegratorCheckConfig::default();
+    let results = check_integrator_with(registry, name, fixed, &cfg)?;
+    print!("{}", format_integrator_results(&results));
     Ok(results.iter().all(|r| r.passed()))
 }
