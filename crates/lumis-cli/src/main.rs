@@ -45,15 +45,16 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Statistically check BSDF, light, light-sampler and integrator plugins over a
-    /// sweep of their parameters: for BSDFs, chi-square of sample_f against
-    /// pdf, pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
-    /// reciprocity and finiteness, at incident angles down to cos theta =
-    /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
-    /// around and inside them, consistency and finiteness; for light
-    /// samplers, the pmf against the draws; for integrators, white furnaces
-    /// and agreement with the built-in path tracer. Exits non-zero on any failure
-    /// and writes observed-vs-expected PNGs for failed chi-square cases.
+    /// Statistically check BSDF, light, light-sampler and integrator
+    /// plugins over a sweep of their parameters: for BSDFs, chi-square of
+    /// sample_f against pdf, pdf normalisation, sample_f/f/pdf consistency,
+    /// albedo <= 1, reciprocity and finiteness, at incident angles down to
+    /// cos theta = 1e-4; for lights, chi-square of sample_li against pdf_li
+    /// from points around and inside them, consistency and finiteness; for
+    /// light samplers, the pmf against the draws; for integrators, white
+    /// furnaces and agreement with the built-in path tracer. Exits non-zero
+    /// on any failure and writes observed-vs-expected PNGs for failed
+    /// chi-square cases.
     CheckPlugin {
         /// A plugin library: checks every plugin of these kinds it registers.
         library: Option<PathBuf>,
