@@ -7,6 +7,7 @@ mod brdf;
 mod checkpoint;
 mod converge;
 mod diff;
+mod integrator_check;
 mod interrupt;
 mod listing;
 mod metadata;
@@ -21,6 +22,10 @@ pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
 pub use checkpoint::{checkpoint_path, Checkpoint};
 pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
+pub use integrator_check::{
+    check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,
+    IntegratorTest, KNOWN_DEPTHS,
+};
 pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
 pub use metadata::ImageMetadata;

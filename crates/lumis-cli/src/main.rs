@@ -14,10 +14,11 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, converge, diff_images, new_plugin, plugin_listing, plugin_markdown,
-    precompute_table, registry_with_search_path, render_reference, render_scene_file,
-    stop_on_interrupt, tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, NewPluginArgs,
-    PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
+    new_plugin, plugin_listing, plugin_markdown, precompute_table, registry_with_search_path,
+    render_reference, render_scene_file, stop_on_interrupt, tabulate_bsdf, AnalyzeArgs,
+    ConvergeArgs, DiffArgs, IntegratorCheckConfig, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
+    RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -46,16 +47,18 @@ enum Command {
         #[arg(long)]
         markdown: bool,
     },
-    /// Statistically check BSDF, light and light-sampler plugins over a
-    /// sweep of their parameters: for BSDFs, chi-square of sample_f against
-    /// pdf, pdf normalisation, sample_f/f/pdf consistency, albedo <= 1,
-    /// reciprocity and finiteness, at incident angles down to cos theta =
-    /// 1e-4; for lights, chi-square of sample_li against pdf_li from points
-    /// around and inside them, consistency and finiteness; for light
-    /// samplers, the pmf against the draws; for samplers, the range [0, 1),
-    /// determinism, the declared film pattern (exactly) and uniformity.
-    /// Exits non-zero on any failure
-    /// and writes observed-vs-expected PNGs for failed chi-square cases.
+    /// Statistically check BSDF, light, light-sampler, sampler and
+    /// integrator plugins over a sweep of their parameters: for BSDFs,
+    /// chi-square of sample_f against pdf, pdf normalisation,
+    /// sample_f/f/pdf consistency, albedo <= 1, reciprocity and finiteness,
+    /// at incident angles down to cos theta = 1e-4; for lights, chi-square
+    /// of sample_li against pdf_li from points around and inside them,
+    /// consistency and finiteness; for light samplers, the pmf against the
+    /// draws; for samplers, the range [0, 1), determinism, the declared film
+    /// pattern (exactly) and uniformity; for integrators, white furnaces and
+    /// agreement with the built-in path tracer. Exits non-zero on any
+    /// failure and writes observed-vs-expected PNGs for failed chi-square
+    /// cases.
     CheckPlugin {
         /// A plugin library: checks every plugin of these kinds it registers.
         library: Option<PathBuf>,
@@ -71,6 +74,9 @@ enum Command {
         /// Check this sampler (built-in or from the library); repeatable.
         #[arg(long)]
         sampler: Vec<String>,
+        /// Check this integrator (built-in or from the library); repeatable.
+        #[arg(long)]
+        integrator: Vec<String>,
         /// Samples per chi-square test.
         #[arg(long, default_value_t = 1_000_000)]
         samples: usize,
@@ -189,6 +195,7 @@ fn main() -> ExitCode {
             light,
             light_sampler,
             sampler,
+            integrator,
             samples,
             bins,
             out,
@@ -199,6 +206,7 @@ fn main() -> ExitCode {
                 light,
                 light_sampler,
                 sampler,
+                integrator,
             };
             check_plugin(library, names, samples, bins, &out, &set).map(Outcome::passed)
         }),
@@ -319,6 +327,7 @@ struct PluginNames {
     light: Vec<String>,
     light_sampler: Vec<String>,
     sampler: Vec<String>,
+    integrator: Vec<String>,
 }
 
 impl PluginNames {
@@ -327,6 +336,7 @@ impl PluginNames {
             && self.light.is_empty()
             && self.light_sampler.is_empty()
             && self.sampler.is_empty()
+            && self.integrator.is_empty()
     }
 
     /// Adds the plugins of the checked kinds that `registry` has and
@@ -342,6 +352,7 @@ impl PluginNames {
                 PluginKind::Light => self.light.push(name),
                 PluginKind::LightSampler => self.light_sampler.push(name),
                 PluginKind::Sampler => self.sampler.push(name),
+                PluginKind::Integrator => self.integrator.push(name),
                 _ => {}
             }
         }
@@ -372,7 +383,7 @@ fn check_plugin(
     }
     if names.is_empty() {
         return Err(Error::msg(
-            "nothing to check: give a plugin library that registers BSDFs, lights, light samplers or samplers, or --bsdf, --light, --light-sampler or --sampler NAME",
+            "nothing to check: give a plugin library that registers BSDFs, lights, light samplers, samplers or integrators, or --bsdf, --light, --light-sampler, --sampler or --integrator NAME",
         ));
     }
     let mut all_passed = true;
@@ -387,6 +398,9 @@ fn check_plugin(
     }
     for name in &names.sampler {
         all_passed &= check_sampler_plugin(&registry, name, &fixed)?;
+    }
+    for name in &names.integrator {
+        all_passed &= check_integrator_plugin(&registry, name, &fixed)?;
     }
     Ok(all_passed)
 }
@@ -463,5 +477,17 @@ fn check_sampler_plugin(
 ) -> Result<bool> {
     let results = check_sampler_with(registry, name, fixed, &SamplerCheckConfig::default())?;
     print!("{}", format_sampler_results(&results));
+    Ok(results.iter().all(|r| r.passed()))
+}
+
+/// Checks the integrator `name` on the kit's tiny scenes.
+fn check_integrator_plugin(
+    registry: &Registry,
+    name: &str,
+    fixed: &[(String, String)],
+) -> Result<bool> {
+    let cfg = IntegratorCheckConfig::default();
+    let results = check_integrator_with(registry, name, fixed, &cfg)?;
+    print!("{}", format_integrator_results(&results));
     Ok(results.iter().all(|r| r.passed()))
 }

@@ -40,8 +40,6 @@ pub enum NewPluginKind {
 struct Template {
     lib: &'static str,
     check: &'static str,
-    /// How to check the built library with `lumis check-plugin`.
-    check_command: &'static str,
     /// How a scene uses the plugin.
     scene: &'static str,
 }
@@ -73,38 +71,30 @@ impl NewPluginKind {
     }
 
     fn template(self) -> Template {
-        const CHECK: &str = "lumis check-plugin target/release/lib{{lib}}.so";
-        const NO_CHECK: &str =
-            "# lumis check-plugin checks BSDFs; tests/check.rs checks this plugin";
         match self {
             Self::Bsdf => Template {
                 lib: include_str!("../templates/bsdf/lib.rs"),
                 check: include_str!("../templates/bsdf/check.rs"),
-                check_command: CHECK,
                 scene: "[[bsdf]]\nname = \"matte\"\ntype = \"{{plugin}}\"\nreflectance = [0.8, 0.6, 0.4]",
             },
             Self::Light => Template {
                 lib: include_str!("../templates/light/lib.rs"),
                 check: include_str!("../templates/light/check.rs"),
-                check_command: NO_CHECK,
                 scene: "[[shape]]\ntype = \"quad\"\ncorner = [-0.5, 1.9, -0.5]\nedge_u = [1, 0, 0]\nedge_v = [0, 0, 1]\nbsdf = \"white\"\nemission = { type = \"{{plugin}}\", radiance = [10, 10, 10] }",
             },
             Self::Sampler => Template {
                 lib: include_str!("../templates/sampler/lib.rs"),
                 check: include_str!("../templates/sampler/check.rs"),
-                check_command: NO_CHECK,
                 scene: "[sampler]\ntype = \"{{plugin}}\"\nstrata = 8",
             },
             Self::LightSampler => Template {
                 lib: include_str!("../templates/light-sampler/lib.rs"),
                 check: include_str!("../templates/light-sampler/check.rs"),
-                check_command: NO_CHECK,
                 scene: "[light_sampler]\ntype = \"{{plugin}}\"",
             },
             Self::Integrator => Template {
                 lib: include_str!("../templates/integrator/lib.rs"),
                 check: include_str!("../templates/integrator/check.rs"),
-                check_command: NO_CHECK,
                 scene: "[integrator]\ntype = \"{{plugin}}\"\nmax_depth = 8",
             },
         }
@@ -203,8 +193,7 @@ pub fn new_plugin(args: &NewPluginArgs, parent: &Path) -> Result<PathBuf> {
         ))
     })?;
     let fill = |text: &str| {
-        text.replace("{{check}}", template.check_command)
-            .replace("{{scene}}", template.scene)
+        text.replace("{{scene}}", template.scene)
             .replace("{{kind}}", args.kind.label())
             .replace("{{crate}}", &args.name)
             .replace("{{plugin}}", &args.name)
