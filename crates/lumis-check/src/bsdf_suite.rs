@@ -31,6 +31,7 @@ use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
 use crate::lobe_zoom::chi_square_zoomed;
 use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
+use crate::sweep::declared;
 pub use crate::sweep::{
     parameter_sweep, parameter_sweep_with, variant, Variant, INTERIOR_VALUES, STAND_IN_BSDFS,
 };
@@ -406,10 +407,8 @@ pub fn check_bsdf(
     name: &str,
     cfg: &BsdfCheckConfig,
 ) -> Result<Vec<CaseResult>> {
-    let plugin = registry
-        .find(PluginKind::Bsdf, name)
-        .ok_or_else(|| Error::msg(format!("no bsdf plugin named \"{name}\"")))?;
-    check_bsdf_variants(registry, name, &parameter_sweep(&plugin.spec)?, cfg)
+    let spec = declared(registry, PluginKind::Bsdf, name)?;
+    check_bsdf_variants(registry, name, &parameter_sweep(&spec)?, cfg)
 }
 
 /// [`check_bsdf`] with parameters held fixed (see [`parameter_sweep_with`]).
@@ -419,15 +418,8 @@ pub fn check_bsdf_with(
     fixed: &[(String, String)],
     cfg: &BsdfCheckConfig,
 ) -> Result<Vec<CaseResult>> {
-    let plugin = registry
-        .find(PluginKind::Bsdf, name)
-        .ok_or_else(|| Error::msg(format!("no bsdf plugin named \"{name}\"")))?;
-    check_bsdf_variants(
-        registry,
-        name,
-        &parameter_sweep_with(&plugin.spec, fixed)?,
-        cfg,
-    )
+    let spec = declared(registry, PluginKind::Bsdf, name)?;
+    check_bsdf_variants(registry, name, &parameter_sweep_with(&spec, fixed)?, cfg)
 }
 
 /// Runs every check for each of `variants` of the BSDF plugin `name` and

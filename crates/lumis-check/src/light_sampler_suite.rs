@@ -13,8 +13,8 @@ use std::fmt::Write;
 
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    doc, Error, Light, LightInput, LightSampleContext, LightSampler, LightShape, Location,
-    PluginEntity, PluginKind, Registry, Result, Vec2, Vec3,
+    doc, Light, LightInput, LightSampleContext, LightSampler, LightShape, Location, PluginEntity,
+    PluginKind, Registry, Result, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -23,7 +23,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 use crate::corrected_significance;
 use crate::light_suite::{SCENE_CENTER, SCENE_RADIUS};
 use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
-use crate::sweep::{parameter_sweep_with, Variant};
+use crate::sweep::{declared, parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -172,10 +172,8 @@ pub fn check_light_sampler_with(
     fixed: &[(String, String)],
     cfg: &LightSamplerCheckConfig,
 ) -> Result<Vec<LightSamplerCaseResult>> {
-    let plugin = registry
-        .find(PluginKind::LightSampler, name)
-        .ok_or_else(|| Error::msg(format!("no light_sampler plugin named \"{name}\"")))?;
-    let variants = parameter_sweep_with(&plugin.spec, fixed)?;
+    let spec = declared(registry, PluginKind::LightSampler, name)?;
+    let variants = parameter_sweep_with(&spec, fixed)?;
     let lights = stand_in_lights(registry)?;
     let samplers: Vec<_> = variants
         .iter()

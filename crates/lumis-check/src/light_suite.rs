@@ -31,7 +31,7 @@ use crate::adapters::light_pair;
 use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
 use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
-use crate::sweep::{parameter_sweep_with, Variant};
+use crate::sweep::{declared, parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -219,12 +219,10 @@ fn with_positions(
     name: &str,
     fixed: &[(String, String)],
 ) -> Result<Vec<(String, String)>> {
-    let plugin = registry
-        .find(PluginKind::Light, name)
-        .ok_or_else(|| Error::msg(format!("no light plugin named \"{name}\"")))?;
+    let spec = declared(registry, PluginKind::Light, name)?;
     let mut out = fixed.to_vec();
     let mut places = [LIGHT_POSITION, SECOND_POSITION].into_iter();
-    for p in plugin.spec.params {
+    for p in spec.params {
         if p.ty == ParamType::Vec3
             && p.default == ParamDefault::Required
             && !fixed.iter().any(|(k, _)| k == p.name)
@@ -246,10 +244,8 @@ pub fn check_light_with(
     cfg: &LightCheckConfig,
 ) -> Result<Vec<LightCaseResult>> {
     let fixed = with_positions(registry, name, fixed)?;
-    let plugin = registry
-        .find(PluginKind::Light, name)
-        .ok_or_else(|| Error::msg(format!("no light plugin named \"{name}\"")))?;
-    let variants = parameter_sweep_with(&plugin.spec, &fixed)?;
+    let spec = declared(registry, PluginKind::Light, name)?;
+    let variants = parameter_sweep_with(&spec, &fixed)?;
     check_light_variants(registry, name, &variants, cfg)
 }
 

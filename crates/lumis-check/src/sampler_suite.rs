@@ -20,14 +20,14 @@
 use std::fmt::Write;
 
 use lumis_core::{
-    Error, Location, PixelPattern, PluginEntity, PluginKind, Registry, Result, Sampler, UVec2, Vec2,
+    Location, PixelPattern, PluginEntity, PluginKind, Registry, Result, Sampler, UVec2, Vec2,
 };
 use lumis_sampling::hash_u64;
 use rayon::prelude::*;
 
 use crate::corrected_significance;
 use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
-use crate::sweep::{parameter_sweep_with, variant, Variant};
+use crate::sweep::{declared, parameter_sweep_with, variant, Variant};
 use crate::uniformity::uniformity_2d;
 
 /// How thoroughly to check.
@@ -116,12 +116,10 @@ pub fn check_sampler_with(
     fixed: &[(String, String)],
     cfg: &SamplerCheckConfig,
 ) -> Result<Vec<SamplerCaseResult>> {
-    let plugin = registry
-        .find(PluginKind::Sampler, name)
-        .ok_or_else(|| Error::msg(format!("no sampler plugin named \"{name}\"")))?;
-    let mut variants = parameter_sweep_with(&plugin.spec, fixed)?;
-    let sweeps_spp = plugin.spec.params.iter().any(|p| p.name == "spp")
-        && !fixed.iter().any(|(k, _)| k == "spp");
+    let spec = declared(registry, PluginKind::Sampler, name)?;
+    let mut variants = parameter_sweep_with(&spec, fixed)?;
+    let sweeps_spp =
+        spec.params.iter().any(|p| p.name == "spp") && !fixed.iter().any(|(k, _)| k == "spp");
     if sweeps_spp {
         let base = variants[0].table.clone();
         for spp in SPP_EXTREMES {

@@ -5,7 +5,7 @@
 
 use lumis_core::doc::{self, Table};
 use lumis_core::params::ParamDefault;
-use lumis_core::{Error, ParamType, PluginSpec, Result};
+use lumis_core::{Error, ParamType, PluginKind, PluginSpec, Registry, Result};
 use lumis_sampling::Pcg32;
 
 /// One parameter setting of the sweep.
@@ -59,6 +59,15 @@ fn name_seed(plugin: &str, parameter: &str) -> u64 {
         .fold(0xcbf2_9ce4_8422_2325, |h, b| {
             (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
         })
+}
+
+/// The declaration of the `kind` plugin `name`, or an error naming what
+/// is missing: where every suite starts.
+pub fn declared(registry: &Registry, kind: PluginKind, name: &str) -> Result<PluginSpec> {
+    registry
+        .find(kind, name)
+        .map(|p| p.spec)
+        .ok_or_else(|| Error::msg(format!("no {} plugin named \"{name}\"", kind.table_name())))
 }
 
 /// A named parameter setting, from TOML text (`"roughness = 0.01\n..."`).

@@ -24,7 +24,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use lumis_check::corrected_significance;
-use lumis_check::sweep::{parameter_sweep_with, Variant};
+use lumis_check::sweep::{declared, parameter_sweep_with, Variant};
 use lumis_core::params::{ParamDefault, ParamValue};
 use lumis_core::{
     doc::Value, Error, Integrator, Location, PluginEntity, PluginKind, PluginSpec, Registry, Result,
@@ -149,15 +149,13 @@ pub fn check_integrator_with(
     fixed: &[(String, String)],
     cfg: &IntegratorCheckConfig,
 ) -> Result<Vec<IntegratorCaseResult>> {
-    let plugin = registry
-        .find(PluginKind::Integrator, name)
-        .ok_or_else(|| Error::msg(format!("no integrator plugin named \"{name}\"")))?;
+    let spec = declared(registry, PluginKind::Integrator, name)?;
     if cfg.resolution == 0 || cfg.block == 0 || cfg.spp == 0 || cfg.compare_spp == 0 {
         return Err(Error::msg(
             "integrator check: resolution, block, spp and compare_spp must be positive",
         ));
     }
-    let variants = parameter_sweep_with(&plugin.spec, fixed)?;
+    let variants = parameter_sweep_with(&spec, fixed)?;
     let blocks = cfg.resolution.div_ceil(cfg.block).pow(2);
     // One z-test per channel for each furnace, per channel and block for
     // the comparison.
@@ -165,7 +163,7 @@ pub fn check_integrator_with(
     let significance = corrected_significance(cfg.alpha, tests);
     let mut results = Vec::new();
     for (v, variant) in variants.iter().enumerate() {
-        let depth = declared_depth(&plugin.spec, variant);
+        let depth = declared_depth(&spec, variant);
         let entity = PluginEntity::new(
             PluginKind::Integrator,
             owner(name, variant),
