@@ -30,7 +30,7 @@ use crate::adapters::bsdf_pair;
 use crate::chi_square::{ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
 use crate::lobe_zoom::chi_square_zoomed;
-use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
+use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::declared;
 pub use crate::sweep::{
     parameter_sweep, parameter_sweep_with, variant, Variant, INTERIOR_VALUES, STAND_IN_BSDFS,
@@ -102,6 +102,9 @@ impl Outcome for CaseResult {
     }
     fn not_testable(&self) -> Option<&str> {
         self.not_testable.as_deref()
+    }
+    fn problems(&self) -> &[String] {
+        &self.problems
     }
 }
 
@@ -579,29 +582,16 @@ pub fn format_results(results: &[CaseResult]) -> String {
             r.albedo,
             verdict(r)
         );
-        if let Some(why) = &r.refused {
-            let _ = writeln!(
-                out,
-                "    not tested: the plugin refuses these parameters: {why}"
-            );
-            continue;
-        }
-        if let Some(why) = &r.not_testable {
-            let _ = writeln!(out, "    not testable: {why}");
-        }
-        if let Some(d) = &c.defect {
-            let _ = writeln!(out, "    chi-square: {d}");
-        }
-        if !c.passed && c.defect.is_none() && r.not_testable.is_none() {
-            let _ = writeln!(
-                out,
-                "    chi-square: statistic {:.1} with {} degrees of freedom",
-                c.statistic, c.degrees_of_freedom
-            );
-        }
-        for p in &r.problems {
-            let _ = writeln!(out, "    {p}");
-        }
+        let statistic = match &c.defect {
+            Some(d) => Some(format!("chi-square: {d}")),
+            None => (!c.passed && r.not_testable.is_none()).then(|| {
+                format!(
+                    "chi-square: statistic {:.1} with {} degrees of freedom",
+                    c.statistic, c.degrees_of_freedom
+                )
+            }),
+        };
+        write_notes(&mut out, r, statistic);
     }
     let _ = writeln!(out, "{}", summary(results));
     out

@@ -22,7 +22,7 @@ use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 use crate::corrected_significance;
 use crate::light_suite::{SCENE_CENTER, SCENE_RADIUS};
-use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
+use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::{declared, parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
@@ -156,6 +156,9 @@ impl Outcome for LightSamplerCaseResult {
     }
     fn not_testable(&self) -> Option<&str> {
         None
+    }
+    fn problems(&self) -> &[String] {
+        &self.problems
     }
 }
 
@@ -388,23 +391,13 @@ pub fn format_light_sampler_results(results: &[LightSamplerCaseResult]) -> Strin
             r.p_value,
             verdict(r)
         );
-        if let Some(why) = &r.refused {
-            let _ = writeln!(
-                out,
-                "    not tested: the plugin refuses these parameters: {why}"
-            );
-            continue;
-        }
-        if r.problems.is_empty() && r.p_value < r.significance {
-            let _ = writeln!(
-                out,
-                "    chi-square: statistic {:.1}, p-value below {:.3e}",
+        let statistic = (r.problems.is_empty() && r.p_value < r.significance).then(|| {
+            format!(
+                "chi-square: statistic {:.1}, p-value below {:.3e}",
                 r.statistic, r.significance
-            );
-        }
-        for p in &r.problems {
-            let _ = writeln!(out, "    {p}");
-        }
+            )
+        });
+        write_notes(&mut out, r, statistic);
     }
     let _ = writeln!(out, "{}", summary(results));
     out

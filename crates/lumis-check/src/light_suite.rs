@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use crate::adapters::light_pair;
 use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
-use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
+use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::{declared, parameter_sweep_with, Variant};
 
 /// How thoroughly to check.
@@ -183,6 +183,9 @@ impl Outcome for LightCaseResult {
     }
     fn not_testable(&self) -> Option<&str> {
         self.not_testable.as_deref()
+    }
+    fn problems(&self) -> &[String] {
+        &self.problems
     }
 }
 
@@ -599,30 +602,16 @@ pub fn format_light_results(results: &[LightCaseResult]) -> String {
             r.point,
             r.power.luminance(),
         );
-        if let Some(why) = &r.refused {
-            let _ = writeln!(
-                out,
-                "    not tested: the plugin refuses these parameters: {why}"
-            );
-            continue;
-        }
-        if let Some(why) = &r.not_testable {
-            let _ = writeln!(out, "    not testable: {why}");
-        }
-        if let Some(c) = &r.chi_square {
-            if let Some(d) = &c.defect {
-                let _ = writeln!(out, "    chi-square: {d}");
-            } else if !c.passed {
-                let _ = writeln!(
-                    out,
-                    "    chi-square: statistic {:.1} with {} degrees of freedom",
+        let statistic = r.chi_square.as_ref().and_then(|c| match &c.defect {
+            Some(d) => Some(format!("chi-square: {d}")),
+            None => (!c.passed).then(|| {
+                format!(
+                    "chi-square: statistic {:.1} with {} degrees of freedom",
                     c.statistic, c.degrees_of_freedom
-                );
-            }
-        }
-        for p in &r.problems {
-            let _ = writeln!(out, "    {p}");
-        }
+                )
+            }),
+        });
+        write_notes(&mut out, r, statistic);
     }
     let _ = writeln!(out, "{}", summary(results));
     out

@@ -2,6 +2,8 @@
 //! the word its table row shows, the closing count, and how a plugin the
 //! sweep could not make, or one that panicked, counts.
 
+use std::fmt::Write;
+
 use lumis_core::{Error, Registry};
 
 /// How a case ended.
@@ -12,6 +14,8 @@ pub trait Outcome {
     fn refused(&self) -> Option<&str>;
     /// Why a test could not decide, as the kit established it.
     fn not_testable(&self) -> Option<&str>;
+    /// Everything that failed besides the suite's statistical test.
+    fn problems(&self) -> &[String];
 }
 
 /// The result column of a case's row.
@@ -21,6 +25,25 @@ pub fn verdict(case: &impl Outcome) -> &'static str {
         (None, _, false) => "FAILED",
         (None, Some(_), true) => "not testable",
         (None, None, true) => "ok",
+    }
+}
+
+/// The lines under a case's row: why the plugin refused it (and nothing
+/// more), why a test could not decide, `statistic` (the suite's own line
+/// for a failed statistical test), and every problem.
+pub fn write_notes(out: &mut String, case: &impl Outcome, statistic: Option<String>) {
+    if let Some(why) = case.refused() {
+        let _ = writeln!(
+            out,
+            "    not tested: the plugin refuses these parameters: {why}"
+        );
+        return;
+    }
+    if let Some(why) = case.not_testable() {
+        let _ = writeln!(out, "    not testable: {why}");
+    }
+    for line in statistic.iter().chain(case.problems()) {
+        let _ = writeln!(out, "    {line}");
     }
 }
 

@@ -26,7 +26,7 @@ use lumis_sampling::hash_u64;
 use rayon::prelude::*;
 
 use crate::corrected_significance;
-use crate::outcome::{add_faults, summary, unmade, verdict, Outcome};
+use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::{declared, parameter_sweep_with, variant, Variant};
 use crate::uniformity::uniformity_2d;
 
@@ -100,6 +100,9 @@ impl Outcome for SamplerCaseResult {
     }
     fn not_testable(&self) -> Option<&str> {
         self.not_testable.as_deref()
+    }
+    fn problems(&self) -> &[String] {
+        &self.problems
     }
 }
 
@@ -379,19 +382,7 @@ pub fn format_sampler_results(results: &[SamplerCaseResult]) -> String {
             r.p_value,
             verdict(r)
         );
-        if let Some(why) = &r.refused {
-            let _ = writeln!(
-                out,
-                "    not tested: the plugin refuses these parameters: {why}"
-            );
-            continue;
-        }
-        if let Some(why) = &r.not_testable {
-            let _ = writeln!(out, "    not testable: {why}");
-        }
-        for p in &r.problems {
-            let _ = writeln!(out, "    {p}");
-        }
+        write_notes(&mut out, r, None);
     }
     let _ = writeln!(out, "{}", summary(results));
     out

@@ -18,7 +18,7 @@
 //! neither is "not testable". The suite renders scenes, so it lives with
 //! the renderer rather than in the dependency-light lumis-check.
 
-use lumis_check::outcome::{self, add_faults, summary, unmade, verdict, Outcome as _};
+use lumis_check::outcome::{self, add_faults, summary, unmade, verdict, write_notes, Outcome as _};
 use std::fmt::Write;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
@@ -132,6 +132,9 @@ impl outcome::Outcome for IntegratorCaseResult {
     }
     fn not_testable(&self) -> Option<&str> {
         self.not_testable.as_deref()
+    }
+    fn problems(&self) -> &[String] {
+        &self.problems
     }
 }
 
@@ -571,27 +574,13 @@ pub fn format_integrator_results(results: &[IntegratorCaseResult]) -> String {
             r.p_value,
             verdict(r)
         );
-        if let Some(why) = &r.refused {
-            let _ = writeln!(
-                out,
-                "    not tested: the plugin refuses these parameters: {why}"
-            );
-            continue;
-        }
-        if let Some(why) = &r.not_testable {
-            let _ = writeln!(out, "    not testable: {why}");
-            continue;
-        }
-        if r.problems.is_empty() && !r.passed() {
-            let _ = writeln!(
-                out,
-                "    z-test: |z| = {:.2}, p-value below {:.3e}",
+        let statistic = (r.problems.is_empty() && !r.passed()).then(|| {
+            format!(
+                "z-test: |z| = {:.2}, p-value below {:.3e}",
                 r.z, r.significance
-            );
-        }
-        for p in &r.problems {
-            let _ = writeln!(out, "    {p}");
-        }
+            )
+        });
+        write_notes(&mut out, r, statistic);
     }
     let _ = writeln!(out, "{}", summary(results));
     out
