@@ -54,6 +54,9 @@ pub struct Material {
     /// `KHR_texture_transform` of the base colour texture: offset,
     /// rotation (radians), scale.
     pub base_color_transform: Option<([f32; 2], f32, [f32; 2])>,
+    /// Index into [`Asset::images`] of a tangent-space normal map, with
+    /// its `scale`.
+    pub normal_texture: Option<(usize, f32)>,
 }
 
 impl Material {
@@ -70,6 +73,7 @@ impl Material {
             emissive_texture: None,
             metallic_roughness_texture: None,
             base_color_transform: None,
+            normal_texture: None,
         }
     }
 }
@@ -246,8 +250,11 @@ pub fn encode(asset: &Asset, uri: Option<&str>) -> (String, Vec<u8>) {
             let emissive_texture = m
                 .emissive_texture
                 .map_or(String::new(), |t| format!(",\"emissiveTexture\":{{\"index\":{t}}}"));
+            let normal_texture = m.normal_texture.map_or(String::new(), |(t, scale)| {
+                format!(",\"normalTexture\":{{\"index\":{t},\"scale\":{scale:?}}}")
+            });
             format!(
-                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}{metallic_roughness}}},\"emissiveFactor\":[{}],\"doubleSided\":{}{emissive_texture}}}",
+                "{{\"name\":\"{}\",\"pbrMetallicRoughness\":{{\"baseColorFactor\":[{}],\"metallicFactor\":{:?},\"roughnessFactor\":{:?}{texture}{metallic_roughness}}},\"emissiveFactor\":[{}],\"doubleSided\":{}{emissive_texture}{normal_texture}}}",
                 m.name,
                 floats(&m.base_color),
                 m.metallic,

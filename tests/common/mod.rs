@@ -322,6 +322,18 @@ pub fn region_error(
     (full, var.sqrt())
 }
 
+/// The green channel of the BSDF at `hit` seen from world direction `wo`
+/// and lit from world direction `wi` (both unit), in the hit's own shading
+/// frame and texture lookup: where a normal map's lean shows.
+pub fn f_at_hit(hit: &SurfaceInteraction, wo: lumis_core::Vec3, wi: lumis_core::Vec3) -> f32 {
+    let ctx = lumis_core::BsdfContext {
+        texture: hit.texture,
+        ..lumis_core::BsdfContext::default()
+    };
+    let (wo, wi) = (hit.shading.to_local(wo), hit.shading.to_local(wi));
+    hit.bsdf.f(&ctx, wo, wi).g
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -135,6 +135,15 @@ pub trait Bsdf: Send + Sync {
         (self.f(ctx, wo, wi), self.pdf(ctx, wo, wi))
     }
 
+    /// Whether the model reads directions against the surface's texture
+    /// tangents (an anisotropic lobe, a normal map). Its hits then get the
+    /// frame of [`crate::Frame::from_tangents`], `x` along `dp/du` and `y`
+    /// toward the image's up, which costs a little per hit; otherwise the
+    /// frame turns about the normal arbitrarily.
+    fn uses_tangent_frame(&self) -> bool {
+        false
+    }
+
     /// [`Bsdf::sample_f`] for each lane `i` of a batch: `out[i]` is
     /// `sample_f(&ctx[i], wo[i], u1[i], u2[i])`. The wavefront integrator
     /// calls it once per material and wave. The default loops over

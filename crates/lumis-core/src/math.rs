@@ -31,6 +31,31 @@ impl Frame {
         Self { x, y, z: n.into() }
     }
 
+    /// The frame of a textured surface with unit normal `n`: `x` along the
+    /// tangent part of `dp/du`, `y` toward the image's up (`-dp/dv`: uv
+    /// (0, 0) is an image's top-left corner), as tangent-space normal maps
+    /// mean them (glTF 2.0, 3.9.3; MikkTSpace's sign per triangle). Where
+    /// the texture is mirrored the frame is left-handed, which reflection
+    /// models symmetric under `y -> -y` (isotropic and anisotropic
+    /// microfacet lobes alike) do not see. Degenerate tangents give
+    /// [`Frame::from_z`].
+    #[inline]
+    pub fn from_tangents(n: Vec3, dpdu: Vec3, dpdv: Vec3) -> Self {
+        let t = dpdu - n * n.dot(dpdu);
+        let length_sq = t.length_squared();
+        if !(length_sq > 1e-24 && length_sq.is_finite()) {
+            return Self::from_z(n);
+        }
+        let x = t / length_sq.sqrt();
+        let y = n.cross(x);
+        let y = if y.dot(dpdv) > 0.0 { -y } else { y };
+        Self {
+            x: x.into(),
+            y: y.into(),
+            z: n.into(),
+        }
+    }
+
     /// The normal, `z`.
     #[inline]
     pub fn normal(&self) -> Vec3 {
@@ -90,6 +115,27 @@ pub fn safe_sqrt(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tangent_frames_follow_u_and_the_images_up() {
+        let n = Vec3::new(0.2, 0.1, 1.0).normalize();
+        // u to the right (+x), v down the image (-y): a right-handed frame.
+        let f = Frame::from_tangents(n, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, -3.0, 0.0));
+        assert!(f.x.dot(Vec3A::X) > 0.9 && f.y.dot(Vec3A::Y) > 0.9);
+        assert!((f.x.cross(f.y) - f.z).length() < 1e-5);
+        assert!(f.x.dot(f.z).abs() < 1e-6 && (f.x.length() - 1.0).abs() < 1e-6);
+        // Mirrored in u: x follows u to the left, y stays the image's up.
+        let m = Frame::from_tangents(n, Vec3::new(-2.0, 0.0, 0.0), Vec3::new(0.0, -3.0, 0.0));
+        assert!(m.x.dot(Vec3A::X) < -0.9 && m.y.dot(Vec3A::Y) > 0.9);
+        assert!((m.x.cross(m.y) + m.z).length() < 1e-5, "left-handed");
+        let v = Vec3::new(0.1, 0.7, -0.2);
+        assert!((m.to_world(m.to_local(v)) - v).length() < 1e-6);
+        // A tangent along the normal has no direction in the plane.
+        assert_eq!(
+            Frame::from_tangents(Vec3::Z, Vec3::Z, Vec3::Y),
+            Frame::from_z(Vec3::Z)
+        );
+    }
 
     #[test]
     fn frame_is_orthonormal_for_all_hemispheres() {

@@ -123,6 +123,7 @@ pub fn load_str(
                 .camera
                 .pixel_footprint(plugins.sampler.samples_per_pixel())
         }),
+        tangent_frames: assembled.tangent_frames,
     };
     Ok(LoadedScene {
         name: name.to_string(),

@@ -6,7 +6,7 @@ use lumis_core::glam::{Mat3, Vec3A, Vec4};
 use lumis_core::math::{gamma, Frame};
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Bsdf, BsdfFlags, Light, LightIndex, LightSampler, PixelFootprint, Ray, Scene,
+    Bsdf, BsdfFlags, Light, LightIndex, LightSampler, LightShape, PixelFootprint, Ray, Scene,
     SurfaceInteraction, TextureQuery, Vec2, Vec3,
 };
 use lumis_embree::{Hit, PacketWidth, Packets, PaddedBuffer, Triangle, Vertex, INVALID_ID};
@@ -189,6 +189,10 @@ pub struct RenderScene {
     /// The camera's pixel footprint, which gives hits on surfaces with
     /// texture coordinates the uv footprint their textures filter over.
     pub(crate) footprint: Option<PixelFootprint>,
+    /// Whether hits build their shading frames from `dp/du` and `dp/dv`
+    /// ([`Frame::from_tangents`]), which a BSDF of the scene reads
+    /// ([`lumis_core::Bsdf::uses_tangent_frame`]).
+    pub(crate) tangent_frames: bool,
 }
 
 impl RenderScene {
@@ -247,6 +251,18 @@ impl RenderScene {
         match &self.footprint {
             Some(footprint) => footprint.query(uv, point.p, point.n, dp_duv.0, dp_duv.1),
             None => TextureQuery::at(uv),
+        }
+    }
+
+    /// `shading` turned about its normal to follow the texture tangents
+    /// `dp_duv`, in a scene whose BSDFs read them.
+    #[inline]
+    fn shading_frame(&self, shading: Frame, dp_duv: Option<(Vec3, Vec3)>) -> Frame {
+        match dp_duv {
+            Some((dpdu, dpdv)) if self.tangent_frames => {
+                Frame::from_tangents(shading.normal(), dpdu, dpdv)
+            }
+            _ => shading,
         }
     }
 
@@ -375,7 +391,7 @@ impl RenderScene {
 
     /// A hit inside an instance: shaded in object space, then placed.
     #[inline]
-    fn instance_hit<const FOOTPRINT: bool>(&self, hit: &Hit) -> SurfaceInteraction<'_> {
+    fn instance_hit<const DIFFERENTIALS: bool>(&self, hit: &Hit) -> SurfaceInteraction<'_> {
         let Geometry::Instance {
             prototype,
             placement,
@@ -385,7 +401,7 @@ impl RenderScene {
             unreachable!("inst_id names an instance geometry")
         };
         let mesh = &self.prototypes[*prototype as usize].meshes[hit.geom_id as usize];
-        let (local, local_shading, uv, dp_duv) = mesh_hit(mesh, hit, FOOTPRINT);
+        let (local, local_shading, uv, dp_duv) = mesh_hit(mesh, hit, DIFFERENTIALS);
         let (p, p_error) = placement.point(local.p, local.p_error);
         let n = placement.normal(local.n);
         let ns = placement.normal(local_shading.normal());
@@ -395,13 +411,14 @@ impl RenderScene {
             .and_then(|l| l.get(hit.prim_id as usize))
             .and_then(|&i| LightIndex::new(i));
         let point = SurfacePoint { p, p_error, n };
-        let texture = match dp_duv {
-            Some((u, v)) if FOOTPRINT => {
-                self.texture_query(uv, &point, (placement.linear * u, placement.linear * v))
-            }
-            _ => TextureQuery::at(uv),
-        };
-        self.interaction(point, Frame::from_z(ns), texture, mesh.bsdf, light)
+        let shading = Frame::from_z(ns);
+        if !DIFFERENTIALS {
+            return self.interaction(point, shading, TextureQuery::at(uv), mesh.bsdf, light);
+        }
+        let dp_duv = dp_duv.map(|(u, v)| (placement.linear * u, placement.linear * v));
+        let texture = dp_duv.map_or(TextureQuery::at(uv), |d| self.texture_query(uv, &point, d));
+        let shading = self.shading_frame(shading, dp_duv);
+        self.interaction(point, shading, texture, mesh.bsdf, light)
     }
 }
 
@@ -469,9 +486,9 @@ fn mesh_hit(mesh: &MeshData, hit: &Hit, dp_duv: bool) -> MeshHit {
 }
 
 /// The uv at barycentrics `b` of triangle `tri` (vertices `p`):
-/// interpolated texture coordinates, else the barycentrics themselves;
-/// with `dp_duv`, also the triangle's `dp/du` and `dp/dv` where its uvs
-/// are not degenerate.
+/// interpolated texture coordinates, else the barycentrics `(b1, b2)`
+/// themselves; with `dp_duv`, also the triangle's `dp/du` and `dp/dv`
+/// where its uvs are not degenerate.
 #[inline(always)]
 fn mesh_uv(
     mesh: &MeshData,
@@ -480,57 +497,67 @@ fn mesh_uv(
     p: [Vec3A; 3],
     dp_duv: bool,
 ) -> (Vec2, Option<(Vec3, Vec3)>) {
-    match &mesh.uvs {
+    let (uv, t) = match &mesh.uvs {
         Some(uvs) => {
             let t = tri.map(|i| uvs[i as usize]);
-            let derivatives = if dp_duv {
-                lumis_core::footprint::triangle_dp_duv(p.map(Vec3::from), t)
-            } else {
-                None
-            };
-            (t[0] * b0 + t[1] * b1 + t[2] * b2, derivatives)
+            (t[0] * b0 + t[1] * b1 + t[2] * b2, t)
         }
-        None => (Vec2::new(b1, b2), None),
-    }
+        None => (Vec2::new(b1, b2), LightShape::BARYCENTRIC_UVS),
+    };
+    let derivatives = if dp_duv {
+        lumis_core::footprint::triangle_dp_duv(p.map(Vec3::from), t)
+    } else {
+        None
+    };
+    (uv, derivatives)
 }
 
 impl RenderScene {
-    /// The interaction where `ray` found `hit`, in a scene with a pixel
-    /// footprint or without one. Two copies of the hit code, chosen by one
-    /// branch per hit: a scene without textures runs one that has no
-    /// footprint work in it at all (measured: checked per hit, the
+    /// The interaction where `ray` found `hit`, in a scene whose hits need
+    /// the surface's uv derivatives (for a pixel footprint or tangent
+    /// frames) or not. Two copies of the hit code, chosen by one branch per
+    /// hit: a scene without filtered textures or tangent frames runs one
+    /// that has no such work in it at all (measured: checked per hit, the
     /// footprint cost the Cornell box 3% of its time).
     #[inline(always)]
     fn interaction_at(&self, ray: &Ray, hit: &Hit) -> SurfaceInteraction<'_> {
-        if self.footprint.is_some() {
+        if self.footprint.is_some() || self.tangent_frames {
             self.interaction_with::<true>(ray, hit)
         } else {
             self.interaction_with::<false>(ray, hit)
         }
     }
 
-    /// [`Self::interaction_at`], with `FOOTPRINT` saying whether the scene
-    /// has a pixel footprint.
+    /// [`Self::interaction_at`], with `DIFFERENTIALS` saying whether hits
+    /// need `dp/du` and `dp/dv` (for a pixel footprint or tangent frames).
     #[inline(always)]
-    fn interaction_with<const FOOTPRINT: bool>(
+    fn interaction_with<const DIFFERENTIALS: bool>(
         &self,
         ray: &Ray,
         hit: &Hit,
     ) -> SurfaceInteraction<'_> {
         if hit.inst_id != INVALID_ID {
-            return self.instance_hit::<FOOTPRINT>(hit);
+            return self.instance_hit::<DIFFERENTIALS>(hit);
         }
         match &self.geometries[hit.geom_id as usize] {
             Geometry::Mesh(mesh) => {
-                let (point, shading, uv, dp_duv) = mesh_hit(mesh, hit, FOOTPRINT);
+                let (point, shading, uv, dp_duv) = mesh_hit(mesh, hit, DIFFERENTIALS);
                 let light = mesh
                     .lights
                     .get(hit.prim_id as usize)
                     .and_then(|&i| LightIndex::new(i));
-                let texture = match dp_duv {
-                    Some(dp_duv) if FOOTPRINT => self.texture_query(uv, &point, dp_duv),
-                    _ => TextureQuery::at(uv),
-                };
+                if !DIFFERENTIALS {
+                    return self.interaction(
+                        point,
+                        shading,
+                        TextureQuery::at(uv),
+                        mesh.bsdf,
+                        light,
+                    );
+                }
+                let texture =
+                    dp_duv.map_or(TextureQuery::at(uv), |d| self.texture_query(uv, &point, d));
+                let shading = self.shading_frame(shading, dp_duv);
                 self.interaction(point, shading, texture, mesh.bsdf, light)
             }
             Geometry::Instance { .. } => unreachable!("instances report an inst_id"),
@@ -555,18 +582,15 @@ impl RenderScene {
                     outward.z.clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI,
                 );
                 let point = SurfacePoint { p, p_error, n };
-                let texture = if FOOTPRINT {
-                    self.texture_query(uv, &point, sphere_dp_duv(local, phi))
-                } else {
-                    TextureQuery::at(uv)
-                };
-                self.interaction(
-                    point,
-                    Frame::from_z(n),
-                    texture,
-                    *bsdf,
-                    light.and_then(LightIndex::new),
-                )
+                let light = light.and_then(LightIndex::new);
+                if !DIFFERENTIALS {
+                    let texture = TextureQuery::at(uv);
+                    return self.interaction(point, Frame::from_z(n), texture, *bsdf, light);
+                }
+                let dp_duv = sphere_dp_duv(local, phi);
+                let texture = self.texture_query(uv, &point, dp_duv);
+                let shading = self.shading_frame(Frame::from_z(n), Some(dp_duv));
+                self.interaction(point, shading, texture, *bsdf, light)
             }
         }
     }
@@ -848,6 +872,7 @@ mod tests {
             report: LoadReport::default(),
             packets,
             footprint: None,
+            tangent_frames: false,
         }
     }
 

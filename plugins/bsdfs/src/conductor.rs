@@ -11,7 +11,7 @@
 
 use lumis_core::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
-    Rgb, TexturedRgb, Vec2, Vec3,
+    Rgb, TextureQuery, TexturedRgb, Vec2, Vec3,
 };
 
 use lumis_sampling::real::{load, F32x8, Real, V3};
@@ -93,11 +93,52 @@ impl ConductorFresnel {
     }
 }
 
+/// A metal's Fresnel term: the same everywhere, or from `eta` and `k`
+/// textures at each hit (pbrt-v4's `ConductorMaterial` reads its
+/// spectrum textures per hit the same way).
+#[derive(Debug, Clone)]
+pub enum MetalFresnel {
+    Fixed(ConductorFresnel),
+    Textured { eta: TexturedRgb, k: TexturedRgb },
+}
+
+impl From<ConductorFresnel> for MetalFresnel {
+    fn from(fresnel: ConductorFresnel) -> Self {
+        Self::Fixed(fresnel)
+    }
+}
+
+impl MetalFresnel {
+    /// The Fresnel term at the hit `query` looks up.
+    #[inline]
+    pub fn at(&self, query: &TextureQuery) -> ConductorFresnel {
+        match self {
+            Self::Fixed(fresnel) => *fresnel,
+            // A texel out of the physical range (eta <= 0, k < 0) is held
+            // at its edge, as the constants are checked to be.
+            Self::Textured { eta, k } => ConductorFresnel::Complex {
+                eta: eta.eval(query).map(|c| c.max(1e-3)),
+                k: k.eval(query).map(|c| c.max(0.0)),
+            },
+        }
+    }
+
+    /// The Fresnel term if it is the same everywhere: what the batched
+    /// methods work on lanes with.
+    #[inline]
+    pub fn fixed(&self) -> Option<ConductorFresnel> {
+        match self {
+            Self::Fixed(fresnel) => Some(*fresnel),
+            Self::Textured { .. } => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Conductor {
     /// Its lobe, fixed or textured; a fixed delta is a mirror.
     roughness: Roughness,
-    fresnel: ConductorFresnel,
+    fresnel: MetalFresnel,
     scale: Rgb,
     /// A textured `specular_reflectance`, which multiplies every value.
     tint: Option<TexturedRgb>,
@@ -107,13 +148,13 @@ pub struct Conductor {
 impl Conductor {
     /// A rough conductor; a delta mirror if `microfacet` is smooth.
     pub fn new(microfacet: Microfacet, fresnel: ConductorFresnel, sampling: LobeSampling) -> Self {
-        Self::with_roughness(microfacet.into(), fresnel, sampling)
+        Self::with_roughness(microfacet.into(), fresnel.into(), sampling)
     }
 
     /// A conductor of fixed or textured `roughness`.
     pub fn with_roughness(
         roughness: Roughness,
-        fresnel: ConductorFresnel,
+        fresnel: MetalFresnel,
         sampling: LobeSampling,
     ) -> Self {
         Self {
@@ -128,10 +169,10 @@ impl Conductor {
         }
     }
 
-    pub fn mirror(fresnel: ConductorFresnel) -> Self {
+    pub fn mirror(fresnel: impl Into<MetalFresnel>) -> Self {
         Self {
             roughness: Roughness::Fixed(None),
-            fresnel,
+            fresnel: fresnel.into(),
             scale: Rgb::WHITE,
             tint: None,
             sampling: LobeSampling::Cosine,
@@ -165,7 +206,7 @@ impl Conductor {
         let Some(mf) = &self.roughness.at(&ctx.texture) else {
             let wi = Vec3::new(-wo.x, -wo.y, wo.z);
             return Some(BsdfSample {
-                f: self.scale * self.fresnel.eval(wo.z) / wo.z,
+                f: self.scale * self.fresnel.at(&ctx.texture).eval(wo.z) / wo.z,
                 wi,
                 pdf: 1.0,
                 flags: BsdfFlags::SPECULAR | BsdfFlags::REFLECTION,
@@ -184,7 +225,7 @@ impl Conductor {
             baseline => baseline.sample_baseline(u2)?,
         };
         let lobe = LobeTerms::at(mf, wo, wi)?;
-        let (f, pdf) = self.rough_eval(mf, &lobe, wi);
+        let (f, pdf) = self.rough_eval(mf, self.fresnel.at(&ctx.texture), &lobe, wi);
         BsdfSample::reflection(
             wi,
             BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
@@ -241,14 +282,21 @@ impl Conductor {
         }
     }
 
-    /// `(f, pdf)` of the rough lobe at one pair above the surface.
+    /// `(f, pdf)` of the rough lobe of Fresnel term `fresnel` at one pair
+    /// above the surface.
     #[inline]
-    fn rough_eval(&self, mf: &Microfacet, lobe: &LobeTerms<f32>, wi: Vec3) -> (Rgb, f32) {
+    fn rough_eval(
+        &self,
+        mf: &Microfacet,
+        fresnel: ConductorFresnel,
+        lobe: &LobeTerms<f32>,
+        wi: Vec3,
+    ) -> (Rgb, f32) {
         let f = self.rough_f(
             lobe,
             wi.z,
             || mf.lambda(wi),
-            || self.fresnel.eval(lobe.wo_m).to_array(),
+            || fresnel.eval(lobe.wo_m).to_array(),
         );
         (f.into(), self.rough_pdf(mf, lobe, wi.z))
     }
@@ -259,7 +307,13 @@ impl Conductor {
     /// SIMD lanes, each lane the bits [`Bsdf::eval`] gives; zero where
     /// there is no lobe.
     #[inline(always)]
-    fn eval_lanes<L: Real>(&self, mf: &Microfacet, wo: &[Vec3], wi: &[Vec3]) -> ([L; 3], L) {
+    fn eval_lanes<L: Real>(
+        &self,
+        mf: &Microfacet,
+        fresnel: ConductorFresnel,
+        wo: &[Vec3],
+        wi: &[Vec3],
+    ) -> ([L; 3], L) {
         let zero = L::splat(0.0);
         let (m, wo_m, mut bits) = half_vector_lanes::<L>(wo, wi);
         for i in 0..wo.len() {
@@ -291,7 +345,7 @@ impl Conductor {
             &terms,
             wi.z,
             || mf.lambda_lanes([wi.x, wi.y, wi.z]),
-            || self.fresnel.eval_lanes(wo_m),
+            || fresnel.eval_lanes(wo_m),
         );
         let pdf = L::select(lobe, self.rough_pdf(mf, &terms, wi.z), zero);
         (f, pdf)
@@ -342,13 +396,17 @@ impl Bsdf for Conductor {
         }
     }
 
+    fn uses_tangent_frame(&self) -> bool {
+        self.roughness.is_anisotropic()
+    }
+
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         let Some(mf) = &self.roughness.at(&ctx.texture) else {
             return Rgb::BLACK;
         };
         LobeTerms::at(mf, wo, wi).map_or(Rgb::BLACK, |lobe| {
-            let fresnel = || self.fresnel.eval(lobe.wo_m).to_array();
+            let fresnel = || self.fresnel.at(&ctx.texture).eval(lobe.wo_m).to_array();
             self.tinted(
                 ctx,
                 self.rough_f(&lobe, wi.z, || mf.lambda(wi), fresnel).into(),
@@ -376,7 +434,7 @@ impl Bsdf for Conductor {
             return (Rgb::BLACK, 0.0);
         };
         LobeTerms::at(mf, wo, wi).map_or((Rgb::BLACK, 0.0), |lobe| {
-            let (f, pdf) = self.rough_eval(mf, &lobe, wi);
+            let (f, pdf) = self.rough_eval(mf, self.fresnel.at(&ctx.texture), &lobe, wi);
             (self.tinted(ctx, f), pdf)
         })
     }
@@ -388,7 +446,9 @@ impl Bsdf for Conductor {
             out.fill((Rgb::BLACK, 0.0));
             return;
         }
-        let (Some(mf), None) = (self.roughness.fixed(), &self.tint) else {
+        let (Some(mf), Some(fresnel), None) =
+            (self.roughness.fixed(), self.fresnel.fixed(), &self.tint)
+        else {
             for (i, out) in out.iter_mut().enumerate() {
                 *out = self.eval(&ctx[i], wo[i], wi[i]);
             }
@@ -400,7 +460,7 @@ impl Bsdf for Conductor {
             .zip(wi.chunks(width))
             .zip(out.chunks_mut(width))
         {
-            let (f, pdf) = self.eval_lanes::<Lanes>(mf, wo, wi);
+            let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, wi);
             let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
             for (i, out) in out.iter_mut().enumerate() {
                 *out = (Rgb::new(f[0][i], f[1][i], f[2][i]), pdf[i]);
@@ -422,11 +482,11 @@ impl Bsdf for Conductor {
         u2: &[Vec2],
         out: &mut [Option<BsdfSample>],
     ) {
-        let mf = match (self.roughness.fixed(), self.sampling) {
-            (Some(mf), LobeSampling::Model(_))
+        let (mf, fresnel) = match (self.roughness.fixed(), self.fresnel.fixed(), self.sampling) {
+            (Some(mf), Some(fresnel), LobeSampling::Model(_))
                 if mf.sampling == NormalSampling::Visible && self.tint.is_none() =>
             {
-                mf
+                (mf, fresnel)
             }
             _ => {
                 for (i, out) in out.iter_mut().enumerate() {
@@ -461,7 +521,7 @@ impl Bsdf for Conductor {
                     *wi = fresnel::reflect(wo[i], m);
                 }
             }
-            let (f, pdf) = self.eval_lanes::<Lanes>(mf, wo, &wi[..n]);
+            let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, &wi[..n]);
             let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
             for (i, out) in out.iter_mut().enumerate() {
                 *out = BsdfSample::reflection(
@@ -487,6 +547,51 @@ mod tests {
         fn eval(&self, q: &lumis_core::TextureQuery) -> Rgb {
             self.0 * (1.0 + q.uv.x)
         }
+    }
+
+    /// Textured `eta` and `k` give at each hit the conductor of that
+    /// hit's values, the batched methods included.
+    #[test]
+    fn a_textured_ior_is_the_metal_of_each_texel() {
+        let mf = Microfacet::new(Distribution::Ggx, 0.3, 0.3);
+        let sampling: LobeSampling = MicrofacetLobeSampling::Visible.into();
+        let (eta, k) = (Rgb::new(0.2, 0.9, 1.1), Rgb::new(3.9, 2.4, 1.9));
+        let ramp = |c: Rgb| lumis_core::params::Textured::Texture(std::sync::Arc::new(UvRamp(c)));
+        let fresnel = MetalFresnel::Textured {
+            eta: ramp(eta),
+            k: ramp(k),
+        };
+        let textured = Conductor::with_roughness(mf.into(), fresnel, sampling);
+        let (wo, wi) = (
+            Vec3::new(0.3, 0.1, 0.95).normalize(),
+            Vec3::new(-0.4, 0.2, 0.9).normalize(),
+        );
+        let ctx: Vec<BsdfContext> = [0.0f32, 0.5, 1.0]
+            .iter()
+            .map(|&u| BsdfContext {
+                texture: TextureQuery::at(Vec2::new(u, 0.0)),
+                ..BsdfContext::default()
+            })
+            .collect();
+        let mut batch = vec![(Rgb::BLACK, 0.0); ctx.len()];
+        textured.eval_batch(&ctx, &[wo; 3], &[wi; 3], &mut batch);
+        for (ctx, batch) in ctx.iter().zip(batch) {
+            let s = 1.0 + ctx.texture.uv.x;
+            let texel = ConductorFresnel::Complex {
+                eta: eta * s,
+                k: k * s,
+            };
+            let plain = Conductor::new(mf, texel, sampling);
+            let at = BsdfContext::default();
+            assert_eq!(textured.eval(ctx, wo, wi), plain.eval(&at, wo, wi));
+            assert_eq!(batch, plain.eval(&at, wo, wi));
+            let u2 = Vec2::new(0.3, 0.6);
+            assert_eq!(
+                textured.sample_f(ctx, wo, 0.5, u2),
+                plain.sample_f(&at, wo, 0.5, u2)
+            );
+        }
+        assert!(textured.eval(&ctx[0], wo, wi).0 != textured.eval(&ctx[2], wo, wi).0);
     }
 
     #[test]

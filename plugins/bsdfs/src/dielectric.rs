@@ -253,6 +253,10 @@ impl Bsdf for Dielectric {
         }
     }
 
+    fn uses_tangent_frame(&self) -> bool {
+        self.roughness.is_anisotropic()
+    }
+
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         match &self.roughness.at(&ctx.texture) {

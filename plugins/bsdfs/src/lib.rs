@@ -1,6 +1,6 @@
 //! Standard BSDFs: diffuse, Blinn, rough conductor and mirror, smooth and
-//! rough dielectric, plastic; the `twosided` adapter; with the microfacet
-//! and Fresnel machinery they share.
+//! rough dielectric, plastic; the `twosided` and `normalmap` adapters;
+//! with the microfacet and Fresnel machinery they share.
 
 mod blinn;
 mod conductor;
@@ -10,15 +10,17 @@ pub mod fresnel;
 mod lobe_sampling;
 mod metal_params;
 pub mod microfacet;
+mod normalmap;
 mod plastic;
 mod twosided;
 
 pub use blinn::{Blinn, BlinnParams, BlinnSampling};
-pub use conductor::{Conductor, ConductorFresnel, ConductorParams};
+pub use conductor::{Conductor, ConductorFresnel, ConductorParams, MetalFresnel};
 pub use dielectric::{Dielectric, DielectricParams};
 pub use diffuse::{Diffuse, DiffuseParams, DiffuseSampling};
 pub use lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
 pub use metal_params::{MetalName, MetalParams};
+pub use normalmap::{NormalMap, NormalMapParams};
 pub use plastic::{Plastic, PlasticParams};
 pub use twosided::{TwoSided, TwoSidedParams};
 
@@ -40,5 +42,8 @@ pub fn register(registry: &mut Registry) -> Result<()> {
         Ok(Arc::new(Dielectric::from_params(p)?))
     })?;
     registry.add_bsdf(plastic::SPEC, |p| Ok(Arc::new(Plastic::from_params(p)?)))?;
-    registry.add_bsdf(twosided::SPEC, |p| Ok(Arc::new(TwoSided::from_params(p)?)))
+    registry.add_bsdf(twosided::SPEC, |p| Ok(Arc::new(TwoSided::from_params(p)?)))?;
+    registry.add_bsdf(normalmap::SPEC, |p| {
+        Ok(Arc::new(NormalMap::from_params(p)?))
+    })
 }

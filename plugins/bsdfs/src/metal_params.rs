@@ -4,7 +4,7 @@
 use lumis_core::params::Textured;
 use lumis_core::{ParamChoice, Params, PluginParams, Result, Rgb, TexturedRgb};
 
-use crate::conductor::ConductorFresnel;
+use crate::conductor::{ConductorFresnel, MetalFresnel};
 use crate::fresnel;
 
 /// The `material` choice: a metal of [`fresnel::METALS`], or none.
@@ -34,10 +34,12 @@ pub struct MetalParams {
     /// reflector, Fresnel = 1
     #[param(default = None)]
     pub material: MetalName,
-    /// real part of the IOR per channel, with k; replaces material
-    pub eta: Option<Rgb>,
-    /// imaginary part (absorption) of the IOR per channel, with eta
-    pub k: Option<Rgb>,
+    /// real part of the IOR per channel, with k, or a texture; replaces
+    /// material
+    pub eta: Option<TexturedRgb>,
+    /// imaginary part (absorption) of the IOR per channel, with eta, or a
+    /// texture
+    pub k: Option<TexturedRgb>,
     /// multiplies the Fresnel term (not physical; for artistic tints), each
     /// channel in [0, 1], or a texture
     #[param(default = 1.0)]
@@ -45,11 +47,12 @@ pub struct MetalParams {
 }
 
 impl MetalParams {
-    /// The metal's Fresnel term: named, or given as `eta` and `k`.
-    pub fn fresnel(&self, params: &Params) -> Result<ConductorFresnel> {
+    /// The metal's Fresnel term: named, or given as `eta` and `k`
+    /// (constants or textures).
+    pub fn fresnel(&self, params: &Params) -> Result<MetalFresnel> {
         let keys = Self::KEYS;
-        match (self.eta, self.k) {
-            (None, None) => Ok(match self.material {
+        match (&self.eta, &self.k) {
+            (None, None) => Ok(MetalFresnel::Fixed(match self.material {
                 MetalName::None => ConductorFresnel::Perfect,
                 named => {
                     let metal = fresnel::metal(named.name())
@@ -59,20 +62,26 @@ impl MetalParams {
                         k: metal.k.into(),
                     }
                 }
-            }),
+            })),
             (Some(eta), Some(k)) => {
                 if params.is_given(keys.material) {
                     return Err(
                         params.error(keys.material, "give either material or eta and k, not both")
                     );
                 }
+                let (Some(eta), Some(k)) = (eta.constant(), k.constant()) else {
+                    return Ok(MetalFresnel::Textured {
+                        eta: eta.clone(),
+                        k: k.clone(),
+                    });
+                };
                 if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
                     return Err(params.error(
                         keys.eta,
                         format!("eta must be > 0 and k >= 0 per channel, got eta {eta:?}, k {k:?}"),
                     ));
                 }
-                Ok(ConductorFresnel::Complex { eta, k })
+                Ok(MetalFresnel::Fixed(ConductorFresnel::Complex { eta, k }))
             }
             (Some(_), None) => Err(params.error(keys.eta, "needs k too (the absorption)")),
             (None, Some(_)) => Err(params.error(keys.k, "needs eta too (the real part)")),

@@ -10,7 +10,9 @@
 
 use std::f32::consts::PI;
 use std::ops::{Add, Div, Mul};
+use std::sync::Arc;
 
+use lumis_core::params::Textured;
 use lumis_core::{ParamChoice, PluginParams, TextureQuery, TexturedFloat, Vec2, Vec3};
 use lumis_sampling::real::{Real, V3};
 use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
@@ -129,6 +131,22 @@ impl Roughness {
         match self {
             Roughness::Fixed(mf) => mf.as_ref(),
             Roughness::Textured { .. } => None,
+        }
+    }
+
+    /// Whether the lobe's width differs between the tangents: it then
+    /// needs a frame whose `x` follows `dp/du` (pbrt-v4 orients `alpha_x`
+    /// the same way).
+    pub fn is_anisotropic(&self) -> bool {
+        match self {
+            Roughness::Fixed(mf) => mf.is_some_and(|mf| mf.alpha_x != mf.alpha_y),
+            Roughness::Textured {
+                alpha_x, alpha_y, ..
+            } => match (alpha_x, alpha_y) {
+                (Textured::Constant(x), Textured::Constant(y)) => x != y,
+                (Textured::Texture(x), Textured::Texture(y)) => !Arc::ptr_eq(x, y),
+                _ => true,
+            },
         }
     }
 

@@ -288,6 +288,10 @@ impl Bsdf for Plastic {
         }
     }
 
+    fn uses_tangent_frame(&self) -> bool {
+        self.coat.is_anisotropic()
+    }
+
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         self.eval_f(&self.base(ctx), wo, wi)

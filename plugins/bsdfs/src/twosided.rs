@@ -69,6 +69,10 @@ impl Bsdf for TwoSided {
         self.inner.flags()
     }
 
+    fn uses_tangent_frame(&self) -> bool {
+        self.inner.uses_tangent_frame()
+    }
+
     #[inline]
     fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
         let (wo, wi) = to_front(wo, wi);

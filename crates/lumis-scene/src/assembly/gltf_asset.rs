@@ -5,18 +5,19 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use lumis_core::doc::Table;
+use lumis_core::doc::{Table, Value};
 use lumis_core::glam::{Mat3, Mat4};
-use lumis_core::texture::Named;
+use lumis_core::texture::{Named, NO_TEXTURES};
 use lumis_core::{
-    Bsdf, BsdfScope, Error, LightShape, Location, PluginEntity, PluginKind, Result, Vec2, Vec3,
+    Bsdf, BsdfScope, Error, LightShape, Location, PluginEntity, PluginKind, Result, Textures, Vec2,
+    Vec3,
 };
 use lumis_embree::{PaddedBuffer, SceneBuilder};
 
 use super::bvh::{PendingInstance, PendingPrototype};
 use super::has_area;
 use super::state::Assembly;
-use crate::gltf::{AssetEmission, GltfImport, ImportedMaterial, MaterialBsdf};
+use crate::gltf::{normal_map_params, AssetEmission, GltfImport, ImportedMaterial, MaterialBsdf};
 use crate::render_scene::{Geometry, MeshData, Placement, NO_LIGHT};
 
 /// What a material became in the scene: its BSDF's index and, if it
@@ -146,8 +147,26 @@ fn place_materials<'m>(
                 asm.footprint |= asset.textures.values().any(|t| t.uses_footprint());
                 let scope = BsdfScope::textures(&asset.textures);
                 let mut bsdf = asm.registry.create::<dyn Bsdf>(&asset.entity, scope)?;
+                if let Some(scale) = asset.normal_scale {
+                    let params = normal_map_params(&asset.entity.location, scale);
+                    bsdf = wrapped(
+                        bsdf,
+                        "normalmap",
+                        params,
+                        &asset.textures,
+                        &asset.entity,
+                        asm,
+                    )?;
+                }
                 if asset.two_sided {
-                    bsdf = two_sided(bsdf, &asset.entity, asm)?;
+                    bsdf = wrapped(
+                        bsdf,
+                        "twosided",
+                        Vec::new(),
+                        &NO_TEXTURES,
+                        &asset.entity,
+                        asm,
+                    )?;
                 }
                 asm.bsdfs.push_unnamed(bsdf)
             }
@@ -158,22 +177,31 @@ fn place_materials<'m>(
     Ok(placed)
 }
 
-/// A `doubleSided` material's BSDF: `inner` in the `twosided` plugin, made
-/// as a scene's `[[bsdf]] type = "twosided"` naming it would be.
-fn two_sided(inner: Arc<dyn Bsdf>, entity: &PluginEntity, asm: &Assembly) -> Result<Arc<dyn Bsdf>> {
-    const INNER: &str = "doubleSided material";
+/// `inner` in the adapter plugin `type_name` (`normalmap` for a
+/// `normalTexture`, `twosided` for `doubleSided`), made as a scene's
+/// `[[bsdf]]` naming it would be, with `params` besides the inner BSDF and
+/// `textures` for them to name.
+fn wrapped(
+    inner: Arc<dyn Bsdf>,
+    type_name: &str,
+    mut params: Vec<(&str, Value)>,
+    textures: &Textures,
+    entity: &PluginEntity,
+    asm: &Assembly,
+) -> Result<Arc<dyn Bsdf>> {
+    const INNER: &str = "material";
     let mut bsdfs = Named::<dyn Bsdf>::new();
     bsdfs.insert(INNER, inner);
-    let table = Table::built(&entity.location, [("bsdf", INNER.into())]);
+    params.push(("bsdf", INNER.into()));
     let outer = PluginEntity::new(
         PluginKind::Bsdf,
-        format!("{} (doubleSided)", entity.owner),
-        "twosided",
-        table,
+        format!("{} ({type_name})", entity.owner),
+        type_name,
+        Table::built(&entity.location, params),
         entity.location.clone(),
     );
     let scope = BsdfScope {
-        textures: &lumis_core::texture::NO_TEXTURES,
+        textures,
         bsdfs: &bsdfs,
     };
     asm.registry.create::<dyn Bsdf>(&outer, scope)

@@ -37,6 +37,10 @@ pub(crate) struct Assembled {
     pub report: LoadReport,
     /// Whether an imported texture filters over the pixel footprint.
     pub footprint: bool,
+    /// Whether a BSDF reads directions against texture tangents
+    /// ([`Bsdf::uses_tangent_frame`]): hits then build their frames from
+    /// `dp/du`.
+    pub tangent_frames: bool,
 }
 
 /// Adds `shapes` to a new Embree scene, then the lights not attached to
@@ -93,9 +97,12 @@ pub(crate) fn assemble(
     lights.extend(scene_lights);
     report.compaction = accel.compaction;
     report.compact = accel.compaction.decide(counts.unique_triangles);
-    if !report.compact {
+    let bsdfs = bsdfs.into_bsdfs();
+    let tangent_frames = bsdfs.iter().any(|b| b.uses_tangent_frame());
+    if !report.compact && !tangent_frames {
         // Scenes that keep the fast BVH also keep flat meshes' frames; a
-        // compact scene is one whose memory matters more.
+        // compact scene is one whose memory matters more. (Tangent frames
+        // are built per hit, from the uvs.)
         for geometry in &mut geometries {
             if let Geometry::Mesh(mesh) = geometry {
                 mesh.store_flat_frames();
@@ -112,12 +119,13 @@ pub(crate) fn assemble(
         embree,
         geometries,
         prototypes,
-        bsdfs: bsdfs.into_bsdfs(),
+        bsdfs,
         lights,
         infinite_lights,
         counts,
         report,
         footprint,
+        tangent_frames,
     })
 }
 

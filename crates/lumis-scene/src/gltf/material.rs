@@ -20,6 +20,10 @@ pub(crate) const BASE_COLOR: &str = "baseColorTexture";
 /// green channel.
 pub(crate) const ROUGHNESS: &str = "metallicRoughnessTexture";
 
+/// The name under which the `normalmap` adapter finds a material's
+/// `normalTexture` (its linear colours).
+pub(crate) const NORMAL: &str = "normalTexture";
+
 /// Which of a material's parameters its textures give.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Textured {
@@ -43,7 +47,8 @@ const DIELECTRIC_IOR: f32 = 1.5;
 ///   colour is the base's albedo seen through the coat at normal incidence
 ///   (plastic's linear mode), where glTF mixes the two by Schlick's Fresnel.
 ///
-/// `doubleSided` wraps either in the `twosided` BSDF plugin. Where
+/// A `normalTexture` wraps either in the `normalmap` BSDF plugin
+/// ([`normal_map_params`]), and `doubleSided` wraps that in `twosided`. Where
 /// `textured` says so, the conductor's reflectance or the plastic's base is
 /// `{ texture = BASE_COLOR }`, and the roughness `{ texture = ROUGHNESS }`
 /// (the textures carry the factors), which the caller creates the BSDF
@@ -126,6 +131,19 @@ pub(crate) fn bsdf_entity(
         )
     };
     Ok((bsdf, warnings))
+}
+
+/// The parameters of the `normalmap` adapter around a material's BSDF
+/// (named `inner`), besides it: the `normalTexture` as [`NORMAL`] and its
+/// `scale`.
+pub(crate) fn normal_map_params(at: &Location, scale: f32) -> Vec<(&'static str, Value)> {
+    vec![
+        (
+            "normals",
+            Value::Table(Table::built(at, [("texture", NORMAL.into())])),
+        ),
+        ("scale", scale.into()),
+    ]
 }
 
 /// The name under which its emission finds its `emissiveTexture`,

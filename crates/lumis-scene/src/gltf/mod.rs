@@ -30,6 +30,7 @@ use rayon::prelude::*;
 
 use crate::bsdf_ref::BsdfRef;
 pub(crate) use decode::{MissingNormals, Part};
+pub(crate) use material::normal_map_params;
 pub(crate) use resolve::{AssetEmission, ImportedMaterial, MaterialBsdf};
 
 /// What a `[[shape]] type = "gltf"` asks of the importer.

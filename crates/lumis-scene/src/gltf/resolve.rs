@@ -38,8 +38,12 @@ pub(crate) struct AssetBsdf {
     /// `doubleSided`: the BSDF is seen from both sides.
     pub two_sided: bool,
     /// What the entity's textured parameters name: the `baseColorTexture`
-    /// (times `baseColorFactor`) as [`material::BASE_COLOR`].
+    /// (times `baseColorFactor`) as [`material::BASE_COLOR`], the
+    /// roughness as [`material::ROUGHNESS`] and the `normalTexture` as
+    /// [`material::NORMAL`].
     pub textures: Textures,
+    /// The `normalTexture`'s `scale`, where the BSDF is normal-mapped.
+    pub normal_scale: Option<f32>,
 }
 
 /// The light plugin of an emissive material's triangles.
@@ -138,15 +142,23 @@ pub(crate) fn resolve_materials(
                 let mut textures = Textures::new();
                 let [r, g, b, _] = pbr.base_color_factor();
                 let base_color = loader.load(
-                    pbr.base_color_texture(),
+                    pbr.base_color_texture().map(Slot::of),
                     TextureUse::Colour(Rgb::new(r, g, b)),
                     (material::BASE_COLOR, "baseColorFactor"),
                     &mut textures,
                 );
                 let roughness = loader.load(
-                    pbr.metallic_roughness_texture(),
+                    pbr.metallic_roughness_texture().map(Slot::of),
                     TextureUse::Roughness(pbr.roughness_factor()),
                     (material::ROUGHNESS, "roughnessFactor"),
+                    &mut textures,
+                );
+                let normal_texture = material.normal_texture();
+                let normal_scale = normal_texture.as_ref().map(|n| n.scale());
+                let normal_mapped = loader.load(
+                    normal_texture.map(Slot::normal),
+                    TextureUse::Normal,
+                    (material::NORMAL, "the surface's normals"),
                     &mut textures,
                 );
                 let (entity, warnings) = material::bsdf_entity(
@@ -168,6 +180,7 @@ pub(crate) fn resolve_materials(
                     entity,
                     two_sided: material.index().is_some() && material.double_sided(),
                     textures,
+                    normal_scale: normal_scale.filter(|_| normal_mapped),
                 })
             }
         };
@@ -175,7 +188,7 @@ pub(crate) fn resolve_materials(
         let mut emission_textures = Textures::new();
         if let Some(radiance) = radiance {
             loader.load(
-                material.emissive_texture(),
+                material.emissive_texture().map(Slot::of),
                 TextureUse::Colour(radiance),
                 (material::EMISSIVE, "emissiveFactor"),
                 &mut emission_textures,
@@ -204,6 +217,44 @@ pub(crate) fn resolve_materials(
     Ok(out)
 }
 
+/// A material's reference to a texture: which, read at which TEXCOORD
+/// set, through which uv transform.
+struct Slot<'a> {
+    texture: gltf::Texture<'a>,
+    tex_coord: u32,
+    transform: UvTransform,
+}
+
+impl<'a> Slot<'a> {
+    /// A `textureInfo`, with its `KHR_texture_transform` (whose `texCoord`
+    /// overrides the info's).
+    fn of(info: gltf::texture::Info<'a>) -> Self {
+        let (transform, tex_coord) = match info.texture_transform() {
+            Some(x) => (
+                khr_texture_transform(x.offset(), x.rotation(), x.scale()),
+                x.tex_coord().unwrap_or(info.tex_coord()),
+            ),
+            None => (UvTransform::default(), info.tex_coord()),
+        };
+        Self {
+            texture: info.texture(),
+            tex_coord,
+            transform,
+        }
+    }
+
+    /// A `normalTextureInfo`. The gltf crate drops a
+    /// `KHR_texture_transform` on it, so its uvs are untransformed (the
+    /// import warns where the asset uses the extension).
+    fn normal(info: gltf::material::NormalTexture<'a>) -> Self {
+        Self {
+            texture: info.texture(),
+            tex_coord: info.tex_coord(),
+            transform: UvTransform::default(),
+        }
+    }
+}
+
 /// Loads a material's textures, all of which must read one TEXCOORD set.
 struct TextureLoader<'a> {
     asset: &'a buffers::Asset,
@@ -221,16 +272,16 @@ impl TextureLoader<'_> {
     /// out with a warning, and the material keeps its `factor`.
     fn load(
         &mut self,
-        info: Option<gltf::texture::Info>,
+        slot: Option<Slot>,
         usage: TextureUse,
         (name, factor): (&'static str, &str),
         into: &mut Textures,
     ) -> bool {
-        let Some(info) = info else {
+        let Some(slot) = slot else {
             return false;
         };
         let loaded = match (
-            texture_of(self.asset, &info, self.asset_path, usage),
+            texture_of(self.asset, &slot, self.asset_path, usage),
             self.uv_set,
         ) {
             (Ok((_, set)), Some(other)) if other != set => Err(format!(
@@ -267,25 +318,20 @@ enum TextureUse {
     /// the GGX alpha that [`material::bsdf_entity`]'s lobes take (alpha is
     /// then what the mip map averages).
     Roughness(f32),
+    /// A linear tangent-space normal map, its colours as stored (the
+    /// `normalmap` BSDF decodes and scales them).
+    Normal,
 }
 
-/// A material's texture as `usage` reads it, with its sampler and
-/// `KHR_texture_transform`, as the `image` texture plugin; and the TEXCOORD
-/// set it reads (the transform's `texCoord` overrides the texture info's).
+/// A material's texture as `usage` reads it, with its sampler and uv
+/// transform, as the `image` texture plugin; and the TEXCOORD set it reads.
 fn texture_of(
     asset: &buffers::Asset,
-    info: &gltf::texture::Info,
+    slot: &Slot,
     asset_path: &Path,
     usage: TextureUse,
 ) -> std::result::Result<(ImageTexture, u32), String> {
-    let (transform, set) = match info.texture_transform() {
-        Some(x) => (
-            khr_texture_transform(x.offset(), x.rotation(), x.scale()),
-            x.tex_coord().unwrap_or(info.tex_coord()),
-        ),
-        None => (UvTransform::default(), info.tex_coord()),
-    };
-    let texture = info.texture();
+    let (texture, transform, set) = (&slot.texture, slot.transform, slot.tex_coord);
     let image = texture.source();
     let bytes = image_bytes(asset, &image, asset_path)?;
     let mut stored = image_texture::decode(&bytes).map_err(|e| {
@@ -328,6 +374,7 @@ fn texture_of(
             };
             (Encoding::Linear, Rgb::WHITE)
         }
+        TextureUse::Normal => (Encoding::Linear, Rgb::WHITE),
     };
     let texture = ImageTexture::new(
         stored,

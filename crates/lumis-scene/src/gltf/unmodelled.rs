@@ -30,6 +30,15 @@ pub(crate) fn unmodelled_features(document: &gltf::Document) -> Vec<String> {
             "{see_through} materials with alphaMode MASK or BLEND rendered opaque (alpha is not modelled)"
         ));
     }
+    let transformed = document
+        .extensions_used()
+        .any(|e| e == "KHR_texture_transform");
+    if transformed && document.materials().any(|m| m.normal_texture().is_some()) {
+        out.push(
+            "normal textures read without KHR_texture_transform (the glTF reader drops it on them)"
+                .into(),
+        );
+    }
     const MODELLED: &[&str] = &["KHR_materials_emissive_strength", "KHR_texture_transform"];
     for ext in document.extensions_used() {
         if !MODELLED.contains(&ext) {
