@@ -23,6 +23,7 @@ use std::sync::{Arc, Mutex};
 use glam::{UVec2, Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample};
+use crate::denoiser::{DenoiseInput, Denoiser};
 use crate::error::{Error, Result};
 use crate::integrator::Integrator;
 use crate::interaction::LightSampleContext;
@@ -365,6 +366,15 @@ impl Sampler for FaultedSampler {
     }
     fn clone_sampler(&self) -> Box<dyn Sampler> {
         Box::new(FaultedSampler(self.0))
+    }
+}
+
+/// A panicking denoiser is an error: the host still has the raw render.
+impl Denoiser for Guarded<Box<dyn Denoiser>> {
+    fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
+        self.guard.call(&self.label, "Denoiser::denoise", || {
+            self.inner.denoise(input)
+        })?
     }
 }
 
