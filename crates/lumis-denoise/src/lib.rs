@@ -2,7 +2,7 @@
 //!
 //! `build.rs` provisions the library (system install, `OIDN_DIR`, else the
 //! official runtime from the `pyoidn` wheel, cached outside the source
-//! tree); [`ffi`] binds the few C calls needed, the crate's only unsafe code.
+//! tree); `ffi` binds the few C calls needed, the crate's only unsafe code.
 
 mod ffi;
 mod oidn;
