@@ -60,7 +60,8 @@ fn main() {
             );
         }
     };
-    println!("cargo:rustc-link-lib=dylib=OpenImageDenoise");
+    // `src/ffi.rs` links `-l OpenImageDenoise`; a library on the default
+    // search path needs no directory.
     if let Some(dir) = lib_dir {
         let dir = dir.display();
         println!("cargo:rustc-link-search=native={dir}");
