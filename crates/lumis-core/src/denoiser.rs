@@ -74,3 +74,40 @@ pub trait Denoiser: Send + Sync {
     /// panic) when the input is invalid or the denoiser fails.
     fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>>;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn validation_names_what_was_expected() {
+        let pixels = [[0.5f32; 3]; 6];
+        let input = DenoiseInput {
+            width: 3,
+            height: 2,
+            color: &pixels,
+            albedo: None,
+            normal: None,
+        };
+        assert!(input.validate().is_ok());
+        let err = |input: DenoiseInput<'_>| input.validate().unwrap_err().message;
+        assert!(err(DenoiseInput {
+            normal: Some(&pixels),
+            ..input
+        })
+        .contains("a normal image needs an albedo image too"));
+        assert!(err(DenoiseInput {
+            normal: Some(&pixels[..5]),
+            albedo: Some(&pixels),
+            ..input
+        })
+        .contains("the normal image has 5 pixels, expected 6 (3x2 like the colour)"));
+        let mut infinite = pixels;
+        infinite[5][2] = f32::INFINITY;
+        assert!(err(DenoiseInput {
+            albedo: Some(&infinite),
+            ..input
+        })
+        .contains("the albedo image has a non-finite value [0.5, 0.5, inf] at pixel (2, 1)"));
+    }
+}

@@ -452,4 +452,35 @@ mod tests {
             "{err}"
         );
     }
+
+    struct Panicking;
+
+    impl Denoiser for Panicking {
+        fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
+            Ok(vec![input.color[input.width * input.height]])
+        }
+    }
+
+    #[test]
+    fn a_panicking_denoiser_is_an_error() {
+        let faults = Arc::new(FaultSink::default());
+        let guard = PluginGuard::new("libdenoise.so", faults.clone());
+        let denoiser: Box<dyn Denoiser> = Box::new(Panicking);
+        let guarded = Guarded::new(denoiser, guard, Arc::from("denoiser (type = \"x\")"));
+        let input = DenoiseInput {
+            width: 1,
+            height: 1,
+            color: &[[1.0; 3]],
+            albedo: None,
+            normal: None,
+        };
+        let err = guarded.denoise(&input).unwrap_err().to_string();
+        assert!(
+            err.contains(
+                "denoiser (type = \"x\") from 'libdenoise.so' panicked in Denoiser::denoise"
+            ),
+            "{err}"
+        );
+        assert!(faults.check().is_err());
+    }
 }
