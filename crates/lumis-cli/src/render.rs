@@ -330,10 +330,11 @@ pub fn render_scene_file(
         }
     }
     let outputs = Outputs::claim(&exr, Some(&png))?;
-    let denoised_outputs = match &loaded.denoiser {
-        Some(_) => Some(crate::denoise::claim_denoised_outputs(&exr)?),
-        None => None,
-    };
+    let denoised_outputs = loaded
+        .denoiser
+        .as_ref()
+        .map(|_| crate::denoise::claim_denoised_outputs(&exr))
+        .transpose()?;
     crate::warn_if_threads_capped(args.threads);
     let spp = loaded.sampler.samples_per_pixel();
     if spp == 0 {
