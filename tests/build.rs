@@ -1,7 +1,10 @@
-//! Puts the Embree library directory found by lumis-embree into the rpath of
-//! these end-to-end tests.
+//! Puts the library directories found by lumis-embree (Embree) and
+//! lumis-denoise (Open Image Denoise) into the rpath of these end-to-end
+//! tests.
 fn main() {
-    if let Ok(dir) = std::env::var("DEP_LUMIS_EMBREE_LIBDIR") {
-        println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
+    for dir in ["DEP_LUMIS_EMBREE_LIBDIR", "DEP_LUMIS_OIDN_LIBDIR"] {
+        if let Ok(dir) = std::env::var(dir) {
+            println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
+        }
     }
 }

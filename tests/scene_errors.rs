@@ -213,3 +213,28 @@ fn missing_required_tables_and_keys() {
     let err = load(&BASE.replace("fov = 40.0\n", ""));
     assert_contains(&err, &["needs 'fov'"]);
 }
+
+#[test]
+fn unknown_denoiser_types_and_parameters_are_named() {
+    let err = load(&with("[denoiser]\ntype = \"oidnn\"\n"));
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:18:8",
+            "unknown denoiser type \"oidnn\"",
+            "available: oidn",
+        ],
+    );
+    let err = load(&with("[denoiser]\ntype = \"oidn\"\nqualty = \"fast\"\n"));
+    assert_contains(&err, &["bad.toml:19:1", "'qualty'", "quality"]);
+    let err = load(&with("[denoiser]\ntype = \"oidn\"\nquality = \"best\"\n"));
+    assert_contains(
+        &err,
+        &[
+            "bad.toml:19:11",
+            "'quality'",
+            "\"high\", \"balanced\", \"fast\"",
+            "\"best\"",
+        ],
+    );
+}

@@ -6,6 +6,7 @@ mod assignments;
 mod brdf;
 mod checkpoint;
 mod converge;
+mod denoise;
 mod diff;
 mod integrator_check;
 mod interrupt;
@@ -50,6 +51,7 @@ pub fn builtin_registry() -> Result<Registry> {
     lumis_lights::register(&mut registry)?;
     lumis_light_samplers::register(&mut registry)?;
     lumis_integrators::register_specialized::<lumis_scene::RenderScene>(&mut registry)?;
+    lumis_denoise::register(&mut registry)?;
     Ok(registry)
 }
 

@@ -102,6 +102,7 @@ fn kind_heading(kind: PluginKind) -> &'static str {
         PluginKind::Light => "Lights (`[[light]]`, and a shape's `emission`)",
         PluginKind::LightSampler => "Light samplers (`[light_sampler]`)",
         PluginKind::Integrator => "Integrators (`[integrator]`)",
+        PluginKind::Denoiser => "Denoisers (`[denoiser]`, run on the finished film)",
     }
 }
 

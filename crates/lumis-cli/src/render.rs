@@ -80,6 +80,8 @@ pub struct RenderReport {
     pub image: Image,
     pub exr: PathBuf,
     pub png: PathBuf,
+    /// The denoised EXR, when the scene has a `[denoiser]`.
+    pub denoised: Option<PathBuf>,
     pub spp: u32,
     /// Stopped by a signal: the image holds the passes finished before it.
     pub interrupted: bool,
@@ -112,7 +114,10 @@ impl RenderReport {
             self.stats.bsdf_light_hits,
             self.stats.light_samples,
             self.exr.display(),
-        )
+        ) + &match &self.denoised {
+            Some(path) => format!(", denoised -> {}", path.display()),
+            None => String::new(),
+        }
     }
 }
 
@@ -325,6 +330,11 @@ pub fn render_scene_file(
         }
     }
     let outputs = Outputs::claim(&exr, Some(&png))?;
+    let denoised_outputs = loaded
+        .denoiser
+        .as_ref()
+        .map(|_| crate::denoise::claim_denoised_outputs(&exr))
+        .transpose()?;
     crate::warn_if_threads_capped(args.threads);
     let spp = loaded.sampler.samples_per_pixel();
     if spp == 0 {
@@ -450,10 +460,29 @@ pub fn render_scene_file(
         }
         interrupted = false;
     }
+    // Only a finished render is denoised, after its raw image is on disk.
+    let denoised = match (&loaded.denoiser, &denoised_outputs) {
+        (Some(denoiser), Some(denoised)) if !interrupted => {
+            // The film's albedo and normal AOVs guide the denoiser once the
+            // film produces them; until then it sees the colour alone.
+            crate::denoise::write_denoised(
+                denoiser.as_ref(),
+                &state.film.image(),
+                None,
+                None,
+                denoised,
+                &metadata(&state),
+                &exr,
+            )?;
+            Some(denoised.exr.clone())
+        }
+        _ => None,
+    };
     Ok(RenderReport {
         image: state.film.image(),
         exr,
         png,
+        denoised,
         spp: state.film.samples,
         interrupted,
         seconds,

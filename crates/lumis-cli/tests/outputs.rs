@@ -85,3 +85,61 @@ fn a_second_writer_is_refused_and_a_dead_ones_lock_taken_over() {
     assert!(!lock.exists());
     assert_eq!(header(&tmp.path().join("plates.exr"), "spp"), "1");
 }
+
+/// With a `[denoiser]`, the raw render stays the main output, the same
+/// image a render without one makes, and the denoised one sits beside it.
+#[test]
+fn a_denoiser_writes_its_image_beside_the_raw_one() {
+    let tmp = scratch("denoised");
+    let plain = path_in(tmp.path(), "plain.exr");
+    assert!(lumis(&small_render(&plain, "2")).status.success());
+    let out = path_in(tmp.path(), "plates.exr");
+    let mut args = small_render(&out, "2");
+    args.extend(["--set", "denoiser.type=\"oidn\""]);
+    let result = lumis(&args);
+    assert!(result.status.success(), "{result:?}");
+    assert_eq!(
+        files_in(tmp.path()),
+        [
+            "plain.exr",
+            "plain.png",
+            "plates.denoised.exr",
+            "plates.denoised.png",
+            "plates.exr",
+            "plates.png"
+        ]
+    );
+    let read = |name: &str| lumis_image::read_exr(&tmp.path().join(name)).unwrap();
+    assert_eq!(
+        read("plates.exr"),
+        read("plain.exr"),
+        "the raw image changed"
+    );
+    let denoised = read("plates.denoised.exr");
+    assert_eq!((denoised.width, denoised.height), (32, 32));
+    assert!(denoised.pixels.iter().flatten().all(|v| v.is_finite()));
+    assert_eq!(header(&tmp.path().join("plates.denoised.exr"), "spp"), "2");
+}
+
+/// A denoise that cannot be written (its PNG's path is a directory here)
+/// fails the command and says where the raw render is, which is written.
+#[test]
+fn a_failed_denoise_keeps_the_raw_render() {
+    let tmp = scratch("denoise-fails");
+    std::fs::create_dir_all(tmp.path().join("plates.denoised.png/in-the-way")).unwrap();
+    let out = path_in(tmp.path(), "plates.exr");
+    let mut args = small_render(&out, "1");
+    args.extend(["--set", "denoiser.type=\"oidn\""]);
+    let result = lumis(&args);
+    assert!(!result.status.success(), "{result:?}");
+    let stderr = String::from_utf8(result.stderr).unwrap();
+    assert!(
+        stderr.contains("denoising failed; the raw render is in") && stderr.contains("plates.exr"),
+        "{stderr}"
+    );
+    assert_eq!(header(&tmp.path().join("plates.exr"), "spp"), "1");
+    assert_eq!(
+        files_in(tmp.path()),
+        ["plates.denoised.png", "plates.exr", "plates.png"]
+    );
+}

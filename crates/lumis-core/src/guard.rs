@@ -23,6 +23,7 @@ use std::sync::{Arc, Mutex};
 use glam::{UVec2, Vec2, Vec3};
 
 use crate::bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample};
+use crate::denoiser::{DenoiseInput, Denoiser};
 use crate::error::{Error, Result};
 use crate::integrator::Integrator;
 use crate::interaction::LightSampleContext;
@@ -368,6 +369,15 @@ impl Sampler for FaultedSampler {
     }
 }
 
+/// A panicking denoiser is an error: the host still has the raw render.
+impl Denoiser for Guarded<Box<dyn Denoiser>> {
+    fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
+        self.guard.call(&self.label, "Denoiser::denoise", || {
+            self.inner.denoise(input)
+        })?
+    }
+}
+
 impl Integrator for Guarded<Box<dyn Integrator>> {
     fn li(
         &self,
@@ -441,5 +451,36 @@ mod tests {
             err.contains("bsdf 'faulty' (sigma = 0.65) from 'libfaulty.so' panicked in Bsdf::f: wi.z = 0 is too low"),
             "{err}"
         );
+    }
+
+    struct Panicking;
+
+    impl Denoiser for Panicking {
+        fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
+            Ok(vec![input.color[input.width * input.height]])
+        }
+    }
+
+    #[test]
+    fn a_panicking_denoiser_is_an_error() {
+        let faults = Arc::new(FaultSink::default());
+        let guard = PluginGuard::new("libdenoise.so", faults.clone());
+        let denoiser: Box<dyn Denoiser> = Box::new(Panicking);
+        let guarded = Guarded::new(denoiser, guard, Arc::from("denoiser (type = \"x\")"));
+        let input = DenoiseInput {
+            width: 1,
+            height: 1,
+            color: &[[1.0; 3]],
+            albedo: None,
+            normal: None,
+        };
+        let err = guarded.denoise(&input).unwrap_err().to_string();
+        assert!(
+            err.contains(
+                "denoiser (type = \"x\") from 'libdenoise.so' panicked in Denoiser::denoise"
+            ),
+            "{err}"
+        );
+        assert!(faults.check().is_err());
     }
 }

@@ -3,13 +3,14 @@
 //! Math (a glam re-export plus frames and floating-point helpers), RGB
 //! radiance, rays and surface interactions with pbrt-v4 style error bounds,
 //! the plugin traits ([`Sampler`], [`Bsdf`], [`Texture`], [`Light`],
-//! [`LightSampler`], [`Integrator`]) with the [`Scene`] they query, and the plugin machinery:
+//! [`LightSampler`], [`Integrator`], [`Denoiser`]) with the [`Scene`] they query, and the plugin machinery:
 //! the scene document model, [`Params`] and the [`Registry`].
 
 // The derives name `::lumis_core`, which this lets them do here too.
 extern crate self as lumis_core;
 
 pub mod bsdf;
+pub mod denoiser;
 pub mod doc;
 pub mod entity;
 pub mod error;
@@ -32,6 +33,7 @@ pub mod stats;
 pub mod texture;
 
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
+pub use denoiser::{DenoiseInput, Denoiser};
 pub use entity::PluginEntity;
 pub use error::{Error, Location, Result};
 pub use footprint::{PackedFootprint, PixelFootprint};

@@ -9,6 +9,7 @@ use std::fmt;
 use std::sync::Arc;
 
 use crate::bsdf::Bsdf;
+use crate::denoiser::Denoiser;
 use crate::entity::PluginEntity;
 use crate::error::{Error, Result};
 use crate::guard::{FaultSink, Guarded, PluginGuard};
@@ -28,16 +29,18 @@ pub enum PluginKind {
     Light,
     LightSampler,
     Integrator,
+    Denoiser,
 }
 
 impl PluginKind {
-    pub const ALL: [PluginKind; 6] = [
+    pub const ALL: [PluginKind; 7] = [
         PluginKind::Sampler,
         PluginKind::Texture,
         PluginKind::Bsdf,
         PluginKind::Light,
         PluginKind::LightSampler,
         PluginKind::Integrator,
+        PluginKind::Denoiser,
     ];
 
     /// The scene-file table that names plugins of this kind.
@@ -49,6 +52,7 @@ impl PluginKind {
             PluginKind::Light => "light",
             PluginKind::LightSampler => "light_sampler",
             PluginKind::Integrator => "integrator",
+            PluginKind::Denoiser => "denoiser",
         }
     }
 }
@@ -80,6 +84,7 @@ pub type BsdfFactory = fn(&Params) -> Result<Arc<dyn Bsdf>>;
 pub type LightFactory = fn(&Params, &LightShape) -> Result<Box<dyn Light>>;
 pub type LightSamplerFactory = fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>>;
 pub type IntegratorFactory = fn(&Params) -> Result<Box<dyn Integrator>>;
+pub type DenoiserFactory = fn(&Params) -> Result<Box<dyn Denoiser>>;
 
 // Factories as registered: the plugin's own function, or that function
 // guarded; shared, since registries are cloned per scene.
@@ -90,6 +95,7 @@ type MakeLight = Arc<dyn Fn(&Params, &LightShape) -> Result<Box<dyn Light>> + Se
 type MakeLightSampler =
     Arc<dyn Fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>> + Send + Sync>;
 type MakeIntegrator = Arc<dyn Fn(&Params) -> Result<Box<dyn Integrator>> + Send + Sync>;
+type MakeDenoiser = Arc<dyn Fn(&Params) -> Result<Box<dyn Denoiser>> + Send + Sync>;
 
 /// A factory as the registry keeps it: the plugin's own function for a
 /// built-in, or, while a library registers, a closure that calls it under
@@ -251,6 +257,12 @@ impl Registry {
         self.add(spec, Factory::Integrator(make))
     }
 
+    pub fn add_denoiser(&mut self, spec: PluginSpec, factory: DenoiserFactory) -> Result<()> {
+        Self::check_kind(&spec, PluginKind::Denoiser)?;
+        let make: MakeDenoiser = registered!(self, factory, Box::new, |params|);
+        self.add(spec, Factory::Denoiser(make))
+    }
+
     pub fn find(&self, kind: PluginKind, name: &str) -> Option<&Registered> {
         self.plugins
             .iter()
@@ -341,7 +353,7 @@ impl Registry {
 }
 
 /// A plugin interface: its kind, what its factory takes besides the
-/// parameters, and what it makes. Implemented for the six plugin traits
+/// parameters, and what it makes. Implemented for the seven plugin traits
 /// (`dyn Sampler`, `dyn Bsdf`, ...), which name the kind in
 /// [`Registry::create`].
 pub trait PluginInterface: sealed::Sealed {
@@ -378,6 +390,7 @@ mod sealed {
         Light(MakeLight),
         LightSampler(MakeLightSampler),
         Integrator(MakeIntegrator),
+        Denoiser(MakeDenoiser),
     }
 
     impl Sealed for dyn Sampler {}
@@ -386,6 +399,7 @@ mod sealed {
     impl Sealed for dyn Light {}
     impl Sealed for dyn LightSampler {}
     impl Sealed for dyn Integrator {}
+    impl Sealed for dyn Denoiser {}
 }
 
 use sealed::Factory;
@@ -471,6 +485,18 @@ impl PluginInterface for dyn Integrator {
     type Input<'i> = ();
     fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
         let Factory::Integrator(f) = factory else {
+            unreachable!("{KIND_CHECKED}")
+        };
+        f(params)
+    }
+}
+
+impl PluginInterface for dyn Denoiser {
+    const KIND: PluginKind = PluginKind::Denoiser;
+    type Made = Box<dyn Denoiser>;
+    type Input<'i> = ();
+    fn call(factory: &Factory, params: &Params, (): ()) -> Result<Self::Made> {
+        let Factory::Denoiser(f) = factory else {
             unreachable!("{KIND_CHECKED}")
         };
         f(params)

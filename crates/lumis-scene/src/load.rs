@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use lumis_core::doc;
 use lumis_core::files::{read_text_bounded, FileKind, MIB};
-use lumis_core::{Error, Integrator, LightSampler, Location, Registry, Result, Sampler};
+use lumis_core::{Denoiser, Error, Integrator, LightSampler, Location, Registry, Result, Sampler};
 use lumis_render::PerspectiveCamera;
 
 use crate::assembly::assemble;
@@ -23,6 +23,8 @@ pub struct LoadedScene {
     pub camera: PerspectiveCamera,
     pub sampler: Box<dyn Sampler>,
     pub integrator: Box<dyn Integrator>,
+    /// `[denoiser]`, run on the finished film; the raw render is kept too.
+    pub denoiser: Option<Box<dyn Denoiser>>,
     pub seed: u64,
     /// `film.output`, resolved against the scene file's directory.
     pub output: Option<PathBuf>,
@@ -90,6 +92,7 @@ pub fn load_str(
         &description.lights,
         &description.sampler,
         &description.integrator,
+        description.denoiser.as_ref(),
     )?;
 
     let assembled = assemble(
@@ -131,6 +134,7 @@ pub fn load_str(
         camera: description.camera,
         sampler: plugins.sampler,
         integrator: plugins.integrator,
+        denoiser: plugins.denoiser,
         seed: description.seed,
         output: description.film.output,
     })

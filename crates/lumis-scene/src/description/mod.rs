@@ -47,6 +47,7 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "seed",
     "plugins",
     "accel",
+    "denoiser",
 ];
 
 /// A scene as its file describes it, checked and typed.
@@ -58,6 +59,9 @@ pub(crate) struct SceneDescription {
     pub accel: AccelOptions,
     pub sampler: PluginEntity,
     pub integrator: PluginEntity,
+    /// `[denoiser]`: a post-process on the finished film, if the scene asks
+    /// for one.
+    pub denoiser: Option<PluginEntity>,
     /// `[light_sampler]`, or the uniform one when the scene has none.
     pub light_sampler: PluginEntity,
     /// `[[texture]]`s, which BSDF parameters name.
@@ -116,6 +120,17 @@ impl SceneDescription {
         };
         let sampler = required_plugin(&mut root, PluginKind::Sampler, file)?;
         let integrator = required_plugin(&mut root, PluginKind::Integrator, file)?;
+        let denoiser = take_table(&mut root, "denoiser")?
+            .map(|(table, location)| {
+                PluginEntity::from_table(
+                    PluginKind::Denoiser,
+                    "denoiser",
+                    table,
+                    location,
+                    TYPE_KEY,
+                )
+            })
+            .transpose()?;
         Ok(Self {
             seed,
             film,
@@ -124,6 +139,7 @@ impl SceneDescription {
             accel,
             sampler,
             integrator,
+            denoiser,
             light_sampler,
             textures,
             bsdfs,

@@ -9,8 +9,8 @@ mod bsdf_table;
 
 use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfScope, Error, Integrator, Light, LightInput, LightShape, PluginEntity, Registry,
-    Result, Sampler, Texture, Textures,
+    Bsdf, BsdfScope, Denoiser, Error, Integrator, Light, LightInput, LightShape, PluginEntity,
+    Registry, Result, Sampler, Texture, Textures,
 };
 
 pub(crate) use bsdf_table::BsdfTable;
@@ -21,6 +21,7 @@ use crate::description::{NamedPlugin, PluginLibraries};
 pub(crate) struct Plugins {
     pub sampler: Box<dyn Sampler>,
     pub integrator: Box<dyn Integrator>,
+    pub denoiser: Option<Box<dyn Denoiser>>,
     pub bsdfs: BsdfTable,
     /// `[[light]]`s, in file order.
     pub lights: Vec<Box<dyn Light>>,
@@ -29,7 +30,7 @@ pub(crate) struct Plugins {
 }
 
 /// Creates the `[[texture]]`s, `[[bsdf]]`s (whose parameters may name the
-/// textures), `[[light]]`s, sampler and integrator.
+/// textures), `[[light]]`s, sampler, integrator and denoiser.
 pub(crate) fn instantiate(
     registry: &Registry,
     textures: &[NamedPlugin],
@@ -37,6 +38,7 @@ pub(crate) fn instantiate(
     lights: &[PluginEntity],
     sampler: &PluginEntity,
     integrator: &PluginEntity,
+    denoiser: Option<&PluginEntity>,
 ) -> Result<Plugins> {
     let mut by_name = Textures::new();
     for texture in textures {
@@ -73,6 +75,9 @@ pub(crate) fn instantiate(
     Ok(Plugins {
         sampler: registry.create::<dyn Sampler>(sampler, ())?,
         integrator: registry.create::<dyn Integrator>(integrator, ())?,
+        denoiser: denoiser
+            .map(|d| registry.create::<dyn Denoiser>(d, ()))
+            .transpose()?,
         bsdfs: BsdfTable::named(named),
         lights,
         textures: by_name,
