@@ -27,13 +27,14 @@ pub use equirect::Equirect;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "envmap",
-    doc: "environment radiance from an equirectangular EXR image (Mitsuba's convention: +y up, the image centre along +z), looked up bilinearly and importance-sampled by luminance",
+    doc: "environment radiance from an equirectangular EXR or Radiance .hdr image (Mitsuba's convention: +y up, the image centre along +z), looked up bilinearly and importance-sampled by luminance",
     params: EnvMapParams::SPECS,
 };
 
 #[derive(Debug, Clone, PluginParams)]
 pub struct EnvMapParams {
-    /// the equirectangular image (EXR), relative to the scene file
+    /// the equirectangular image (EXR or Radiance .hdr), relative to the
+    /// scene file
     pub filename: PathBuf,
     /// multiplies every texel
     #[param(default = 1.0)]
@@ -144,10 +145,15 @@ fn frame(up: Vec3, degrees: f32) -> Quat {
     Quat::from_rotation_arc(Vec3::Y, up.normalize()) * Quat::from_rotation_y(degrees.to_radians())
 }
 
-/// The texels of an EXR file, checked: a non-empty image of finite,
-/// non-negative values.
+/// The texels of an EXR or Radiance `.hdr` file (told apart by their
+/// first bytes), checked: a non-empty image of finite, non-negative values.
 fn read_map(path: &Path) -> std::result::Result<Equirect, String> {
-    let image = lumis_image::read_exr(path).map_err(|e| e.to_string())?;
+    let image = if lumis_image::is_hdr(path) {
+        lumis_image::read_hdr(path)
+    } else {
+        lumis_image::read_exr(path)
+    }
+    .map_err(|e| e.to_string())?;
     if image.width == 0 || image.height == 0 {
         return Err(format!(
             "the image is {}x{}, expected at least one texel",

@@ -292,6 +292,16 @@ fn files_are_read_relative_to_the_scene_and_bad_ones_refused() {
     );
     assert!((l.b - 4.0).abs() < 1e-5, "{l:?}");
 
+    // A Radiance file: one flat scanline of two texels, 1.0 and 0.5 grey.
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+    hdr.extend([128, 128, 128, 129, 128, 128, 128, 128]);
+    std::fs::write(dir.path().join("sky.hdr"), hdr).unwrap();
+    let light = from_scene(&scene, "filename = \"sky.hdr\"").unwrap();
+    let l = |d: Vec3| light.l(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, d).g;
+    // Texel centres at u = 1/4 (+x) and 3/4 (-x).
+    assert!((l(Vec3::X) - 1.0).abs() < 5e-3 && (l(-Vec3::X) - 0.5).abs() < 5e-3);
+    std::fs::write(dir.path().join("broken.hdr"), "#?RADIANCE\n").unwrap();
+
     write(&dir.path().join("negative.exr"), 3, 2, [1.0, -1.0, 0.0]);
     write(&dir.path().join("nan.exr"), 3, 2, [f32::NAN, 0.0, 0.0]);
     std::fs::write(dir.path().join("text.exr"), "not an image").unwrap();
@@ -300,6 +310,7 @@ fn files_are_read_relative_to_the_scene_and_bad_ones_refused() {
         ("negative.exr", "texel (2, 1)"),
         ("nan.exr", "texel (2, 1)"),
         ("text.exr", "not a readable"),
+        ("broken.hdr", "not a readable Radiance"),
     ] {
         let error = from_scene(&scene, &format!("filename = \"{file}\""))
             .err()
