@@ -186,11 +186,8 @@ impl Light for EnvMapLight {
     }
 
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        let (wi, pdf, l) = match &self.distribution {
-            None => {
-                let wi = warp::square_to_uniform_sphere(u);
-                (wi, warp::UNIFORM_SPHERE_PDF, self.radiance(wi))
-            }
+        let (wi, pdf) = match &self.distribution {
+            None => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
             Some(distribution) => {
                 // A black map has nothing to draw.
                 if distribution.integral() == 0.0 {
@@ -201,17 +198,14 @@ impl Light for EnvMapLight {
                 if !(sin_theta > 0.0 && pdf_uv > 0.0) {
                     return None;
                 }
-                // Looked up at the drawn point: no way back from the
-                // direction (atan2, acos) needed.
                 (
                     (self.to_world * d).normalize(),
                     pdf_uv / (2.0 * PI * PI * sin_theta),
-                    self.map.lookup(uv) * self.scale,
                 )
             }
         };
         Some(LightSample {
-            l,
+            l: self.radiance(wi),
             wi,
             pdf,
             p: self.far_point(ctx, wi),
