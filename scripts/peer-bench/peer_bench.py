@@ -86,7 +86,7 @@ sys.path.insert(0, HERE)
 import to_mitsuba  # noqa: E402
 
 ORDER = ["cornell-box", "glossy-beckmann", "glossy-ggx", "glass-plastic", "measured", "scan-diffuse",
-         "scan-conductor", "textured-gltf", "many-lights"]
+         "scan-conductor", "textured-gltf", "many-lights", "envmap-sky"]
 SAMPLERS = ["independent", "stratified", "multijitter", "ldsampler"]
 VARIANTS = ["llvm_ad_rgb", "scalar_rgb"]
 SUMMARY = re.compile(r"(\d+)x(\d+), (\d+) spp, ([0-9.]+) s, ([0-9.]+) Msamples/s")

@@ -38,7 +38,9 @@ mapping, one lumis construct at a time:
   roughness^2, GGX, `doubleSided` -> `twosided`; base colour textures ->
   `bitmap`) become `mi.Mesh` objects. `emission` -> an `area` emitter
   (one-sided only: Mitsuba's area emitter has no two-sided mode).
-- `[[light]]`: `point`, `constant`.
+- `[[light]]`: `point`, `constant`, `envmap` (importance sampling only;
+  `up` and `rotation` become `to_world`; both renderers interpolate between
+  texel centres, wrapping in u, so one file is one sky).
 """
 import base64
 import hashlib
@@ -87,6 +89,9 @@ def check_keys(table, allowed, where):
 def referenced_files(scene, scene_dir):
     """Every file a scene reads (for the reference cache key)."""
     files = []
+    for light in scene.get("light", []):
+        if "filename" in light:
+            files.append(os.path.join(scene_dir, light["filename"]))
     for shape in scene.get("shape", []):
         if "file" in shape:
             files.append(os.path.join(scene_dir, shape["file"]))
@@ -571,6 +576,23 @@ def convert(path, mi, sampler="independent", spp=64, seed=0, tex_dir=None):
         elif t == "constant":
             check_keys(light, ["type", "radiance"], where)
             out[f"light-{i}"] = {"type": "constant", "radiance": spectrum(light["radiance"], where)}
+        elif t == "envmap":
+            check_keys(light, ["type", "filename", "scale", "up", "rotation", "sampling"], where)
+            if light.get("sampling", "importance") != "importance":
+                raise Unsupported(f"{where}: sampling {light['sampling']!r} (Mitsuba's envmap samples by luminance)")
+            up = np.array([float(x) for x in light.get("up", [0.0, 1.0, 0.0])])
+            up /= np.linalg.norm(up)
+            # The shortest arc taking +y to up, after `rotation` degrees about +y.
+            axis = np.cross([0.0, 1.0, 0.0], up)
+            to_world = mi.ScalarTransform4f()
+            if np.linalg.norm(axis) > 1e-9:
+                angle = math.degrees(math.atan2(np.linalg.norm(axis), up[1]))
+                to_world = to_world.rotate([float(a) for a in axis / np.linalg.norm(axis)], angle)
+            elif up[1] < 0.0:
+                to_world = to_world.rotate([1.0, 0.0, 0.0], 180.0)
+            to_world = to_world.rotate([0.0, 1.0, 0.0], float(light.get("rotation", 0.0)))
+            out[f"light-{i}"] = {"type": "envmap", "filename": os.path.join(scene_dir, light["filename"]),
+                                 "scale": float(light.get("scale", 1.0)), "to_world": to_world}
         else:
             raise Unsupported(f"{where}: light type {t!r}")
     return out

@@ -17,6 +17,7 @@ pub mod outcome;
 pub mod quadrature;
 pub mod sampler_suite;
 pub mod sweep;
+pub mod test_map;
 pub mod uniformity;
 
 pub use chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};

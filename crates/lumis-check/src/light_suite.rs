@@ -32,6 +32,7 @@ use crate::chi_square::{chi_square, ChiSquareConfig, ChiSquareReport};
 use crate::corrected_significance;
 use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::{declared, parameter_sweep_with, Variant};
+use crate::test_map::TestMap;
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,25 +217,46 @@ pub fn instantiate(
 }
 
 /// `fixed` with the kit's positions for the required `vec3` parameters
-/// that it does not hold (a sweep cannot invent where a light is).
-fn with_positions(
+/// that it does not hold (a sweep cannot invent where a light is), and
+/// `map` for its required `path` ones (nor the file it reads).
+fn with_required(
     registry: &Registry,
     name: &str,
     fixed: &[(String, String)],
+    map: Option<&TestMap>,
 ) -> Result<Vec<(String, String)>> {
     let spec = declared(registry, PluginKind::Light, name)?;
     let mut out = fixed.to_vec();
     let mut places = [LIGHT_POSITION, SECOND_POSITION].into_iter();
     for p in spec.params {
-        if p.ty == ParamType::Vec3
-            && p.default == ParamDefault::Required
-            && !fixed.iter().any(|(k, _)| k == p.name)
-        {
-            let [x, y, z] = places.next().unwrap_or(SECOND_POSITION);
-            out.push((p.name.to_string(), format!("[{x:?}, {y:?}, {z:?}]")));
+        if p.default != ParamDefault::Required || fixed.iter().any(|(k, _)| k == p.name) {
+            continue;
+        }
+        match (p.ty, map) {
+            (ParamType::Vec3, _) => {
+                let [x, y, z] = places.next().unwrap_or(SECOND_POSITION);
+                out.push((p.name.to_string(), format!("[{x:?}, {y:?}, {z:?}]")));
+            }
+            (ParamType::Path, Some(map)) => {
+                out.push((
+                    p.name.to_string(),
+                    format!("{:?}", map.path().display().to_string()),
+                ));
+            }
+            _ => {}
         }
     }
     Ok(out)
+}
+
+/// Whether the light `name` reads a file the scene must name.
+fn needs_a_file(registry: &Registry, name: &str, fixed: &[(String, String)]) -> Result<bool> {
+    let spec = declared(registry, PluginKind::Light, name)?;
+    Ok(spec.params.iter().any(|p| {
+        p.ty == ParamType::Path
+            && p.default == ParamDefault::Required
+            && !fixed.iter().any(|(k, _)| k == p.name)
+    }))
 }
 
 /// Runs every check over the sweep of the light plugin `name`'s declared
@@ -246,7 +268,13 @@ pub fn check_light_with(
     fixed: &[(String, String)],
     cfg: &LightCheckConfig,
 ) -> Result<Vec<LightCaseResult>> {
-    let fixed = with_positions(registry, name, fixed)?;
+    // Kept until the checks end: the lights read it when they are made.
+    let map = if needs_a_file(registry, name, fixed)? {
+        Some(TestMap::write()?)
+    } else {
+        None
+    };
+    let fixed = with_required(registry, name, fixed, map.as_ref())?;
     let spec = declared(registry, PluginKind::Light, name)?;
     let variants = parameter_sweep_with(&spec, &fixed)?;
     check_light_variants(registry, name, &variants, cfg)

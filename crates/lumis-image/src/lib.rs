@@ -1,9 +1,11 @@
 //! Images: a linear RGB float buffer, EXR and PNG files with metadata in
-//! the EXR header, writes that never leave a half-written file behind, and
-//! a lock that keeps two processes from writing one output.
+//! the EXR header, Radiance `.hdr` files read, writes that never leave a
+//! half-written file behind, and a lock that keeps two processes from
+//! writing one output.
 
 mod atomic;
 mod exr_io;
+mod hdr_io;
 mod output_lock;
 mod png_io;
 mod process;
@@ -12,6 +14,7 @@ pub use atomic::{remove_stale_temporaries, stage, write_atomically, StagedFile};
 pub use exr_io::{
     read_exr, read_exr_metadata, stage_exr, write_exr, write_exr_with_metadata, ExrMetadata,
 };
+pub use hdr_io::{is_hdr, read_hdr};
 pub use output_lock::{lock_path, OutputLock};
 pub use png_io::{linear_to_srgb8, stage_png, write_png, write_rgb8_png};
 pub use process::process_is_running;

@@ -5,6 +5,7 @@
 //! half/difference parameterizations of direction pairs and their Jacobians.
 
 pub mod distribution;
+pub mod distribution2d;
 pub mod halfdiff;
 pub mod mis;
 pub mod permutation;
@@ -21,6 +22,7 @@ pub mod spherical_triangle;
 pub mod warp;
 
 pub use distribution::Distribution1D;
+pub use distribution2d::Distribution2D;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use permutation::permutation_element;
 pub use radical_inverse::{

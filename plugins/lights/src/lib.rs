@@ -1,9 +1,10 @@
 //! Standard lights: point and spot lights, area lights for quads, triangles
-//! and spheres (each sampled by area or by solid angle), and a constant
-//! environment.
+//! and spheres (each sampled by area or by solid angle), and environments:
+//! constant, or an image.
 
 mod area;
 mod constant;
+mod envmap;
 mod point;
 mod quad;
 mod sphere;
@@ -13,6 +14,7 @@ mod triangle;
 
 pub use area::{AreaLight, Emission, EmissionParams, PlanarShape, Sampling};
 pub use constant::ConstantLight;
+pub use envmap::{EnvMapLight, EnvSampling, Equirect};
 pub use point::PointLight;
 pub use quad::{Quad, QuadLight};
 pub use sphere::SphereLight;
@@ -37,5 +39,8 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     })?;
     registry.add_light(constant::SPEC, |p, shape| {
         Ok(Box::new(ConstantLight::from_params(p, shape)?))
+    })?;
+    registry.add_light(envmap::SPEC, |p, shape| {
+        Ok(Box::new(EnvMapLight::from_params(p, shape)?))
     })
 }

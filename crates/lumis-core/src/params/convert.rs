@@ -249,7 +249,7 @@ macro_rules! plain_param {
 plain_param!(
     bool => Bool,
     String => String,
-    PathBuf => String,
+    PathBuf => Path,
     Rgb => Rgb,
     Vec2 => Vec2,
     Vec3 => Vec3,

@@ -17,6 +17,8 @@ pub enum ParamType {
     Int,
     Float,
     String,
+    /// A file, relative to the scene file that names it.
+    Path,
     /// `[r, g, b]` or one number for grey.
     Rgb,
     /// An `rgb`, or `{ texture = "name" }`.
@@ -44,6 +46,7 @@ impl ParamType {
             ParamType::Int => "int",
             ParamType::Float => "float",
             ParamType::String => "string",
+            ParamType::Path => "path",
             ParamType::Rgb => "rgb",
             ParamType::TexturedRgb => "rgb or texture",
             ParamType::TexturedFloat => "float or texture",
@@ -104,7 +107,9 @@ impl ParamValue {
             ParamType::Bool => matches!(self, ParamValue::Bool(_)),
             ParamType::Int => matches!(self, ParamValue::Int(_)),
             ParamType::Float | ParamType::TexturedFloat => self.is_number(),
-            ParamType::String | ParamType::Bsdf => matches!(self, ParamValue::Str(_)),
+            ParamType::String | ParamType::Path | ParamType::Bsdf => {
+                matches!(self, ParamValue::Str(_))
+            }
             ParamType::Rgb | ParamType::TexturedRgb => self.is_number() || self.is_numbers(3),
             ParamType::Vec2 => self.is_numbers(2),
             ParamType::Vec3 => self.is_numbers(3),
