@@ -8,7 +8,9 @@ use std::time::Instant;
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
-use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, RenderProgress};
+use lumis_render::{
+    progress_units, render_pass, Aov, Film, PassContext, RenderPool, RenderProgress,
+};
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
@@ -78,6 +80,8 @@ const PASS_SECONDS: f64 = 2.0;
 /// The outcome of a render, for the summary line and for tests.
 pub struct RenderReport {
     pub image: Image,
+    /// The outputs `[film] aovs` asked for, as the EXR holds them.
+    pub aovs: Vec<(Aov, Image)>,
     pub exr: PathBuf,
     pub png: PathBuf,
     pub spp: u32,
@@ -213,12 +217,13 @@ fn starting_state(
     seed: u64,
     spp: u32,
     resolution: lumis_core::UVec2,
+    aovs: &[Aov],
 ) -> Result<Checkpoint> {
     let saved = Checkpoint::read(checkpoint)
         .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
     let fresh = || -> Result<Checkpoint> {
         Ok(Checkpoint {
-            film: Film::try_new(resolution)?,
+            film: Film::try_with_aovs(resolution, aovs)?,
             spp,
             passes: 0,
             seed,
@@ -257,6 +262,15 @@ fn starting_state(
             saved.film.width, saved.film.height, resolution.x, resolution.y
         ));
     }
+    let expected = Film::try_with_aovs(lumis_core::UVec2::ONE, aovs)?.aovs;
+    if saved.film.aovs != expected {
+        let names = |aovs: &[Aov]| format!("{aovs:?}").to_lowercase();
+        return refuse(format!(
+            "it holds the outputs {}, not {}",
+            names(&saved.film.aovs),
+            names(&expected)
+        ));
+    }
     if saved.spp != spp {
         return refuse(format!(
             "it is a render of {} spp, not {spp} (a sampler may place each sample by the total count)",
@@ -284,6 +298,11 @@ fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) ->
         }
     };
     spp.clamp(1, remaining)
+}
+
+/// Writes the film's colour and outputs.
+fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Result<()> {
+    outputs.write(&film.image(), &film.aov_images(), metadata)
 }
 
 /// Renders a scene file and writes `PATH.exr` and `PATH.png`, in passes,
@@ -340,6 +359,7 @@ pub fn render_scene_file(
         loaded.seed,
         spp,
         resolution,
+        &loaded.aovs,
     )?;
     // With --stats the scene, its plugins and the sampler run inside the
     // profiling wrappers; the render itself is the same call.
@@ -365,6 +385,7 @@ pub fn render_scene_file(
         integrator: loaded.integrator.as_ref(),
         sampler,
         seed: loaded.seed,
+        clamp: loaded.clamp,
         pool: &pool,
         progress: &progress,
         stop,
@@ -382,7 +403,7 @@ pub fn render_scene_file(
     };
     let save = |state: &Checkpoint| -> Result<()> {
         state.write(&checkpoint_file)?;
-        outputs.write(&state.film.image(), &metadata(state))
+        write_film(&outputs, &state.film, &metadata(state))
     };
     let profile = args.stats.then(Profile::start);
     let mut stats = RenderStats::default();
@@ -435,7 +456,7 @@ pub fn render_scene_file(
             exr.display()
         );
     } else {
-        outputs.write(&state.film.image(), &metadata(&state))?;
+        write_film(&outputs, &state.film, &metadata(&state))?;
         // Last: a kill before this line leaves a checkpoint that resumes
         // to the same, finished image.
         match std::fs::remove_file(&checkpoint_file) {
@@ -452,6 +473,7 @@ pub fn render_scene_file(
     }
     Ok(RenderReport {
         image: state.film.image(),
+        aovs: state.film.aov_images(),
         exr,
         png,
         spp: state.film.samples,

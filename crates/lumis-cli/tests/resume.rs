@@ -9,17 +9,33 @@ use common::*;
 
 const SPP: &str = "96";
 
+/// Every output beside the colour: their sums are state that must resume
+/// exactly too.
+const ALL_AOVS: &str = "film.aovs=[\"albedo\", \"normal\", \"depth\", \"variance\", \"spp\"]";
+
+/// The bits of every channel of an EXR (colour and outputs), by name.
+fn all_channels(path: impl AsRef<std::path::Path>) -> Vec<(String, Vec<u32>)> {
+    lumis_image::read_exr_channels(path.as_ref())
+        .unwrap()
+        .into_iter()
+        .map(|(name, values)| (name, values.into_iter().map(f32::to_bits).collect()))
+        .collect()
+}
+
 /// Starts the render (resuming from the second start on), SIGKILLs it at
 /// each moment, then lets it finish, and compares with an uninterrupted
-/// render.
+/// render, colour and every output.
 fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
     let tmp = scratch(name);
     let whole = path_in(tmp.path(), "whole.exr");
-    let result = lumis(&small_render(&whole, SPP));
+    let mut uninterrupted = small_render(&whole, SPP);
+    uninterrupted.extend(["--set", ALL_AOVS]);
+    let result = lumis(&uninterrupted);
     assert!(result.status.success(), "{result:?}");
 
     let out = path_in(tmp.path(), "plates.exr");
     let mut args = small_render(&out, SPP);
+    args.extend(["--set", ALL_AOVS]);
     args.extend(["--checkpoint", "--pass-spp", "1", "--resume"]);
     // One uninterrupted run with the same flags: the kill moments spread
     // over its duration (which only chooses them; nothing is asserted on it).
@@ -62,6 +78,11 @@ fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
         exr_pixels(&exr),
         exr_pixels(&whole),
         "resumed image differs"
+    );
+    assert_eq!(
+        all_channels(&exr),
+        all_channels(&whole),
+        "resumed outputs differ"
     );
     assert_eq!(
         files_in(tmp.path()),

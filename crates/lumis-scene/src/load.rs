@@ -26,6 +26,10 @@ pub struct LoadedScene {
     pub seed: u64,
     /// `film.output`, resolved against the scene file's directory.
     pub output: Option<PathBuf>,
+    /// `film.aovs`: the outputs written beside the colour.
+    pub aovs: Vec<lumis_render::Aov>,
+    /// `integrator.clamp`: the cap on each sample's largest component.
+    pub clamp: Option<f32>,
 }
 
 /// A scene is text a person writes: far below this bound, which refuses
@@ -132,5 +136,7 @@ pub fn load_str(
         integrator: plugins.integrator,
         seed: description.seed,
         output: description.film.output,
+        aovs: description.film.aovs,
+        clamp: description.clamp,
     })
 }

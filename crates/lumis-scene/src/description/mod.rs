@@ -10,6 +10,7 @@
 
 mod accel;
 mod camera;
+mod clamp;
 mod document;
 mod film;
 mod gltf_shape;
@@ -58,6 +59,8 @@ pub(crate) struct SceneDescription {
     pub accel: AccelOptions,
     pub sampler: PluginEntity,
     pub integrator: PluginEntity,
+    /// `[integrator] clamp`: the cap on each sample's largest component.
+    pub clamp: Option<f32>,
     /// `[light_sampler]`, or the uniform one when the scene has none.
     pub light_sampler: PluginEntity,
     /// `[[texture]]`s, which BSDF parameters name.
@@ -115,7 +118,16 @@ impl SceneDescription {
             None => default_light_sampler(),
         };
         let sampler = required_plugin(&mut root, PluginKind::Sampler, file)?;
-        let integrator = required_plugin(&mut root, PluginKind::Integrator, file)?;
+        let (mut integrator_table, integrator_location) =
+            take_required_table(&mut root, PluginKind::Integrator.table_name(), file)?;
+        let clamp = clamp::take_clamp(&mut integrator_table)?;
+        let integrator = PluginEntity::from_table(
+            PluginKind::Integrator,
+            PluginKind::Integrator.table_name(),
+            integrator_table,
+            integrator_location,
+            TYPE_KEY,
+        )?;
         Ok(Self {
             seed,
             film,
@@ -124,6 +136,7 @@ impl SceneDescription {
             accel,
             sampler,
             integrator,
+            clamp,
             light_sampler,
             textures,
             bsdfs,
