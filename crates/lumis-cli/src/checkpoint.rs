@@ -14,14 +14,19 @@
 //! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 spp:u32 aovs:u32
 //! passes:u64 seed:u64 scene_hash:u64 seconds:f64 sums:[f64; 3 * width * height]
 //! squares:[f64; 3 * width * height]? first_hits:[f64; 7 * width * height]?
-//! checksum:u64
+//! adaptive? checksum:u64
 //! ```
+//!
+//! With adaptive sampling (bit 31 of `aovs`), `adaptive` is its settings
+//! and per-pixel state: `min_spp:u32 max_spp:u32 threshold:f32
+//! counts:[u32; width * height] odd_sums:[f64; 3 * width * height]
+//! active:[u8; width * height]`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
-use lumis_render::{Aov, Film, FirstHitSums};
+use lumis_render::{AdaptiveSampling, Aov, Film, FirstHitSums};
 use lumis_scene::Fnv1a;
 
 const MAGIC: &[u8; 8] = b"LUMISCKP";
@@ -29,6 +34,10 @@ const VERSION: u32 = 2;
 const HEADER_BYTES: usize = 8 + 6 * 4 + 4 * 8;
 /// `f64`s per pixel of the first-hit sums: albedo, normal, depth.
 const FIRST_HIT_VALUES: usize = 7;
+/// The bit of the `aovs` mask saying the film samples adaptively.
+const ADAPTIVE_BIT: u32 = 1 << 31;
+/// Bytes per pixel of the adaptive state: count, odd sums, active flag.
+const ADAPTIVE_PIXEL_BYTES: usize = 4 + 24 + 1;
 
 /// A render's state between passes.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,7 +71,12 @@ impl Checkpoint {
             film.height as u32,
             film.samples,
             self.spp,
-            film.aovs.iter().map(|a| a.bit()).sum(),
+            film.aovs.iter().map(|a| a.bit()).sum::<u32>()
+                | if film.adaptive.is_some() {
+                    ADAPTIVE_BIT
+                } else {
+                    0
+                },
         ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -79,6 +93,23 @@ impl Checkpoint {
             for value in values {
                 out.extend_from_slice(&value.to_le_bytes());
             }
+        }
+        if let Some(adaptive) = &film.adaptive {
+            let settings = adaptive.settings;
+            for v in [
+                settings.min_spp,
+                settings.max_spp,
+                settings.threshold.to_bits(),
+            ] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+            for count in &adaptive.counts {
+                out.extend_from_slice(&count.to_le_bytes());
+            }
+            for value in adaptive.odd_sums.iter().flatten() {
+                out.extend_from_slice(&value.to_le_bytes());
+            }
+            out.extend(adaptive.active.iter().map(|&a| a as u8));
         }
         let mut hash = Fnv1a::default();
         hash.write(&out);
@@ -124,7 +155,8 @@ impl Checkpoint {
             ));
         }
         let (width, height) = (u32_at(12) as usize, u32_at(16) as usize);
-        let mask = u32_at(28);
+        let adaptive = u32_at(28) & ADAPTIVE_BIT != 0;
+        let mask = u32_at(28) & !ADAPTIVE_BIT;
         let aovs: Vec<Aov> = Aov::ALL
             .into_iter()
             .filter(|a| mask & a.bit() != 0)
@@ -132,18 +164,48 @@ impl Checkpoint {
         if aovs.iter().map(|a| a.bit()).sum::<u32>() != mask {
             return Err(format!("its output mask {mask:#x} names unknown outputs"));
         }
+        // The size is checked before any buffer is made for it.
+        let values_per_pixel = 3
+            + 3 * aovs.contains(&Aov::Variance) as usize
+            + FIRST_HIT_VALUES * aovs.iter().any(|a| a.needs_first_hit()) as usize;
+        let pixels = width * height;
+        let sums_bytes = pixels
+            .checked_mul(8 * values_per_pixel)
+            .filter(|&n| n <= body.len() - HEADER_BYTES)
+            .ok_or_else(|| format!("its size does not fit a {width}x{height} film"))?;
+        let rest = &body[HEADER_BYTES + sums_bytes..];
+        let expected_rest = if adaptive {
+            12 + pixels * ADAPTIVE_PIXEL_BYTES
+        } else {
+            0
+        };
+        if rest.len() != expected_rest {
+            return Err(format!("its size does not fit a {width}x{height} film"));
+        }
         let mut film =
             Film::try_with_aovs(lumis_core::UVec2::new(width as u32, height as u32), &aovs)
                 .map_err(|e| e.to_string())?;
-        let values_per_pixel = 3
-            + 3 * film.squares.is_some() as usize
-            + FIRST_HIT_VALUES * film.first_hits.is_some() as usize;
-        width
-            .checked_mul(height)
-            .and_then(|n| n.checked_mul(8 * values_per_pixel))
-            .filter(|&n| n == body.len() - HEADER_BYTES)
-            .ok_or_else(|| format!("its size does not fit a {width}x{height} film"))?;
-        let mut values = body[HEADER_BYTES..]
+        if adaptive {
+            let u32_of = |i: usize| u32::from_le_bytes(rest[i..i + 4].try_into().unwrap());
+            let settings = AdaptiveSampling::new(u32_of(0), u32_of(4), f32::from_bits(u32_of(8)))
+                .map_err(|e| format!("its adaptive sampling: {e}"))?;
+            film = film.with_adaptive(settings).map_err(|e| e.to_string())?;
+            let state = film.adaptive.as_mut().unwrap();
+            let (counts, rest) = rest[12..].split_at(pixels * 4);
+            let (odd_sums, active) = rest.split_at(pixels * 24);
+            for (count, bytes) in state.counts.iter_mut().zip(counts.chunks_exact(4)) {
+                *count = u32::from_le_bytes(bytes.try_into().unwrap());
+            }
+            for (odd, bytes) in state.odd_sums.iter_mut().zip(odd_sums.chunks_exact(24)) {
+                *odd = std::array::from_fn(|c| {
+                    f64::from_le_bytes(bytes[c * 8..c * 8 + 8].try_into().unwrap())
+                });
+            }
+            for (flag, &byte) in state.active.iter_mut().zip(active) {
+                *flag = byte != 0;
+            }
+        }
+        let mut values = body[HEADER_BYTES..HEADER_BYTES + sums_bytes]
             .chunks_exact(8)
             .map(|v| f64::from_le_bytes(v.try_into().unwrap()));
         let mut next = || values.next().unwrap();
@@ -214,6 +276,13 @@ mod tests {
             FirstHitSums::default(),
         ]);
         film.samples = 7;
+        let mut film = film
+            .with_adaptive(AdaptiveSampling::new(2, 16, 0.05).unwrap())
+            .unwrap();
+        let adaptive = film.adaptive.as_mut().unwrap();
+        adaptive.counts = vec![7, 4];
+        adaptive.odd_sums = vec![[0.5, 0.25, -0.0], [1e-9, 2.0, 3.0]];
+        adaptive.active = vec![true, false];
         saved.film = film;
         let back = Checkpoint::from_bytes(&saved.to_bytes()).unwrap();
         assert_eq!(back, saved);

@@ -214,16 +214,20 @@ fn starting_state(
     args: &RenderArgs,
     checkpoint: &Path,
     scene_hash: u64,
-    seed: u64,
-    spp: u32,
-    resolution: lumis_core::UVec2,
-    aovs: &[Aov],
+    loaded: &LoadedScene,
 ) -> Result<Checkpoint> {
+    let (seed, aovs, adaptive) = (loaded.seed, &loaded.aovs, loaded.adaptive);
+    let spp = loaded.sampler.samples_per_pixel();
+    let resolution = loaded.camera.resolution();
     let saved = Checkpoint::read(checkpoint)
         .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
     let fresh = || -> Result<Checkpoint> {
+        let film = Film::try_with_aovs(resolution, aovs)?;
         Ok(Checkpoint {
-            film: Film::try_with_aovs(resolution, aovs)?,
+            film: match adaptive {
+                Some(settings) => film.with_adaptive(settings)?,
+                None => film,
+            },
             spp,
             passes: 0,
             seed,
@@ -269,6 +273,12 @@ fn starting_state(
             "it holds the outputs {}, not {}",
             names(&saved.film.aovs),
             names(&expected)
+        ));
+    }
+    if saved.film.adaptive.as_ref().map(|a| a.settings) != adaptive {
+        return refuse(format!(
+            "it samples {:?}, not {adaptive:?}",
+            saved.film.adaptive.as_ref().map(|a| a.settings)
         ));
     }
     if saved.spp != spp {
@@ -352,15 +362,7 @@ pub fn render_scene_file(
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
     let checkpoint_file = checkpoint_path(&exr);
     let resolution = loaded.camera.resolution();
-    let mut state = starting_state(
-        args,
-        &checkpoint_file,
-        scene_hash,
-        loaded.seed,
-        spp,
-        resolution,
-        &loaded.aovs,
-    )?;
+    let mut state = starting_state(args, &checkpoint_file, scene_hash, &loaded)?;
     // With --stats the scene, its plugins and the sampler run inside the
     // profiling wrappers; the render itself is the same call.
     if args.stats {

@@ -78,6 +78,7 @@ pub fn worker_threads(requested: usize) -> usize {
 struct Batch {
     rays: Vec<Ray>,
     pixel_of_lane: Vec<usize>,
+    index_of_lane: Vec<u32>,
     radiance: Vec<Rgb>,
     /// Lanes holding a ray.
     filled: usize,
@@ -125,15 +126,17 @@ impl Batch {
                 &mut self.radiance[..n],
             )
         });
-        for (&i, l) in self.pixel_of_lane[..n].iter().zip(&self.radiance) {
+        let lanes = self.pixel_of_lane[..n].iter().zip(&self.index_of_lane);
+        for ((&i, &index), l) in lanes.zip(&self.radiance) {
             stats.samples += 1;
+            film.count_sample(i);
             if !l.is_finite() {
                 stats.nonfinite += 1;
                 continue;
             }
             match clamp {
-                Some(max) => film.add_sample(i, clamp_radiance(*l, max)),
-                None => film.add_sample(i, *l),
+                Some(max) => film.add_sample(i, index, clamp_radiance(*l, max)),
+                None => film.add_sample(i, index, *l),
             }
         }
     }
@@ -171,6 +174,7 @@ fn render_tile(
     let mut batch = Batch {
         rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
         pixel_of_lane: vec![0; lanes.len()],
+        index_of_lane: vec![0; lanes.len()],
         radiance: vec![Rgb::BLACK; lanes.len()],
         filled: 0,
     };
@@ -184,6 +188,9 @@ fn render_tile(
             }
             for index in base..(base + samples_per_batch).min(samples.end) {
                 for i in pixels.clone() {
+                    if !film.is_active(i) {
+                        continue;
+                    }
                     let pixel =
                         UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
                     let lane = lanes.lane(batch.filled);
@@ -198,6 +205,7 @@ fn render_tile(
                         film.add_first_hit(i, &seen);
                     }
                     batch.pixel_of_lane[batch.filled] = i;
+                    batch.index_of_lane[batch.filled] = index;
                     batch.filled += 1;
                 }
             }
@@ -246,14 +254,40 @@ pub struct PassContext<'a> {
 }
 
 /// Adds sample indices `film.samples..film.samples + spp` of every pixel to
-/// `film`. Returns `None`, with `film` as it was, where `stop` was set
-/// before the pass finished: a film holds whole passes only, so every
-/// pixel has taken the same samples.
+/// `film` (of every pixel still sampling, with adaptive sampling, which
+/// checks the pixels at its fixed sample counts on the way). Returns
+/// `None` where `stop` was set before the pass finished, with `film`
+/// holding the runs of samples up to the last check passed, if any: a film
+/// holds whole runs only, so every pixel still sampling has taken the same
+/// samples.
 pub fn render_pass(ctx: &PassContext, film: &mut Film, spp: u32) -> Result<Option<PassOutput>> {
     let end = film
         .samples
         .checked_add(spp)
         .ok_or_else(|| Error::msg("more than 2^32 samples per pixel"))?;
+    let mut pass = PassOutput {
+        stats: RenderStats::default(),
+        seconds: 0.0,
+    };
+    while film.samples < end {
+        let run_end = match &film.adaptive {
+            Some(adaptive) => adaptive.settings.next_check(film.samples).min(end),
+            None => end,
+        };
+        let Some(run) = render_run(ctx, film, run_end)? else {
+            return Ok(None);
+        };
+        pass.stats += run.stats;
+        pass.seconds += run.seconds;
+        film.check_convergence();
+    }
+    Ok(Some(pass))
+}
+
+/// Adds sample indices `film.samples..end` of every pixel still sampling
+/// to `film`; `None`, with `film` as it was, once `stop` is set.
+fn render_run(ctx: &PassContext, film: &mut Film, end: u32) -> Result<Option<PassOutput>> {
+    let spp = end - film.samples;
     let samples = film.samples..end;
     let resolution = UVec2::new(film.width as u32, film.height as u32);
     let tiles = tiles(resolution);

@@ -11,6 +11,7 @@
 use lumis_core::{Error, Result, Rgb, UVec2};
 use lumis_image::Image;
 
+use crate::adaptive::{pixel_error, still_active, AdaptiveSampling};
 use crate::aov::Aov;
 use crate::first_hit::FirstHit;
 
@@ -20,6 +21,19 @@ pub struct FirstHitSums {
     pub albedo: [f64; 3],
     pub normal: [f64; 3],
     pub depth: f64,
+}
+
+/// What adaptive sampling keeps per pixel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AdaptiveState {
+    pub settings: AdaptiveSampling,
+    /// Samples each pixel has taken: indices `0..counts[i]`.
+    pub counts: Vec<u32>,
+    /// The sum of each pixel's odd-index samples: one of two independent
+    /// half-buffers (the other is the sum of the rest).
+    pub odd_sums: Vec<[f64; 3]>,
+    /// Pixels still sampling; a pixel that stopped never starts again.
+    pub active: Vec<bool>,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -39,7 +53,10 @@ pub struct Film {
     pub first_hits: Option<Vec<FirstHitSums>>,
     /// The outputs asked for, each once, in [`Aov::ALL`]'s order.
     pub aovs: Vec<Aov>,
-    /// Samples every pixel has taken: indices `0..samples` of the sampler.
+    /// With adaptive sampling, the per-pixel counts and half-buffers.
+    pub adaptive: Option<AdaptiveState>,
+    /// Sample indices `0..samples` of the sampler have been rendered: every
+    /// pixel has taken them all, or (adaptive sampling) stopped before.
     pub samples: u32,
 }
 
@@ -91,17 +108,81 @@ impl Film {
                 aovs.dedup();
                 aovs
             },
+            adaptive: None,
             samples: 0,
         })
     }
 
-    /// Adds a finite radiance sample to pixel `i`.
+    /// This film, sampling adaptively as `settings` say.
+    pub fn with_adaptive(mut self, settings: AdaptiveSampling) -> Result<Self> {
+        let count = self.sums.len();
+        let too_large = || Error::msg("film: no memory for adaptive sampling's buffers");
+        self.adaptive = Some(AdaptiveState {
+            settings,
+            counts: try_buffer(count, 0, too_large)?,
+            odd_sums: try_buffer(count, [0.0; 3], too_large)?,
+            active: try_buffer(count, true, too_large)?,
+        });
+        Ok(self)
+    }
+
+    /// Whether pixel `i` takes the next samples.
     #[inline]
-    pub fn add_sample(&mut self, i: usize, l: Rgb) {
+    pub fn is_active(&self, i: usize) -> bool {
+        self.adaptive.as_ref().is_none_or(|a| a.active[i])
+    }
+
+    /// The samples pixel `i` has taken.
+    #[inline]
+    pub fn samples_of(&self, i: usize) -> u32 {
+        self.adaptive.as_ref().map_or(self.samples, |a| a.counts[i])
+    }
+
+    /// After `samples` sample indices: stops the pixels adaptive sampling
+    /// finds converged, where `samples` is one of its checks.
+    pub fn check_convergence(&mut self) {
+        let (width, height, samples) = (self.width, self.height, self.samples);
+        let Some(adaptive) = &mut self.adaptive else {
+            return;
+        };
+        if !adaptive.settings.is_check(samples) {
+            return;
+        }
+        let threshold = adaptive.settings.threshold as f64;
+        let sums = &self.sums;
+        let next = {
+            let a = &*adaptive;
+            still_active(width, height, &a.active, |i| {
+                pixel_error(sums[i], a.odd_sums[i], a.counts[i]) < threshold
+            })
+        };
+        adaptive.active = next;
+    }
+
+    /// Counts sample `index` of pixel `i`, whether finite or not (a NaN
+    /// or infinite sample counts as a sample of zero).
+    #[inline]
+    pub fn count_sample(&mut self, i: usize) {
+        if let Some(adaptive) = &mut self.adaptive {
+            adaptive.counts[i] += 1;
+        }
+    }
+
+    /// Adds finite radiance sample `index` to pixel `i`.
+    #[inline]
+    pub fn add_sample(&mut self, i: usize, index: u32, l: Rgb) {
         let l = [l.r as f64, l.g as f64, l.b as f64];
         let sum = &mut self.sums[i];
         for c in 0..3 {
             sum[c] += l[c];
+        }
+        if let Some(adaptive) = &mut self.adaptive {
+            if index % 2 == 1 {
+                let odd = &mut adaptive.odd_sums[i];
+                for c in 0..3 {
+                    odd[c] += l[c];
+                }
+            }
         }
         if let Some(squares) = &mut self.squares {
             let square = &mut squares[i];
@@ -144,6 +225,16 @@ impl Film {
                     .collect()
             }),
             aovs: self.aovs.clone(),
+            adaptive: self.adaptive.as_ref().map(|a| AdaptiveState {
+                settings: a.settings,
+                counts: rows()
+                    .flat_map(|row| a.counts[row + x0..row + x1].iter().copied())
+                    .collect(),
+                odd_sums: crop(&a.odd_sums),
+                active: rows()
+                    .flat_map(|row| a.active[row + x0..row + x1].iter().copied())
+                    .collect(),
+            }),
             samples: self.samples,
         }
     }
@@ -164,13 +255,17 @@ impl Film {
         if let (Some(to), Some(from)) = (&mut self.first_hits, &tile.first_hits) {
             paste_rows(to, width, min, from, tw);
         }
+        if let (Some(to), Some(from)) = (&mut self.adaptive, &tile.adaptive) {
+            paste_rows(&mut to.counts, width, min, &from.counts, tw);
+            paste_rows(&mut to.odd_sums, width, min, &from.odd_sums, tw);
+        }
     }
 
-    fn inverse_samples(&self) -> f64 {
-        if self.samples == 0 {
-            0.0
-        } else {
-            1.0 / self.samples as f64
+    /// `1 / n` for pixel `i`'s sample count `n`; 0 before any sample.
+    fn inverse_samples(&self, i: usize) -> f64 {
+        match self.samples_of(i) {
+            0 => 0.0,
+            n => 1.0 / n as f64,
         }
     }
 
@@ -186,8 +281,7 @@ impl Film {
 
     /// The image: each pixel's mean, black before any sample.
     pub fn image(&self) -> Image {
-        let inv = self.inverse_samples();
-        self.image_of(|i| self.sums[i].map(|s| s * inv))
+        self.image_of(|i| self.sums[i].map(|s| s * self.inverse_samples(i)))
     }
 
     /// The image of one output, or `None` for one this film was not made
@@ -196,35 +290,38 @@ impl Film {
         if !self.aovs.contains(&aov) {
             return None;
         }
-        let inv = self.inverse_samples();
-        let n = self.samples as f64;
+        let inv = |i| self.inverse_samples(i);
         Some(match aov {
             Aov::Albedo => {
                 let hits = self.first_hits.as_ref()?;
-                self.image_of(|i| hits[i].albedo.map(|s| s * inv))
+                self.image_of(|i| hits[i].albedo.map(|s| s * inv(i)))
             }
             Aov::Normal => {
                 let hits = self.first_hits.as_ref()?;
-                self.image_of(|i| hits[i].normal.map(|s| s * inv))
+                self.image_of(|i| hits[i].normal.map(|s| s * inv(i)))
             }
             Aov::Depth => {
                 let hits = self.first_hits.as_ref()?;
-                self.image_of(|i| [hits[i].depth * inv; 3])
+                self.image_of(|i| [hits[i].depth * inv(i); 3])
             }
             Aov::Variance => {
                 let squares = self.squares.as_ref()?;
                 // The unbiased sample variance s² = (Σx² − (Σx)²/n)/(n − 1),
                 // over n for the variance of the mean; 0 below two samples.
-                let of_mean = |sum: f64, square: f64| {
-                    if self.samples < 2 {
+                let of_mean = |sum: f64, square: f64, n: u32| {
+                    let n = n as f64;
+                    if n < 2.0 {
                         0.0
                     } else {
                         ((square - sum * sum / n) / ((n - 1.0) * n)).max(0.0)
                     }
                 };
-                self.image_of(|i| std::array::from_fn(|c| of_mean(self.sums[i][c], squares[i][c])))
+                self.image_of(|i| {
+                    let n = self.samples_of(i);
+                    std::array::from_fn(|c| of_mean(self.sums[i][c], squares[i][c], n))
+                })
             }
-            Aov::Spp => self.image_of(|_| [n; 3]),
+            Aov::Spp => self.image_of(|i| [self.samples_of(i) as f64; 3]),
         })
     }
 
@@ -270,7 +367,7 @@ mod tests {
     fn variance_is_that_of_the_mean() {
         let mut film = Film::try_with_aovs(UVec2::new(1, 1), &[Aov::Variance]).unwrap();
         for x in [1.0, 2.0, 3.0, 6.0] {
-            film.add_sample(0, Rgb::new(x, 2.0 * x, 5.0));
+            film.add_sample(0, 0, Rgb::new(x, 2.0 * x, 5.0));
         }
         film.samples = 4;
         // Sample variance of {1, 2, 3, 6}: 14/3; of the mean: 14/12.
@@ -283,11 +380,16 @@ mod tests {
     #[test]
     fn crop_and_paste_round_trip() {
         let aovs = [Aov::Variance, Aov::Albedo];
-        let mut film = Film::try_with_aovs(UVec2::new(5, 4), &aovs).unwrap();
+        let adaptive = AdaptiveSampling::new(2, 4, 0.1).unwrap();
+        let mut film = Film::try_with_aovs(UVec2::new(5, 4), &aovs)
+            .unwrap()
+            .with_adaptive(adaptive)
+            .unwrap();
         let mut tile = film.crop(UVec2::new(1, 2), UVec2::new(4, 4));
         assert_eq!((tile.width, tile.height), (3, 2));
         for i in 0..6 {
-            tile.add_sample(i, Rgb::new(i as f32, 0.0, 1.0));
+            tile.add_sample(i, 1, Rgb::new(i as f32, 0.0, 1.0));
+            tile.count_sample(i);
             tile.add_first_hit(
                 i,
                 &FirstHit {

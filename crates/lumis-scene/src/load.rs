@@ -30,6 +30,8 @@ pub struct LoadedScene {
     pub aovs: Vec<lumis_render::Aov>,
     /// `integrator.clamp`: the cap on each sample's largest component.
     pub clamp: Option<f32>,
+    /// `sampler.adaptive`, its `max_spp` the sampler's spp.
+    pub adaptive: Option<lumis_render::AdaptiveSampling>,
 }
 
 /// A scene is text a person writes: far below this bound, which refuses
@@ -128,6 +130,14 @@ pub fn load_str(
                 .pixel_footprint(plugins.sampler.samples_per_pixel())
         }),
     };
+    let adaptive = description
+        .adaptive
+        .map(|a| {
+            let spp = plugins.sampler.samples_per_pixel();
+            lumis_render::AdaptiveSampling::new(a.min_spp, a.max_spp.unwrap_or(spp), a.threshold)
+                .map_err(|e| Error::at(&a.location, format!("[sampler] {}", e.message)))
+        })
+        .transpose()?;
     Ok(LoadedScene {
         name: name.to_string(),
         scene,
@@ -138,5 +148,6 @@ pub fn load_str(
         output: description.film.output,
         aovs: description.film.aovs,
         clamp: description.clamp,
+        adaptive,
     })
 }

@@ -9,6 +9,7 @@
 //! here, except the glTF asset a `[camera] type = "gltf"` names.
 
 mod accel;
+mod adaptive;
 mod camera;
 mod clamp;
 mod document;
@@ -28,6 +29,7 @@ use lumis_render::PerspectiveCamera;
 
 pub(crate) use accel::AccelOptions;
 pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
+pub(crate) use adaptive::AdaptiveDescription;
 pub(crate) use film::FilmDescription;
 pub(crate) use named::NamedPlugin;
 pub(crate) use plugin_libraries::PluginLibraries;
@@ -58,6 +60,8 @@ pub(crate) struct SceneDescription {
     pub plugin_libraries: PluginLibraries,
     pub accel: AccelOptions,
     pub sampler: PluginEntity,
+    /// `[sampler] adaptive`.
+    pub adaptive: Option<AdaptiveDescription>,
     pub integrator: PluginEntity,
     /// `[integrator] clamp`: the cap on each sample's largest component.
     pub clamp: Option<f32>,
@@ -117,7 +121,16 @@ impl SceneDescription {
             )?,
             None => default_light_sampler(),
         };
-        let sampler = required_plugin(&mut root, PluginKind::Sampler, file)?;
+        let (mut sampler_table, sampler_location) =
+            take_required_table(&mut root, PluginKind::Sampler.table_name(), file)?;
+        let adaptive = adaptive::take_adaptive(&mut sampler_table)?;
+        let sampler = PluginEntity::from_table(
+            PluginKind::Sampler,
+            PluginKind::Sampler.table_name(),
+            sampler_table,
+            sampler_location,
+            TYPE_KEY,
+        )?;
         let (mut integrator_table, integrator_location) =
             take_required_table(&mut root, PluginKind::Integrator.table_name(), file)?;
         let clamp = clamp::take_clamp(&mut integrator_table)?;
@@ -135,6 +148,7 @@ impl SceneDescription {
             plugin_libraries,
             accel,
             sampler,
+            adaptive,
             integrator,
             clamp,
             light_sampler,
@@ -158,14 +172,6 @@ fn default_light_sampler() -> PluginEntity {
         Table::default(),
         Location::Builtin,
     )
-}
-
-/// The top-level table of a plugin `kind` the scene must have
-/// (`[sampler]`, `[integrator]`).
-fn required_plugin(root: &mut Table, kind: PluginKind, file: &Location) -> Result<PluginEntity> {
-    let key = kind.table_name();
-    let (table, location) = take_required_table(root, key, file)?;
-    PluginEntity::from_table(kind, key, table, location, TYPE_KEY)
 }
 
 fn check_top_level_keys(root: &Table) -> Result<()> {

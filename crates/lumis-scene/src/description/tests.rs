@@ -165,3 +165,44 @@ fn integrator_clamp_is_read_by_the_scene_not_the_plugin() {
         assert!(err.contains("clamp"), "{bad}: {err}");
     }
 }
+
+#[test]
+fn sampler_adaptive_is_read_by_the_scene_and_sets_the_spp() {
+    let with = |adaptive: &str, spp: &str| {
+        try_describe(&BASE.replace(
+            "type = \"independent\"\n",
+            &format!("type = \"independent\"\n{spp}adaptive = {adaptive}\n"),
+        ))
+    };
+    let scene = with("{ min_spp = 4, max_spp = 64, threshold = 0.01 }", "").unwrap();
+    let adaptive = scene.adaptive.unwrap();
+    assert_eq!((adaptive.min_spp, adaptive.max_spp), (4, Some(64)));
+    assert_eq!(adaptive.threshold, 0.01);
+    assert!(scene.sampler.table.get("adaptive").is_none());
+    assert_eq!(
+        scene.sampler.table.get("spp").map(|n| n.value.clone()),
+        Some(lumis_core::doc::Value::Int(64))
+    );
+    let same = with(
+        "{ min_spp = 4, max_spp = 64, threshold = 0.01 }",
+        "spp = 64\n",
+    );
+    assert!(same.is_ok());
+    for (adaptive, spp, expected) in [
+        (
+            "{ min_spp = 4, max_spp = 64, threshold = 0.01 }",
+            "spp = 32\n",
+            "disagree",
+        ),
+        (
+            "{ min_spp = 4, threshold = 0.01, spread = 2 }",
+            "",
+            "spread",
+        ),
+        ("{ max_spp = 4, threshold = 0.01 }", "", "min_spp"),
+        ("4", "", "expected a table"),
+    ] {
+        let err = with(adaptive, spp).err().unwrap().to_string();
+        assert!(err.contains(expected), "{adaptive}: {err}");
+    }
+}
