@@ -122,6 +122,7 @@ fn concrete_and_dyn_scene_loops_agree() {
             seed: loaded.seed,
             threads: 1,
             progress: false,
+            clamp: loaded.clamp,
         };
         let run = |scene: &dyn Scene| {
             render(

@@ -441,6 +441,7 @@ fn render_image(scene: &LoadedScene) -> Vec<f32> {
         seed: scene.seed,
         threads: 2,
         progress: false,
+        clamp: scene.clamp,
     };
     let out = render(
         &scene.camera,
@@ -1323,6 +1324,7 @@ fn instanced_and_baked_meshes_render_alike() {
                 seed: s.seed,
                 threads: 2,
                 progress: false,
+                clamp: s.clamp,
             },
         )
         .unwrap()

@@ -30,6 +30,7 @@ fn render_opaque(loaded: &LoadedScene) -> RenderOutput {
         seed: loaded.seed,
         threads: 2,
         progress: false,
+        clamp: loaded.clamp,
     };
     render(
         &loaded.camera,

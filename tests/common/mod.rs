@@ -45,6 +45,7 @@ pub fn render_loaded(loaded: &LoadedScene, threads: usize) -> RenderOutput {
         seed: loaded.seed,
         threads,
         progress: false,
+        clamp: loaded.clamp,
     };
     render(
         &loaded.camera,

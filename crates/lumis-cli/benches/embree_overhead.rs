@@ -111,6 +111,7 @@ fn overhead(scene_path: &str, spp: u32, registry: &Registry) {
         seed: loaded.seed,
         threads: 1,
         progress: false,
+        clamp: loaded.clamp,
     };
     let run = |scene: &dyn Scene| {
         render(
@@ -385,6 +386,7 @@ fn packets(scene_path: &str, spp: u32, registry: &Registry) {
         seed: loaded.seed,
         threads: 1,
         progress: false,
+        clamp: loaded.clamp,
     };
     let camera_ray = loaded.camera.generate_ray(UVec2::ZERO, Vec2::splat(0.5));
     let recording = BatchRecording {

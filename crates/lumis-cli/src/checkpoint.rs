@@ -3,25 +3,41 @@
 //! render makes, bit for bit.
 //!
 //! The file holds the film's per-pixel sums in double precision (an image
-//! of means, rounded to `f32`, could not be continued exactly), the sample
-//! count, the passes, the seed and the scene hash, in little-endian binary
-//! behind a magic number and followed by an FNV-1a checksum of all of it:
+//! of means, rounded to `f32`, could not be continued exactly), the sums
+//! behind the outputs the scene asks for (`aovs`, a mask of
+//! [`Aov::bit`]s: the squares with `variance`, the first-hit sums with
+//! `albedo`, `normal` or `depth`), the sample count, the passes, the seed
+//! and the scene hash, in little-endian binary behind a magic number and
+//! followed by an FNV-1a checksum of all of it:
 //!
 //! ```text
-//! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 spp:u32 passes:u64
-//! seed:u64 scene_hash:u64 seconds:f64 sums:[f64; 3 * width * height] checksum:u64
+//! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 spp:u32 aovs:u32
+//! passes:u64 seed:u64 scene_hash:u64 seconds:f64 sums:[f64; 3 * width * height]
+//! squares:[f64; 3 * width * height]? first_hits:[f64; 7 * width * height]?
+//! adaptive? checksum:u64
 //! ```
+//!
+//! With adaptive sampling (bit 31 of `aovs`), `adaptive` is its settings
+//! and per-pixel state: `min_spp:u32 max_spp:u32 threshold:f32
+//! counts:[u32; width * height] odd_sums:[f64; 3 * width * height]
+//! active:[u8; width * height]`.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
-use lumis_render::Film;
+use lumis_render::{AdaptiveSampling, Aov, Film, FirstHitSums};
 use lumis_scene::Fnv1a;
 
 const MAGIC: &[u8; 8] = b"LUMISCKP";
-const VERSION: u32 = 1;
-const HEADER_BYTES: usize = 8 + 5 * 4 + 4 * 8;
+const VERSION: u32 = 2;
+const HEADER_BYTES: usize = 8 + 6 * 4 + 4 * 8;
+/// `f64`s per pixel of the first-hit sums: albedo, normal, depth.
+const FIRST_HIT_VALUES: usize = 7;
+/// The bit of the `aovs` mask saying the film samples adaptively.
+const ADAPTIVE_BIT: u32 = 1 << 31;
+/// Bytes per pixel of the adaptive state: count, odd sums, active flag.
+const ADAPTIVE_PIXEL_BYTES: usize = 4 + 24 + 1;
 
 /// A render's state between passes.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,6 +71,12 @@ impl Checkpoint {
             film.height as u32,
             film.samples,
             self.spp,
+            film.aovs.iter().map(|a| a.bit()).sum::<u32>()
+                | if film.adaptive.is_some() {
+                    ADAPTIVE_BIT
+                } else {
+                    0
+                },
         ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -62,10 +84,32 @@ impl Checkpoint {
             out.extend_from_slice(&v.to_le_bytes());
         }
         out.extend_from_slice(&self.seconds.to_le_bytes());
-        for sum in &film.sums {
-            for c in sum {
-                out.extend_from_slice(&c.to_le_bytes());
+        let buffers = film.sums.iter().chain(film.squares.iter().flatten());
+        for value in buffers.flatten() {
+            out.extend_from_slice(&value.to_le_bytes());
+        }
+        for hit in film.first_hits.iter().flatten() {
+            let values = hit.albedo.iter().chain(&hit.normal).chain([&hit.depth]);
+            for value in values {
+                out.extend_from_slice(&value.to_le_bytes());
             }
+        }
+        if let Some(adaptive) = &film.adaptive {
+            let settings = adaptive.settings;
+            for v in [
+                settings.min_spp,
+                settings.max_spp,
+                settings.threshold.to_bits(),
+            ] {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+            for count in &adaptive.counts {
+                out.extend_from_slice(&count.to_le_bytes());
+            }
+            for value in adaptive.odd_sums.iter().flatten() {
+                out.extend_from_slice(&value.to_le_bytes());
+            }
+            out.extend(adaptive.active.iter().map(|&a| a as u8));
         }
         let mut hash = Fnv1a::default();
         hash.write(&out);
@@ -111,29 +155,80 @@ impl Checkpoint {
             ));
         }
         let (width, height) = (u32_at(12) as usize, u32_at(16) as usize);
-        let pixels = width
-            .checked_mul(height)
-            .filter(|n| n.checked_mul(24) == Some(body.len() - HEADER_BYTES))
+        let adaptive = u32_at(28) & ADAPTIVE_BIT != 0;
+        let mask = u32_at(28) & !ADAPTIVE_BIT;
+        let aovs: Vec<Aov> = Aov::ALL
+            .into_iter()
+            .filter(|a| mask & a.bit() != 0)
+            .collect();
+        if aovs.iter().map(|a| a.bit()).sum::<u32>() != mask {
+            return Err(format!("its output mask {mask:#x} names unknown outputs"));
+        }
+        // The size is checked before any buffer is made for it.
+        let values_per_pixel = 3
+            + 3 * aovs.contains(&Aov::Variance) as usize
+            + FIRST_HIT_VALUES * aovs.iter().any(|a| a.needs_first_hit()) as usize;
+        let pixels = width * height;
+        let sums_bytes = pixels
+            .checked_mul(8 * values_per_pixel)
+            .filter(|&n| n <= body.len() - HEADER_BYTES)
             .ok_or_else(|| format!("its size does not fit a {width}x{height} film"))?;
-        let sums = body[HEADER_BYTES..]
-            .chunks_exact(24)
-            .map(|p| {
-                std::array::from_fn(|c| f64::from_le_bytes(p[c * 8..c * 8 + 8].try_into().unwrap()))
-            })
-            .collect::<Vec<[f64; 3]>>();
-        debug_assert_eq!(sums.len(), pixels);
+        let rest = &body[HEADER_BYTES + sums_bytes..];
+        let expected_rest = if adaptive {
+            12 + pixels * ADAPTIVE_PIXEL_BYTES
+        } else {
+            0
+        };
+        if rest.len() != expected_rest {
+            return Err(format!("its size does not fit a {width}x{height} film"));
+        }
+        let mut film =
+            Film::try_with_aovs(lumis_core::UVec2::new(width as u32, height as u32), &aovs)
+                .map_err(|e| e.to_string())?;
+        if adaptive {
+            let u32_of = |i: usize| u32::from_le_bytes(rest[i..i + 4].try_into().unwrap());
+            let settings = AdaptiveSampling::new(u32_of(0), u32_of(4), f32::from_bits(u32_of(8)))
+                .map_err(|e| format!("its adaptive sampling: {e}"))?;
+            film = film.with_adaptive(settings).map_err(|e| e.to_string())?;
+            let state = film.adaptive.as_mut().unwrap();
+            let (counts, rest) = rest[12..].split_at(pixels * 4);
+            let (odd_sums, active) = rest.split_at(pixels * 24);
+            for (count, bytes) in state.counts.iter_mut().zip(counts.chunks_exact(4)) {
+                *count = u32::from_le_bytes(bytes.try_into().unwrap());
+            }
+            for (odd, bytes) in state.odd_sums.iter_mut().zip(odd_sums.chunks_exact(24)) {
+                *odd = std::array::from_fn(|c| {
+                    f64::from_le_bytes(bytes[c * 8..c * 8 + 8].try_into().unwrap())
+                });
+            }
+            for (flag, &byte) in state.active.iter_mut().zip(active) {
+                *flag = byte != 0;
+            }
+        }
+        let mut values = body[HEADER_BYTES..HEADER_BYTES + sums_bytes]
+            .chunks_exact(8)
+            .map(|v| f64::from_le_bytes(v.try_into().unwrap()));
+        let mut next = || values.next().unwrap();
+        for buffer in std::iter::once(&mut film.sums).chain(film.squares.as_mut()) {
+            for pixel in buffer {
+                *pixel = std::array::from_fn(|_| next());
+            }
+        }
+        for hit in film.first_hits.iter_mut().flatten() {
+            *hit = FirstHitSums {
+                albedo: std::array::from_fn(|_| next()),
+                normal: std::array::from_fn(|_| next()),
+                depth: next(),
+            };
+        }
+        film.samples = u32_at(20);
         Ok(Self {
-            film: Film {
-                width,
-                height,
-                sums,
-                samples: u32_at(20),
-            },
+            film,
             spp: u32_at(24),
-            passes: u64_at(28),
-            seed: u64_at(36),
-            scene_hash: u64_at(44),
-            seconds: f64::from_bits(u64_at(52)),
+            passes: u64_at(32),
+            seed: u64_at(40),
+            scene_hash: u64_at(48),
+            seconds: f64::from_bits(u64_at(56)),
         })
     }
 }
@@ -143,13 +238,11 @@ mod tests {
     use super::*;
 
     fn example() -> Checkpoint {
+        let mut film = Film::try_new(lumis_core::UVec2::new(2, 1)).unwrap();
+        film.sums = vec![[1.0, -0.0, f64::MIN_POSITIVE], [3.5, 1e300, 0.1]];
+        film.samples = 7;
         Checkpoint {
-            film: Film {
-                width: 2,
-                height: 1,
-                sums: vec![[1.0, -0.0, f64::MIN_POSITIVE], [3.5, 1e300, 0.1]],
-                samples: 7,
-            },
+            film,
             spp: 16,
             passes: 3,
             seed: u64::MAX,
@@ -165,6 +258,35 @@ mod tests {
         assert_eq!(Checkpoint::read(&path).unwrap(), None);
         example().write(&path).unwrap();
         assert_eq!(Checkpoint::read(&path).unwrap(), Some(example()));
+    }
+
+    #[test]
+    fn the_outputs_sums_round_trip_exactly() {
+        let mut saved = example();
+        let aovs = [Aov::Spp, Aov::Variance, Aov::Normal];
+        let mut film = Film::try_with_aovs(lumis_core::UVec2::new(2, 1), &aovs).unwrap();
+        film.sums = saved.film.sums.clone();
+        film.squares = Some(vec![[2.0, 0.5, 1e-300], [7.0, 8.0, 9.0]]);
+        film.first_hits = Some(vec![
+            FirstHitSums {
+                albedo: [0.1, 0.2, 0.3],
+                normal: [-1.0, 0.0, 1.0],
+                depth: 12.5,
+            },
+            FirstHitSums::default(),
+        ]);
+        film.samples = 7;
+        let mut film = film
+            .with_adaptive(AdaptiveSampling::new(2, 16, 0.05).unwrap())
+            .unwrap();
+        let adaptive = film.adaptive.as_mut().unwrap();
+        adaptive.counts = vec![7, 4];
+        adaptive.odd_sums = vec![[0.5, 0.25, -0.0], [1e-9, 2.0, 3.0]];
+        adaptive.active = vec![true, false];
+        saved.film = film;
+        let back = Checkpoint::from_bytes(&saved.to_bytes()).unwrap();
+        assert_eq!(back, saved);
+        assert_eq!(back.film.aovs, [Aov::Normal, Aov::Variance, Aov::Spp]);
     }
 
     #[test]

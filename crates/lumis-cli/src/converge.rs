@@ -243,6 +243,7 @@ pub fn converge(
             seed,
             threads: args.threads,
             progress: false,
+            clamp: loaded.clamp,
         };
         let out = render(
             &loaded.camera,

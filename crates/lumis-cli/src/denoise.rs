@@ -65,7 +65,7 @@ pub fn write_denoised(
         height: color.height,
         pixels,
     };
-    outputs.write(&denoised, metadata).map_err(failed)
+    outputs.write(&denoised, &[], metadata).map_err(failed)
 }
 
 #[cfg(test)]

@@ -356,6 +356,7 @@ fn settings(loaded: &lumis_scene::LoadedScene, seed: u64) -> RenderSettings {
         seed,
         threads: 0,
         progress: false,
+        clamp: loaded.clamp,
     }
 }
 

@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
-use lumis_image::{Image, OutputLock};
+use lumis_image::{ExrLayer, Image, OutputLock};
+use lumis_render::Aov;
 
 use crate::checkpoint::checkpoint_path;
 use crate::metadata::ImageMetadata;
@@ -40,18 +41,33 @@ impl Outputs {
         })
     }
 
-    /// Writes the image: both files are written in full under temporary
-    /// names first, then the PNG renamed into place and the EXR last. A
+    /// Writes the image, with `aovs` as named layers of the EXR beside the
+    /// colour (the PNG is the colour alone): both files are written in
+    /// full under temporary names first, then the PNG renamed into place and the EXR last. A
     /// failure before the renames (a full disk) leaves both old files; a
     /// kill between them leaves a new PNG beside the old EXR, whose header
     /// still tells the truth about itself.
-    pub fn write(&self, image: &Image, metadata: &ImageMetadata) -> Result<()> {
+    pub fn write(
+        &self,
+        image: &Image,
+        aovs: &[(Aov, Image)],
+        metadata: &ImageMetadata,
+    ) -> Result<()> {
         let png = match &self.png {
             Some(path) => Some(lumis_image::stage_png(path, image).map_err(image_error)?),
             None => None,
         };
-        let exr = lumis_image::stage_exr(&self.exr, image, &metadata.attributes())
-            .map_err(image_error)?;
+        let layers: Vec<ExrLayer> = aovs
+            .iter()
+            .map(|(aov, image)| ExrLayer {
+                name: aov.name(),
+                channels: aov.channels(),
+                image,
+            })
+            .collect();
+        let exr =
+            lumis_image::stage_exr_with_layers(&self.exr, image, &layers, &metadata.attributes())
+                .map_err(image_error)?;
         if let Some(png) = png {
             png.commit().map_err(image_error)?;
         }

@@ -180,6 +180,7 @@ pub fn render_reference(
             integrator: loaded.integrator.as_ref(),
             sampler: loaded.sampler.as_ref(),
             seed,
+            clamp: loaded.clamp,
             pool: &pool,
             progress: &progress,
             stop,
@@ -218,7 +219,7 @@ pub fn render_reference(
         meta.seconds += out.seconds;
         meta.version = lumis_version();
         if let Some(image) = &mean {
-            outputs.write(image, &meta)?;
+            outputs.write(image, &[], &meta)?;
         }
     }
     Ok((exr, meta))

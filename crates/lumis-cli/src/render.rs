@@ -8,7 +8,9 @@ use std::time::Instant;
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
-use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, RenderProgress};
+use lumis_render::{
+    progress_units, render_pass, Aov, Film, PassContext, RenderPool, RenderProgress,
+};
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
@@ -78,6 +80,8 @@ const PASS_SECONDS: f64 = 2.0;
 /// The outcome of a render, for the summary line and for tests.
 pub struct RenderReport {
     pub image: Image,
+    /// The outputs `[film] aovs` asked for, as the EXR holds them.
+    pub aovs: Vec<(Aov, Image)>,
     pub exr: PathBuf,
     pub png: PathBuf,
     /// The denoised EXR, when the scene has a `[denoiser]`.
@@ -215,15 +219,20 @@ fn starting_state(
     args: &RenderArgs,
     checkpoint: &Path,
     scene_hash: u64,
-    seed: u64,
-    spp: u32,
-    resolution: lumis_core::UVec2,
+    loaded: &LoadedScene,
 ) -> Result<Checkpoint> {
+    let (seed, aovs, adaptive) = (loaded.seed, &loaded.aovs, loaded.adaptive);
+    let spp = loaded.sampler.samples_per_pixel();
+    let resolution = loaded.camera.resolution();
     let saved = Checkpoint::read(checkpoint)
         .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
     let fresh = || -> Result<Checkpoint> {
+        let film = Film::try_with_aovs(resolution, aovs)?;
         Ok(Checkpoint {
-            film: Film::try_new(resolution)?,
+            film: match adaptive {
+                Some(settings) => film.with_adaptive(settings)?,
+                None => film,
+            },
             spp,
             passes: 0,
             seed,
@@ -262,6 +271,21 @@ fn starting_state(
             saved.film.width, saved.film.height, resolution.x, resolution.y
         ));
     }
+    let expected = Film::try_with_aovs(lumis_core::UVec2::ONE, aovs)?.aovs;
+    if saved.film.aovs != expected {
+        let names = |aovs: &[Aov]| format!("{aovs:?}").to_lowercase();
+        return refuse(format!(
+            "it holds the outputs {}, not {}",
+            names(&saved.film.aovs),
+            names(&expected)
+        ));
+    }
+    if saved.film.adaptive.as_ref().map(|a| a.settings) != adaptive {
+        return refuse(format!(
+            "it samples {:?}, not {adaptive:?}",
+            saved.film.adaptive.as_ref().map(|a| a.settings)
+        ));
+    }
     if saved.spp != spp {
         return refuse(format!(
             "it is a render of {} spp, not {spp} (a sampler may place each sample by the total count)",
@@ -289,6 +313,11 @@ fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) ->
         }
     };
     spp.clamp(1, remaining)
+}
+
+/// Writes the film's colour and outputs.
+fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Result<()> {
+    outputs.write(&film.image(), &film.aov_images(), metadata)
 }
 
 /// Renders a scene file and writes `PATH.exr` and `PATH.png`, in passes,
@@ -343,14 +372,7 @@ pub fn render_scene_file(
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
     let checkpoint_file = checkpoint_path(&exr);
     let resolution = loaded.camera.resolution();
-    let mut state = starting_state(
-        args,
-        &checkpoint_file,
-        scene_hash,
-        loaded.seed,
-        spp,
-        resolution,
-    )?;
+    let mut state = starting_state(args, &checkpoint_file, scene_hash, &loaded)?;
     // With --stats the scene, its plugins and the sampler run inside the
     // profiling wrappers; the render itself is the same call.
     if args.stats {
@@ -375,6 +397,7 @@ pub fn render_scene_file(
         integrator: loaded.integrator.as_ref(),
         sampler,
         seed: loaded.seed,
+        clamp: loaded.clamp,
         pool: &pool,
         progress: &progress,
         stop,
@@ -392,7 +415,7 @@ pub fn render_scene_file(
     };
     let save = |state: &Checkpoint| -> Result<()> {
         state.write(&checkpoint_file)?;
-        outputs.write(&state.film.image(), &metadata(state))
+        write_film(&outputs, &state.film, &metadata(state))
     };
     let profile = args.stats.then(Profile::start);
     let mut stats = RenderStats::default();
@@ -445,7 +468,7 @@ pub fn render_scene_file(
             exr.display()
         );
     } else {
-        outputs.write(&state.film.image(), &metadata(&state))?;
+        write_film(&outputs, &state.film, &metadata(&state))?;
         // Last: a kill before this line leaves a checkpoint that resumes
         // to the same, finished image.
         match std::fs::remove_file(&checkpoint_file) {
@@ -463,13 +486,15 @@ pub fn render_scene_file(
     // Only a finished render is denoised, after its raw image is on disk.
     let denoised = match (&loaded.denoiser, &denoised_outputs) {
         (Some(denoiser), Some(denoised)) if !interrupted => {
-            // The film's albedo and normal AOVs guide the denoiser once the
-            // film produces them; until then it sees the colour alone.
+            // The film's albedo and normal (which a scene with a denoiser
+            // always makes) guide it.
+            let aovs = state.film.aov_images();
+            let guide = |wanted: Aov| aovs.iter().find(|(aov, _)| *aov == wanted).map(|(_, i)| i);
             crate::denoise::write_denoised(
                 denoiser.as_ref(),
                 &state.film.image(),
-                None,
-                None,
+                guide(Aov::Albedo),
+                guide(Aov::Normal),
                 denoised,
                 &metadata(&state),
                 &exr,
@@ -480,6 +505,7 @@ pub fn render_scene_file(
     };
     Ok(RenderReport {
         image: state.film.image(),
+        aovs: state.film.aov_images(),
         exr,
         png,
         denoised,

@@ -87,7 +87,8 @@ fn a_second_writer_is_refused_and_a_dead_ones_lock_taken_over() {
 }
 
 /// With a `[denoiser]`, the raw render stays the main output, the same
-/// image a render without one makes, and the denoised one sits beside it.
+/// image a render without one makes (with the denoiser's albedo and
+/// normal guides as layers), and the denoised one sits beside it.
 #[test]
 fn a_denoiser_writes_its_image_beside_the_raw_one() {
     let tmp = scratch("denoised");
@@ -115,6 +116,21 @@ fn a_denoiser_writes_its_image_beside_the_raw_one() {
         read("plain.exr"),
         "the raw image changed"
     );
+    // The albedo and normal that guided the denoiser are layers of the raw
+    // EXR, though the scene lists no outputs.
+    let channels: Vec<String> = lumis_image::read_exr_channels(&tmp.path().join("plates.exr"))
+        .unwrap()
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect();
+    for layer in [
+        "albedo.R", "albedo.G", "albedo.B", "normal.X", "normal.Y", "normal.Z",
+    ] {
+        assert!(
+            channels.iter().any(|c| c == layer),
+            "{layer} in {channels:?}"
+        );
+    }
     let denoised = read("plates.denoised.exr");
     assert_eq!((denoised.width, denoised.height), (32, 32));
     assert!(denoised.pixels.iter().flatten().all(|v| v.is_finite()));

@@ -9,17 +9,39 @@ use common::*;
 
 const SPP: &str = "96";
 
+/// Every output beside the colour: their sums are state that must resume
+/// exactly too.
+const ALL_AOVS: &str = "film.aovs=[\"albedo\", \"normal\", \"depth\", \"variance\", \"spp\"]";
+
+/// The bits of every channel of an EXR (colour and outputs), by name.
+fn all_channels(path: impl AsRef<std::path::Path>) -> Vec<(String, Vec<u32>)> {
+    lumis_image::read_exr_channels(path.as_ref())
+        .unwrap()
+        .into_iter()
+        .map(|(name, values)| (name, values.into_iter().map(f32::to_bits).collect()))
+        .collect()
+}
+
 /// Starts the render (resuming from the second start on), SIGKILLs it at
 /// each moment, then lets it finish, and compares with an uninterrupted
-/// render.
-fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
+/// render, colour and every output.
+fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize, sets: &[&str]) {
     let tmp = scratch(name);
     let whole = path_in(tmp.path(), "whole.exr");
-    let result = lumis(&small_render(&whole, SPP));
+    let mut uninterrupted = small_render(&whole, SPP);
+    uninterrupted.extend(["--set", ALL_AOVS]);
+    for set in sets {
+        uninterrupted.extend(["--set", set]);
+    }
+    let result = lumis(&uninterrupted);
     assert!(result.status.success(), "{result:?}");
 
     let out = path_in(tmp.path(), "plates.exr");
     let mut args = small_render(&out, SPP);
+    args.extend(["--set", ALL_AOVS]);
+    for set in sets {
+        args.extend(["--set", set]);
+    }
     args.extend(["--checkpoint", "--pass-spp", "1", "--resume"]);
     // One uninterrupted run with the same flags: the kill moments spread
     // over its duration (which only chooses them; nothing is asserted on it).
@@ -64,6 +86,11 @@ fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
         "resumed image differs"
     );
     assert_eq!(
+        all_channels(&exr),
+        all_channels(&whole),
+        "resumed outputs differ"
+    );
+    assert_eq!(
         files_in(tmp.path()),
         ["plates.exr", "plates.png", "whole.exr", "whole.png"],
         "checkpoint, lock and temporary files are gone"
@@ -72,7 +99,18 @@ fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize) {
 
 #[test]
 fn a_render_killed_at_random_moments_resumes_bit_for_bit() {
-    killed_and_resumed_equals_uninterrupted("kill", 3);
+    killed_and_resumed_equals_uninterrupted("kill", 3, &[]);
+}
+
+/// Adaptive sampling's per-pixel counts, half-buffers and stopped pixels
+/// resume exactly too.
+#[test]
+fn an_adaptive_render_killed_at_random_moments_resumes_bit_for_bit() {
+    killed_and_resumed_equals_uninterrupted(
+        "kill-adaptive",
+        2,
+        &["sampler.adaptive={ min_spp = 8, threshold = 0.05 }"],
+    );
 }
 
 /// The same with many more kills (a few minutes):
@@ -80,7 +118,7 @@ fn a_render_killed_at_random_moments_resumes_bit_for_bit() {
 #[test]
 #[ignore]
 fn a_render_killed_many_times_resumes_bit_for_bit() {
-    killed_and_resumed_equals_uninterrupted("kill-many", 40);
+    killed_and_resumed_equals_uninterrupted("kill-many", 40, &[]);
 }
 
 /// A checkpoint is continued only with `--resume`, and only by the render

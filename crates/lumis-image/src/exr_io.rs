@@ -1,8 +1,10 @@
-//! OpenEXR files: linear float32 RGB.
+//! OpenEXR files: linear float32 RGB, with optional named layers beside
+//! the colour (`albedo.R`, `depth.Z`).
 
 use std::path::Path;
 
-use exr::prelude::{ReadChannels, ReadLayers, SpecificChannels, WritableImage};
+use exr::image::{AnyChannel, AnyChannels, FlatSamples};
+use exr::prelude::{ReadChannels, ReadLayers, WritableImage};
 
 use exr::meta::attribute::{AttributeValue, Text};
 
@@ -29,6 +31,16 @@ pub fn write_exr_with_metadata(
     stage_exr(path, image, metadata)?.commit()
 }
 
+/// A named layer written beside an EXR's colour: channel `name.C` for the
+/// `i`-th entry `C` of `channels` holds component `i` of `image`'s pixels
+/// (the naming of multi-layer EXRs that compositors and denoisers read).
+#[derive(Debug, Clone, Copy)]
+pub struct ExrLayer<'a> {
+    pub name: &'a str,
+    pub channels: &'a [&'a str],
+    pub image: &'a Image,
+}
+
 /// Writes the EXR of [`write_exr_with_metadata`] under a temporary name,
 /// to be renamed into place with [`StagedFile::commit`].
 pub fn stage_exr(
@@ -36,14 +48,51 @@ pub fn stage_exr(
     image: &Image,
     metadata: &[(String, String)],
 ) -> Result<StagedFile, ImageError> {
+    stage_exr_with_layers(path, image, &[], metadata)
+}
+
+/// [`stage_exr`] with `layers` beside the colour, each the size of
+/// `image`.
+pub fn stage_exr_with_layers(
+    path: &Path,
+    image: &Image,
+    layers: &[ExrLayer],
+    metadata: &[(String, String)],
+) -> Result<StagedFile, ImageError> {
     let format_err = |message: String| ImageError::Format {
         path: path.to_path_buf(),
         message,
     };
-    let channels = SpecificChannels::rgb(|pos: exr::math::Vec2<usize>| {
-        let [r, g, b] = image.get(pos.x(), pos.y());
-        (r, g, b)
-    });
+    let component = |image: &Image, c: usize| -> FlatSamples {
+        FlatSamples::F32(image.pixels.iter().map(|p| p[c]).collect())
+    };
+    let mut channels: Vec<AnyChannel<FlatSamples>> = ["R", "G", "B"]
+        .iter()
+        .enumerate()
+        .map(|(c, name)| AnyChannel::new(*name, component(image, c)))
+        .collect();
+    for layer in layers {
+        if (layer.image.width, layer.image.height) != (image.width, image.height)
+            || layer.channels.len() > 3
+        {
+            return Err(format_err(format!(
+                "layer '{}' is {}x{} with {} channels, not {}x{} with at most 3",
+                layer.name,
+                layer.image.width,
+                layer.image.height,
+                layer.channels.len(),
+                image.width,
+                image.height
+            )));
+        }
+        for (c, channel) in layer.channels.iter().enumerate() {
+            let name = format!("{}.{channel}", layer.name);
+            let text = Text::new_or_none(&name)
+                .ok_or_else(|| format_err(format!("'{name}' is not an EXR channel name")))?;
+            channels.push(AnyChannel::new(text, component(layer.image, c)));
+        }
+    }
+    let channels = AnyChannels::sort(channels.into());
     let mut exr_image = exr::image::Image::from_channels((image.width, image.height), channels);
     for (name, value) in metadata {
         let text = |s: &str| {
@@ -94,6 +143,35 @@ pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
         }
     }
     out.sort();
+    Ok(out)
+}
+
+/// Every channel of an EXR file's layers, by full name (`R`,
+/// `albedo.G`), row-major, converted to `f32`.
+pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
+    let image = exr::image::read::read_all_flat_layers_from_file(path).map_err(|e| match e {
+        exr::error::Error::Io(source) => ImageError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        e => ImageError::Format {
+            path: path.to_path_buf(),
+            message: format!("not a readable EXR: {e}"),
+        },
+    })?;
+    let mut out = Vec::new();
+    for layer in &image.layer_data {
+        let prefix = layer
+            .attributes
+            .layer_name
+            .as_ref()
+            .map(|n| format!("{n}."))
+            .unwrap_or_default();
+        for channel in &layer.channel_data.list {
+            let values = channel.sample_data.values_as_f32().collect();
+            out.push((format!("{prefix}{}", channel.name), values));
+        }
+    }
     Ok(out)
 }
 
@@ -152,6 +230,67 @@ mod tests {
         write_exr_with_metadata(&path, &image, &metadata).unwrap();
         assert_eq!(read_exr_metadata(&path).unwrap(), metadata);
         assert_eq!(read_exr(&path).unwrap(), image);
+    }
+
+    #[test]
+    fn layers_are_written_beside_the_colour() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("layers.exr");
+        let mut colour = Image::new(2, 1);
+        colour.set(1, 0, [1.0, 2.0, 3.0]);
+        let mut normal = Image::new(2, 1);
+        normal.set(0, 0, [0.0, -1.0, 0.5]);
+        let depth = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![[4.0; 3], [0.0; 3]],
+        };
+        let layers = [
+            ExrLayer {
+                name: "normal",
+                channels: &["X", "Y", "Z"],
+                image: &normal,
+            },
+            ExrLayer {
+                name: "depth",
+                channels: &["Z"],
+                image: &depth,
+            },
+        ];
+        stage_exr_with_layers(&path, &colour, &layers, &[])
+            .unwrap()
+            .commit()
+            .unwrap();
+        assert_eq!(read_exr(&path).unwrap(), colour);
+        let mut channels = read_exr_channels(&path).unwrap();
+        channels.sort_by(|a, b| a.0.cmp(&b.0));
+        let expected: Vec<(String, Vec<f32>)> = [
+            ("B", vec![0.0, 3.0]),
+            ("G", vec![0.0, 2.0]),
+            ("R", vec![0.0, 1.0]),
+            ("depth.Z", vec![4.0, 0.0]),
+            ("normal.X", vec![0.0, 0.0]),
+            ("normal.Y", vec![-1.0, 0.0]),
+            ("normal.Z", vec![0.5, 0.0]),
+        ]
+        .into_iter()
+        .map(|(n, v)| (n.to_string(), v))
+        .collect();
+        assert_eq!(channels, expected);
+        let wrong = Image::new(1, 1);
+        let err = stage_exr_with_layers(
+            &path,
+            &colour,
+            &[ExrLayer {
+                name: "spp",
+                channels: &["Y"],
+                image: &wrong,
+            }],
+            &[],
+        )
+        .err()
+        .unwrap();
+        assert!(err.to_string().contains("layer 'spp'"), "{err}");
     }
 
     #[test]

@@ -13,6 +13,7 @@ use rayon::prelude::*;
 
 use crate::camera::PerspectiveCamera;
 use crate::film::Film;
+use crate::first_hit::{first_hit, first_hit_rng};
 use crate::profile::{self, Stage};
 use crate::progress::RenderProgress;
 
@@ -28,6 +29,8 @@ pub struct RenderSettings {
     pub threads: usize,
     /// Draw a progress bar on stderr (hidden when stderr is not a terminal).
     pub progress: bool,
+    /// The cap on each sample's largest component ([`clamp_radiance`]).
+    pub clamp: Option<f32>,
 }
 
 pub struct RenderOutput {
@@ -75,21 +78,40 @@ pub fn worker_threads(requested: usize) -> usize {
 struct Batch {
     rays: Vec<Ray>,
     pixel_of_lane: Vec<usize>,
+    index_of_lane: Vec<u32>,
     radiance: Vec<Rgb>,
     /// Lanes holding a ray.
     filled: usize,
 }
 
+/// `l` scaled down, where its largest component exceeds `max`, to have
+/// `max` there (pbrt-v4 `RGBFilm::AddSample`, `maxcomponentvalue`): the
+/// hue stays, and the rare paths whose radiance is huge (caustics through
+/// a small light, found by a BSDF sample) stop showing as fireflies.
+/// Biased: the energy above the cap is lost, so the image is darker than
+/// the converged one wherever such paths carry light. A sample whose
+/// components are all within the cap is returned as it was, bit for bit.
+#[inline]
+pub fn clamp_radiance(l: Rgb, max: f32) -> Rgb {
+    let m = l.r.max(l.g).max(l.b);
+    if m > max {
+        l * (max / m)
+    } else {
+        l
+    }
+}
+
 impl Batch {
-    /// Traces the filled lanes and adds their radiance to their pixels'
-    /// sums, in lane order.
+    /// Traces the filled lanes and adds their radiance (clamped, where the
+    /// scene asks) to their pixels in `film`, in lane order.
     fn trace(
         &mut self,
         scene: &dyn Scene,
         integrator: &dyn Integrator,
         lanes: &mut dyn SamplerLanes,
         stats: &mut RenderStats,
-        sums: &mut [[f64; 3]],
+        film: &mut Film,
+        clamp: Option<f32>,
     ) {
         let n = std::mem::take(&mut self.filled);
         if n == 0 {
@@ -104,22 +126,25 @@ impl Batch {
                 &mut self.radiance[..n],
             )
         });
-        for (&i, l) in self.pixel_of_lane[..n].iter().zip(&self.radiance) {
+        let lanes = self.pixel_of_lane[..n].iter().zip(&self.index_of_lane);
+        for ((&i, &index), l) in lanes.zip(&self.radiance) {
             stats.samples += 1;
+            film.count_sample(i);
             if !l.is_finite() {
                 stats.nonfinite += 1;
                 continue;
             }
-            let sum = &mut sums[i];
-            sum[0] += l.r as f64;
-            sum[1] += l.g as f64;
-            sum[2] += l.b as f64;
+            match clamp {
+                Some(max) => film.add_sample(i, index, clamp_radiance(*l, max)),
+                None => film.add_sample(i, index, *l),
+            }
         }
     }
 }
 
-/// Renders sample indices `samples` of one tile, adding them to `sums`
-/// (the tile's pixels, row-major). The tile's samples go to the integrator
+/// Renders sample indices `samples` of one tile, adding them to `film`
+/// (the tile's pixels, a [`Film::crop`]). Where the film has first-hit
+/// buffers, each camera ray is also traced by [`first_hit`]. The tile's samples go to the integrator
 /// in batches of at most its [`Integrator::batch_size`], one sampler per
 /// batch lane: a run of the tile's pixels, several samples of each. Lane
 /// `l` holds pixel `l % run` of the run throughout, so that a lane keeps
@@ -136,17 +161,20 @@ fn render_tile(
     integrator: &dyn Integrator,
     lanes: &mut dyn SamplerLanes,
     seed: u64,
+    clamp: Option<f32>,
     samples: Range<u32>,
-    mut sums: Vec<[f64; 3]>,
+    mut film: Film,
     stop: &AtomicBool,
-) -> Option<(Vec<[f64; 3]>, RenderStats)> {
+) -> Option<(Film, RenderStats)> {
     profile::enter_worker();
     let mut stats = RenderStats::default();
     let width = tile.max.x - tile.min.x;
-    let count = sums.len();
+    let count = film.sums.len();
+    let first_hits = film.first_hits.is_some();
     let mut batch = Batch {
         rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
         pixel_of_lane: vec![0; lanes.len()],
+        index_of_lane: vec![0; lanes.len()],
         radiance: vec![Rgb::BLACK; lanes.len()],
         filled: 0,
     };
@@ -160,6 +188,9 @@ fn render_tile(
             }
             for index in base..(base + samples_per_batch).min(samples.end) {
                 for i in pixels.clone() {
+                    if !film.is_active(i) {
+                        continue;
+                    }
                     let pixel =
                         UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
                     let lane = lanes.lane(batch.filled);
@@ -168,14 +199,20 @@ fn render_tile(
                     batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
                         camera.generate_ray(pixel, lane.get_pixel_2d())
                     });
+                    if first_hits {
+                        let mut rng = first_hit_rng(pixel, index, seed);
+                        let seen = first_hit(scene, &batch.rays[batch.filled], &mut rng);
+                        film.add_first_hit(i, &seen);
+                    }
                     batch.pixel_of_lane[batch.filled] = i;
+                    batch.index_of_lane[batch.filled] = index;
                     batch.filled += 1;
                 }
             }
-            batch.trace(scene, integrator, lanes, &mut stats, &mut sums);
+            batch.trace(scene, integrator, lanes, &mut stats, &mut film, clamp);
         }
     }
-    Some((sums, stats))
+    Some((film, stats))
 }
 
 /// What one pass of a render did.
@@ -208,6 +245,8 @@ pub struct PassContext<'a> {
     pub integrator: &'a dyn Integrator,
     pub sampler: &'a dyn Sampler,
     pub seed: u64,
+    /// The cap on each sample's largest component ([`clamp_radiance`]).
+    pub clamp: Option<f32>,
     pub pool: &'a RenderPool,
     pub progress: &'a RenderProgress,
     /// Set (by a signal handler) to abandon the pass in flight.
@@ -215,29 +254,45 @@ pub struct PassContext<'a> {
 }
 
 /// Adds sample indices `film.samples..film.samples + spp` of every pixel to
-/// `film`. Returns `None`, with `film` as it was, where `stop` was set
-/// before the pass finished: a film holds whole passes only, so every
-/// pixel has taken the same samples.
+/// `film` (of every pixel still sampling, with adaptive sampling, which
+/// checks the pixels at its fixed sample counts on the way). Returns
+/// `None` where `stop` was set before the pass finished, with `film`
+/// holding the runs of samples up to the last check passed, if any: a film
+/// holds whole runs only, so every pixel still sampling has taken the same
+/// samples.
 pub fn render_pass(ctx: &PassContext, film: &mut Film, spp: u32) -> Result<Option<PassOutput>> {
     let end = film
         .samples
         .checked_add(spp)
         .ok_or_else(|| Error::msg("more than 2^32 samples per pixel"))?;
+    let mut pass = PassOutput {
+        stats: RenderStats::default(),
+        seconds: 0.0,
+    };
+    while film.samples < end {
+        let run_end = match &film.adaptive {
+            Some(adaptive) => adaptive.settings.next_check(film.samples).min(end),
+            None => end,
+        };
+        let Some(run) = render_run(ctx, film, run_end)? else {
+            return Ok(None);
+        };
+        pass.stats += run.stats;
+        pass.seconds += run.seconds;
+        film.check_convergence();
+    }
+    Ok(Some(pass))
+}
+
+/// Adds sample indices `film.samples..end` of every pixel still sampling
+/// to `film`; `None`, with `film` as it was, once `stop` is set.
+fn render_run(ctx: &PassContext, film: &mut Film, end: u32) -> Result<Option<PassOutput>> {
+    let spp = end - film.samples;
     let samples = film.samples..end;
     let resolution = UVec2::new(film.width as u32, film.height as u32);
     let tiles = tiles(resolution);
-    let tile_sums = |tile: &Tile| -> Vec<[f64; 3]> {
-        (tile.min.y..tile.max.y)
-            .flat_map(|y| {
-                let row = y as usize * film.width;
-                film.sums[row + tile.min.x as usize..row + tile.max.x as usize]
-                    .iter()
-                    .copied()
-            })
-            .collect()
-    };
     let start = Instant::now();
-    let rendered: Vec<Option<(Vec<[f64; 3]>, RenderStats)>> = ctx.pool.pool.install(|| {
+    let rendered: Vec<Option<(Film, RenderStats)>> = ctx.pool.pool.install(|| {
         tiles
             .par_iter()
             .map_init(
@@ -250,8 +305,9 @@ pub fn render_pass(ctx: &PassContext, film: &mut Film, spp: u32) -> Result<Optio
                         ctx.integrator,
                         lanes.as_mut(),
                         ctx.seed,
+                        ctx.clamp,
                         samples.clone(),
-                        tile_sums(tile),
+                        film.crop(tile.min, tile.max),
                         ctx.stop,
                     );
                     if out.is_some() {
@@ -267,16 +323,9 @@ pub fn render_pass(ctx: &PassContext, film: &mut Film, spp: u32) -> Result<Optio
         return Ok(None);
     }
     let mut stats = RenderStats::default();
-    for (tile, (sums, tile_stats)) in tiles.iter().zip(rendered.into_iter().flatten()) {
+    for (tile, (tile_film, tile_stats)) in tiles.iter().zip(rendered.into_iter().flatten()) {
         stats += tile_stats;
-        let width = (tile.max.x - tile.min.x) as usize;
-        for (i, sum) in sums.into_iter().enumerate() {
-            let (x, y) = (
-                tile.min.x as usize + i % width,
-                tile.min.y as usize + i / width,
-            );
-            film.sums[y * film.width + x] = sum;
-        }
+        film.paste(tile.min, tile_film);
     }
     film.samples = end;
     Ok(Some(PassOutput { stats, seconds }))
@@ -313,6 +362,7 @@ pub fn render(
         integrator,
         sampler,
         seed: settings.seed,
+        clamp: settings.clamp,
         pool: &pool,
         progress: &progress,
         stop: &never,

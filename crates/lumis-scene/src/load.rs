@@ -7,7 +7,7 @@ use std::time::Instant;
 use lumis_core::doc;
 use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Denoiser, Error, Integrator, LightSampler, Location, Registry, Result, Sampler};
-use lumis_render::PerspectiveCamera;
+use lumis_render::{Aov, PerspectiveCamera};
 
 use crate::assembly::assemble;
 use crate::description::SceneDescription;
@@ -28,6 +28,13 @@ pub struct LoadedScene {
     pub seed: u64,
     /// `film.output`, resolved against the scene file's directory.
     pub output: Option<PathBuf>,
+    /// `film.aovs`, and the albedo and normal a denoiser reads: the outputs
+    /// written beside the colour.
+    pub aovs: Vec<lumis_render::Aov>,
+    /// `integrator.clamp`: the cap on each sample's largest component.
+    pub clamp: Option<f32>,
+    /// `sampler.adaptive`, its `max_spp` the sampler's spp.
+    pub adaptive: Option<lumis_render::AdaptiveSampling>,
 }
 
 /// A scene is text a person writes: far below this bound, which refuses
@@ -128,6 +135,25 @@ pub fn load_str(
         }),
         tangent_frames: assembled.tangent_frames,
     };
+    let adaptive = description
+        .adaptive
+        .map(|a| {
+            let spp = plugins.sampler.samples_per_pixel();
+            lumis_render::AdaptiveSampling::new(a.min_spp, a.max_spp.unwrap_or(spp), a.threshold)
+                .map_err(|e| Error::at(&a.location, format!("[sampler] {}", e.message)))
+        })
+        .transpose()?;
+    // A denoiser is guided by the first hit's albedo and normal (Open Image
+    // Denoise's auxiliary images): the film makes them whether or not the
+    // scene lists them, and the EXR keeps them.
+    let mut aovs = description.film.aovs;
+    if plugins.denoiser.is_some() {
+        for guide in [Aov::Albedo, Aov::Normal] {
+            if !aovs.contains(&guide) {
+                aovs.push(guide);
+            }
+        }
+    }
     Ok(LoadedScene {
         name: name.to_string(),
         scene,
@@ -137,5 +163,8 @@ pub fn load_str(
         denoiser: plugins.denoiser,
         seed: description.seed,
         output: description.film.output,
+        aovs,
+        clamp: description.clamp,
+        adaptive,
     })
 }

@@ -1,9 +1,11 @@
-//! `[film]`: the image's size, where it goes, and its pixel filter.
+//! `[film]`: the image's size, where it goes, its pixel filter, and the
+//! outputs written beside the colour.
 
 use std::path::{Path, PathBuf};
 
 use lumis_core::doc::Table;
 use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2};
+use lumis_render::Aov;
 
 use super::document::{type_of, Located};
 
@@ -24,6 +26,11 @@ const FILM_PARAMS: &[ParamSpec] = &[
         ParamType::Table,
         "pixel filter: { type = \"box\" } (the default)",
     ),
+    ParamSpec::optional(
+        "aovs",
+        ParamType::StringArray,
+        "outputs written as layers of the EXR beside the colour: albedo, normal, depth, variance, spp",
+    ),
 ];
 
 /// What `[film]` asks for.
@@ -32,6 +39,8 @@ pub(crate) struct FilmDescription {
     pub resolution: UVec2,
     /// `output`, resolved against the scene file's directory.
     pub output: Option<PathBuf>,
+    /// `aovs`, in the order written, each once.
+    pub aovs: Vec<Aov>,
 }
 
 /// Reads `[film]` (all defaults when absent; `file` locates its absence).
@@ -64,6 +73,24 @@ pub(crate) fn film(
             }
         }
     }
+    let mut aovs = Vec::new();
+    for name in film.get_opt::<Vec<String>>("aovs")?.unwrap_or_default() {
+        let allowed = || Aov::ALL.map(|a| format!("\"{a}\"")).join(", ");
+        let aov = Aov::from_name(&name).ok_or_else(|| {
+            film.error(
+                "aovs",
+                format!("unknown output \"{name}\"; allowed: {}", allowed()),
+            )
+        })?;
+        if aovs.contains(&aov) {
+            return Err(film.error("aovs", format!("\"{name}\" is listed twice")));
+        }
+        aovs.push(aov);
+    }
     film.finish()?;
-    Ok(FilmDescription { resolution, output })
+    Ok(FilmDescription {
+        resolution,
+        output,
+        aovs,
+    })
 }

@@ -9,7 +9,9 @@
 //! here, except the glTF asset a `[camera] type = "gltf"` names.
 
 mod accel;
+mod adaptive;
 mod camera;
+mod clamp;
 mod document;
 mod film;
 mod gltf_shape;
@@ -27,6 +29,7 @@ use lumis_render::PerspectiveCamera;
 
 pub(crate) use accel::AccelOptions;
 pub use accel::{Compaction, AUTO_COMPACT_TRIANGLES};
+pub(crate) use adaptive::AdaptiveDescription;
 pub(crate) use film::FilmDescription;
 pub(crate) use named::NamedPlugin;
 pub(crate) use plugin_libraries::PluginLibraries;
@@ -58,7 +61,11 @@ pub(crate) struct SceneDescription {
     pub plugin_libraries: PluginLibraries,
     pub accel: AccelOptions,
     pub sampler: PluginEntity,
+    /// `[sampler] adaptive`.
+    pub adaptive: Option<AdaptiveDescription>,
     pub integrator: PluginEntity,
+    /// `[integrator] clamp`: the cap on each sample's largest component.
+    pub clamp: Option<f32>,
     /// `[denoiser]`: a post-process on the finished film, if the scene asks
     /// for one.
     pub denoiser: Option<PluginEntity>,
@@ -118,8 +125,26 @@ impl SceneDescription {
             )?,
             None => default_light_sampler(),
         };
-        let sampler = required_plugin(&mut root, PluginKind::Sampler, file)?;
-        let integrator = required_plugin(&mut root, PluginKind::Integrator, file)?;
+        let (mut sampler_table, sampler_location) =
+            take_required_table(&mut root, PluginKind::Sampler.table_name(), file)?;
+        let adaptive = adaptive::take_adaptive(&mut sampler_table)?;
+        let sampler = PluginEntity::from_table(
+            PluginKind::Sampler,
+            PluginKind::Sampler.table_name(),
+            sampler_table,
+            sampler_location,
+            TYPE_KEY,
+        )?;
+        let (mut integrator_table, integrator_location) =
+            take_required_table(&mut root, PluginKind::Integrator.table_name(), file)?;
+        let clamp = clamp::take_clamp(&mut integrator_table)?;
+        let integrator = PluginEntity::from_table(
+            PluginKind::Integrator,
+            PluginKind::Integrator.table_name(),
+            integrator_table,
+            integrator_location,
+            TYPE_KEY,
+        )?;
         let denoiser = take_table(&mut root, "denoiser")?
             .map(|(table, location)| {
                 PluginEntity::from_table(
@@ -138,7 +163,9 @@ impl SceneDescription {
             plugin_libraries,
             accel,
             sampler,
+            adaptive,
             integrator,
+            clamp,
             denoiser,
             light_sampler,
             textures,
@@ -161,14 +188,6 @@ fn default_light_sampler() -> PluginEntity {
         Table::default(),
         Location::Builtin,
     )
-}
-
-/// The top-level table of a plugin `kind` the scene must have
-/// (`[sampler]`, `[integrator]`).
-fn required_plugin(root: &mut Table, kind: PluginKind, file: &Location) -> Result<PluginEntity> {
-    let key = kind.table_name();
-    let (table, location) = take_required_table(root, key, file)?;
-    PluginEntity::from_table(kind, key, table, location, TYPE_KEY)
 }
 
 fn check_top_level_keys(root: &Table) -> Result<()> {

@@ -115,3 +115,94 @@ emission = { type = "my_triangle", radiance = 1.0 }
     assert_eq!(emission.location.to_string(), "s.toml:19:12");
     assert_eq!(quad.bsdf.location.to_string(), "s.toml:18:8");
 }
+
+fn try_describe(text: &str) -> lumis_core::Result<SceneDescription> {
+    let root = lumis_core::doc::parse(text, "s.toml").unwrap();
+    let file = Location::File {
+        path: Arc::from("s.toml"),
+        line: 1,
+        column: 1,
+    };
+    SceneDescription::from_document(root, &file, Path::new("."))
+}
+
+#[test]
+fn film_aovs_are_typed_and_unknown_names_refused() {
+    use lumis_render::Aov;
+    assert!(describe("").film.aovs.is_empty());
+    let film = describe("[film]\naovs = [\"depth\", \"albedo\", \"spp\"]\n").film;
+    assert_eq!(film.aovs, [Aov::Depth, Aov::Albedo, Aov::Spp]);
+    let err = try_describe(&format!("{BASE}[film]\naovs = [\"albedo\", \"colour\"]\n"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("aovs") && err.contains("\"colour\"") && err.contains("\"variance\""),
+        "{err}"
+    );
+    let err = try_describe(&format!("{BASE}[film]\naovs = [\"spp\", \"spp\"]\n"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("twice"), "{err}");
+}
+
+#[test]
+fn integrator_clamp_is_read_by_the_scene_not_the_plugin() {
+    assert_eq!(describe("").clamp, None);
+    let with = |clamp: &str| {
+        try_describe(&BASE.replace(
+            "type = \"path\"\n",
+            &format!("type = \"path\"\nclamp = {clamp}\n"),
+        ))
+    };
+    let scene = with("10").unwrap();
+    assert_eq!(scene.clamp, Some(10.0));
+    assert!(scene.integrator.table.get("clamp").is_none());
+    assert_eq!(with("0.5").unwrap().clamp, Some(0.5));
+    for bad in ["0", "-1.0", "\"high\"", "1e300"] {
+        let err = with(bad).err().unwrap().to_string();
+        assert!(err.contains("clamp"), "{bad}: {err}");
+    }
+}
+
+#[test]
+fn sampler_adaptive_is_read_by_the_scene_and_sets_the_spp() {
+    let with = |adaptive: &str, spp: &str| {
+        try_describe(&BASE.replace(
+            "type = \"independent\"\n",
+            &format!("type = \"independent\"\n{spp}adaptive = {adaptive}\n"),
+        ))
+    };
+    let scene = with("{ min_spp = 4, max_spp = 64, threshold = 0.01 }", "").unwrap();
+    let adaptive = scene.adaptive.unwrap();
+    assert_eq!((adaptive.min_spp, adaptive.max_spp), (4, Some(64)));
+    assert_eq!(adaptive.threshold, 0.01);
+    assert!(scene.sampler.table.get("adaptive").is_none());
+    assert_eq!(
+        scene.sampler.table.get("spp").map(|n| n.value.clone()),
+        Some(lumis_core::doc::Value::Int(64))
+    );
+    let same = with(
+        "{ min_spp = 4, max_spp = 64, threshold = 0.01 }",
+        "spp = 64\n",
+    );
+    assert!(same.is_ok());
+    for (adaptive, spp, expected) in [
+        (
+            "{ min_spp = 4, max_spp = 64, threshold = 0.01 }",
+            "spp = 32\n",
+            "disagree",
+        ),
+        (
+            "{ min_spp = 4, threshold = 0.01, spread = 2 }",
+            "",
+            "spread",
+        ),
+        ("{ max_spp = 4, threshold = 0.01 }", "", "min_spp"),
+        ("4", "", "expected a table"),
+    ] {
+        let err = with(adaptive, spp).err().unwrap().to_string();
+        assert!(err.contains(expected), "{adaptive}: {err}");
+    }
+}
