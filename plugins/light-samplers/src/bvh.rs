@@ -449,12 +449,8 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn every_leaf_is_reached_by_its_trail() {
-        let lights = scene(300, true, 1);
-        let s = BvhLightSampler::from_bounds(lights.iter().copied());
-        assert_eq!(s.tree_lights(), 300);
-        assert_eq!(s.nodes.len(), 2 * 300 - 1);
+    /// Follows every tree light's trail down from the root to its leaf.
+    fn assert_trails_lead_to_leaves(s: &BvhLightSampler) {
         for (index, slot) in s.slots.iter().enumerate() {
             let Slot::Tree { mut trail } = *slot else {
                 continue;
@@ -470,6 +466,15 @@ mod tests {
             }
             assert_eq!(s.nodes[node].child_or_light as usize, index);
         }
+    }
+
+    #[test]
+    fn every_leaf_is_reached_by_its_trail() {
+        let lights = scene(300, true, 1);
+        let s = BvhLightSampler::from_bounds(lights.iter().copied());
+        assert_eq!(s.tree_lights(), 300);
+        assert_eq!(s.nodes.len(), 2 * 300 - 1);
+        assert_trails_lead_to_leaves(&s);
         assert_eq!(s.slots[300], Slot::Dark);
         assert_eq!(s.slots[301], Slot::Infinite);
     }
@@ -537,6 +542,66 @@ mod tests {
         assert!(BvhLightSampler::from_bounds([])
             .sample(&above, 0.5)
             .is_none());
+    }
+
+    /// Enough lights for the top of the tree to be built on two threads,
+    /// its subtrees spliced together.
+    #[test]
+    fn parallel_builds_splice_their_subtrees() {
+        let count = 3 * PARALLEL_MIN;
+        let s = BvhLightSampler::from_bounds(scene(count, false, 4));
+        assert_eq!(s.tree_lights(), count);
+        assert_trails_lead_to_leaves(&s);
+        let ctx = LightSampleContext::at(Vec3::new(0.5, 6.0, -1.0));
+        let sum: f64 = (0..count as u32).map(|i| f64::from(s.pmf(&ctx, i))).sum();
+        assert!(sum <= 1.0 + 1e-4 && sum > 0.9, "{sum}");
+    }
+
+    /// A million triangle lights (pbrt-scale scenes): the build and the pmf
+    /// stay exact. Half a minute of CPU; `cargo test -p
+    /// lumis-light-samplers -- --ignored --nocapture` prints the build time.
+    #[test]
+    #[ignore]
+    fn a_million_lights() {
+        let count = 1 << 20;
+        let mut rng = Pcg32::new(7, 1);
+        let lights: Vec<_> = (0..count)
+            .map(|_| {
+                let mut c = || 100.0 * rng.next_f32() - 50.0;
+                let p0 = Vec3::new(c(), c(), c());
+                let mut e = || 0.2 * rng.next_f32() - 0.1;
+                let p = [
+                    p0,
+                    p0 + Vec3::new(e(), e(), e()),
+                    p0 + Vec3::new(e(), e(), e()),
+                ];
+                let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Y);
+                Some(LightBounds::planar(
+                    Aabb::of_points(p),
+                    n,
+                    1.0 + 9.0 * rng.next_f32(),
+                    false,
+                ))
+            })
+            .collect();
+        let start = std::time::Instant::now();
+        let s = BvhLightSampler::from_bounds(lights);
+        eprintln!(
+            "built the light BVH over {count} triangles in {:.2} s",
+            start.elapsed().as_secs_f64()
+        );
+        assert_eq!(s.tree_lights(), count);
+        assert_trails_lead_to_leaves(&s);
+        for ctx in contexts(8).iter().take(4) {
+            let sum: f64 = (0..count as u32).map(|i| f64::from(s.pmf(ctx, i))).sum();
+            assert!(sum <= 1.0 + 1e-3 && sum > 0.5, "{sum}");
+            for k in 0..1000 {
+                if let Some(l) = s.sample(ctx, (k as f32 + 0.5) / 1000.0) {
+                    let expected = s.pmf(ctx, l.index);
+                    assert!((l.pmf - expected).abs() <= 1e-6 * expected);
+                }
+            }
+        }
     }
 
     #[test]
