@@ -225,30 +225,46 @@ impl LightBounds {
     /// surface, the cosine of the smallest incident angle. Zero only where
     /// no light in the bounds can reach `p` (pbrt-v4
     /// `LightBounds::Importance`, eq. 12.6).
+    #[inline]
     pub fn importance(&self, p: Vec3, n: Vec3) -> f32 {
         if self.phi <= 0.0 {
             return 0.0;
         }
         let pc = self.bounds.center();
+        // The bounding sphere's radius squared: the half diagonal's.
+        let radius2 = 0.25 * self.bounds.diagonal().length_squared();
+        let to_p = p - pc;
+        let dist2 = to_p.length_squared();
         // Clamped to the half diagonal, so that points inside or near the
         // bounds are not given an unbounded importance.
-        let half_diagonal2 = 0.25 * self.bounds.diagonal().length_squared();
-        let d2 = p.distance_squared(pc).max(half_diagonal2);
-        let b = DirectionCone::subtended_by(&self.bounds, p);
-        let (cos_b, sin_b) = (b.cos_theta, sin_of(b.cos_theta));
-        // From the centre toward `p`; any direction where `p` is the centre
-        // (then the subtended cone is the whole sphere, and it is unused).
-        let wi = (p - pc).try_normalize().unwrap_or(Vec3::Z);
+        let d2 = dist2.max(radius2);
+        // theta_b: the half-angle of the cone from `p` holding the bounding
+        // sphere (`DirectionCone::subtended_by`, here sharing its distance),
+        // and `wi` from the centre toward `p`. Inside the sphere the cone is
+        // every direction and `wi` is unused but by the cosine at a surface,
+        // which the whole-sphere theta_b clamps to 1.
+        let (cos_b, sin_b, wi) = if dist2 >= radius2 && dist2 > 0.0 {
+            let sin2_b = radius2 / dist2;
+            let wi = to_p * dist2.sqrt().recip();
+            ((1.0 - sin2_b).max(0.0).sqrt(), sin2_b.sqrt(), wi)
+        } else {
+            (-1.0, 0.0, Vec3::Z)
+        };
         let mut cos_w = self.w.dot(wi);
         if self.two_sided {
             cos_w = cos_w.abs();
         }
-        let sin_w = sin_of(cos_w);
-        // theta' = max(0, theta_w - theta_o - theta_b), as cosines.
-        let (cos_o, sin_o) = (self.cos_theta_o, sin_of(self.cos_theta_o));
-        let cos_x = cos_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let sin_x = sin_sub_clamped(sin_w, cos_w, sin_o, cos_o);
-        let cos_p = cos_sub_clamped(sin_x, cos_x, sin_b, cos_b);
+        // theta' = max(0, theta_w - theta_o - theta_b), as cosines; 1 (and
+        // no sines needed) where `p` lies within the normals' cone.
+        let cos_o = self.cos_theta_o;
+        let cos_p = if cos_w > cos_o {
+            1.0
+        } else {
+            let (sin_w, sin_o) = (sin_of(cos_w), sin_of(cos_o));
+            let cos_x = cos_w * cos_o + sin_w * sin_o;
+            let sin_x = sin_w * cos_o - cos_w * sin_o;
+            cos_sub_clamped(sin_x, cos_x, sin_b, cos_b)
+        };
         if cos_p <= self.cos_theta_e {
             return 0.0;
         }
@@ -256,7 +272,9 @@ impl LightBounds {
         if n != Vec3::ZERO {
             // theta_i' = max(0, theta_i - theta_b).
             let cos_i = n.dot(wi).abs();
-            importance *= cos_sub_clamped(sin_of(cos_i), cos_i, sin_b, cos_b);
+            if cos_i <= cos_b {
+                importance *= cos_i * cos_b + sin_of(cos_i) * sin_b;
+            }
         }
         if importance.is_nan() {
             return 0.0;
@@ -265,6 +283,7 @@ impl LightBounds {
     }
 }
 
+#[inline]
 fn sin_of(cos: f32) -> f32 {
     (1.0 - cos * cos).max(0.0).sqrt()
 }
@@ -275,15 +294,6 @@ fn cos_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
         1.0
     } else {
         cos_a * cos_b + sin_a * sin_b
-    }
-}
-
-/// `sin(max(0, a - b))` from the sines and cosines of `a` and `b`.
-fn sin_sub_clamped(sin_a: f32, cos_a: f32, sin_b: f32, cos_b: f32) -> f32 {
-    if cos_a > cos_b {
-        0.0
-    } else {
-        sin_a * cos_b - cos_a * sin_b
     }
 }
 
