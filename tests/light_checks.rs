@@ -2,7 +2,7 @@
 //! check-plugin` runs on them (crates/lumis-check/src/light_suite.rs,
 //! light_sampler_suite.rs), and the checks catch planted defects: a light
 //! whose pdf is a few percent off, a light sampler whose pmf disagrees with
-//! its draws.
+//! its draws, one whose pmf sums past 1, one that never picks a lit light.
 
 use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
