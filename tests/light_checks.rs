@@ -2,7 +2,7 @@
 //! check-plugin` runs on them (crates/lumis-check/src/light_suite.rs,
 //! light_sampler_suite.rs), and the checks catch planted defects: a light
 //! whose pdf is a few percent off, a light sampler whose pmf disagrees with
-//! its draws.
+//! its draws, one whose pmf sums past 1, one that never picks a lit light.
 
 use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
@@ -258,6 +258,35 @@ impl LightSampler for OverOne {
     }
 }
 
+/// Uniform over every light but the last finite one (the stand-in sphere,
+/// lit from everywhere outside it), which it never picks: consistent, but
+/// biased.
+struct SkipsALitLight {
+    count: u32,
+}
+
+impl SkipsALitLight {
+    const SKIPPED: u32 = 5;
+}
+
+impl LightSampler for SkipsALitLight {
+    fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
+        let k = ((u * (self.count - 1) as f32) as u32).min(self.count - 2);
+        let index = if k >= Self::SKIPPED { k + 1 } else { k };
+        Some(SampledLight {
+            index,
+            pmf: self.pmf(ctx, index),
+        })
+    }
+    fn pmf(&self, _: &LightSampleContext, index: u32) -> f32 {
+        if index == Self::SKIPPED || index >= self.count {
+            0.0
+        } else {
+            1.0 / (self.count - 1) as f32
+        }
+    }
+}
+
 fn sampler_spec(name: &'static str) -> PluginSpec {
     PluginSpec {
         kind: PluginKind::LightSampler,
@@ -290,6 +319,21 @@ fn a_light_sampler_whose_pmf_disagrees_with_its_draws_fails() {
         lying.iter().all(|r| r.problems.is_empty() && !r.passed()),
         "{}",
         format_light_sampler_results(&lying)
+    );
+    registry
+        .add_light_sampler(sampler_spec("skips-a-lit-light"), |_, lights| {
+            Ok(Box::new(SkipsALitLight {
+                count: lights.len() as u32,
+            }))
+        })
+        .unwrap();
+    let skips = check_light_sampler_with(&registry, "skips-a-lit-light", &[], &cfg).unwrap();
+    assert!(
+        skips
+            .iter()
+            .all(|r| r.problems.iter().any(|p| p.contains("light 5 has pmf 0"))),
+        "{}",
+        format_light_sampler_results(&skips)
     );
     let over = check_light_sampler_with(&registry, "over-one", &[], &cfg).unwrap();
     assert!(

@@ -2,7 +2,8 @@
 //! estimator switches of `path` and `direct`: every estimator of the same
 //! image agrees in the mean (BSDF-only, light-only, MIS balance and power;
 //! direct lighting and full depth; n_f/n_g multi-sample and one-sample;
-//! area and solid-angle light sampling; uniform and power light selection).
+//! area and solid-angle light sampling; uniform, power and bvh light
+//! selection).
 
 use lumis_image::Image;
 use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml};
@@ -46,7 +47,7 @@ fn agree(images: &[(String, Image)], tests_in_file: usize, what: &str) {
 }
 
 /// Comparisons made by this file, for the Bonferroni correction.
-const COMPARISONS: usize = 3 * 2 * 4 + 2 + 3 + 1 + 1 + 2;
+const COMPARISONS: usize = 3 * 2 * 4 + 2 + 3 + 1 + 1 + 3;
 
 fn strategies_agree(scene_file: &str) {
     let scene = read_scene(scene_file);
@@ -190,7 +191,7 @@ fn sample_counts_and_one_sample_mis_agree() {
 }
 
 /// Solid-angle and area sampling of the same lights render the same image;
-/// so do uniform and power light selection.
+/// so do uniform, power and bvh light selection.
 #[test]
 fn light_sampling_modes_agree() {
     let tri = read_scene("cornell-box-triangle-light.toml");
@@ -229,6 +230,10 @@ fn light_sampling_modes_agree() {
             (
                 "power".into(),
                 render(&two, &["light_sampler.type=power", "seed=36"]),
+            ),
+            (
+                "bvh".into(),
+                render(&two, &["light_sampler.type=bvh", "seed=37"]),
             ),
         ],
         COMPARISONS,

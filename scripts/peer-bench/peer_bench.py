@@ -86,7 +86,8 @@ sys.path.insert(0, HERE)
 import to_mitsuba  # noqa: E402
 
 ORDER = ["cornell-box", "glossy-beckmann", "glossy-ggx", "glass-plastic", "measured", "scan-diffuse",
-         "scan-conductor", "textured-gltf", "many-lights", "envmap-sky"]
+         "scan-conductor", "textured-gltf", "many-lights", "envmap-sky",
+         "spread-lights"]
 SAMPLERS = ["independent", "stratified", "multijitter", "ldsampler"]
 VARIANTS = ["llvm_ad_rgb", "scalar_rgb"]
 SUMMARY = re.compile(r"(\d+)x(\d+), (\d+) spp, ([0-9.]+) s, ([0-9.]+) Msamples/s")
@@ -204,6 +205,10 @@ def ensure_assets(scene_path, lumis):
                 not os.path.exists(os.path.join(os.path.dirname(scene_path), s["file"])):
             import fetch_assets
             fetch_assets.dragon()
+        if s.get("type") == "obj" and s["file"].startswith("assets/spread-lights-") and \
+                not os.path.exists(os.path.join(os.path.dirname(scene_path), s["file"])):
+            # Seeded: the same emitters on every machine.
+            subprocess.run([sys.executable, os.path.join(BENCH, "make_spread_lights.py")], check=True)
 
 
 def mitsuba_unsupported(scene_path):

@@ -20,9 +20,11 @@ mapping, one lumis construct at a time:
   emitter sampling by MIS with the power heuristic, one sample each, so only
   lumis's `strategy = "mis"`, `heuristic = "power"`, `beta = 2`, `n_f = n_g =
   1`, multi-sample, are accepted.
-- `[light_sampler]`: only `uniform` (Mitsuba picks an emitter uniformly; an
+- `[light_sampler]`: `uniform` (Mitsuba picks an emitter uniformly; an
   emissive mesh is one emitter sampled by area, which for the equal
-  triangles of the bench scenes is lumis's uniform choice of triangle).
+  triangles of the bench scenes is lumis's uniform choice of triangle), and
+  `bvh`, against that same default (Mitsuba 3 has no light BVH): the same
+  expectation, different noise.
 - BSDFs: `diffuse` (`two_sided` -> `twosided` wrapper), `conductor` (below
   roughness 1e-3 -> `conductor`, else `roughconductor` with `distribution`,
   `alpha` or `alpha_u`/`alpha_v`, `sample_visible`; `material = "none"` or
@@ -508,7 +510,7 @@ def convert(path, mi, sampler="independent", spp=64, seed=0, tex_dir=None):
         if integ.get(key, default) != default:
             raise Unsupported(f"[integrator] {key} = {integ[key]!r} (Mitsuba's path: MIS, power heuristic, 1+1 samples)")
     ls = scene.get("light_sampler", {"type": "uniform"})
-    if ls.get("type") != "uniform":
+    if ls.get("type") not in ("uniform", "bvh"):
         raise Unsupported(f"[light_sampler] type {ls.get('type')!r} (Mitsuba picks emitters uniformly)")
 
     out = {

@@ -1,12 +1,19 @@
 //! The full check of a light-sampler plugin, as `lumis check-plugin` and
 //! the test suite run it: over a sweep of the plugin's own parameters, made
 //! over [`STAND_IN_LIGHTS`] (lights of different kinds, powers and places,
-//! one of them dark), from seeded random reference points, check
+//! one of them dark), from reference points (behind the one-sided quad, on
+//! it, far away, and seeded random ones), check
 //!
-//! - the pmf over all lights sums to 1, each value finite in [0, 1];
+//! - the pmf over all lights sums to 1, each value finite in [0, 1]; a
+//!   sampler that knows some lights cannot reach the point may leave them
+//!   out (a sum below 1), and `sample` then returns no light with the
+//!   probability left over;
+//! - a light of pmf 0 sends no light to the point (else estimates would be
+//!   biased);
 //! - `sample` draws each light with the frequency `pmf` gives it: Pearson's
-//!   chi-square over the lights (a draw of a light of pmf 0, or an index
-//!   past the last light, fails outright), Sidak-corrected for the cases;
+//!   chi-square over the lights and "no light" (a draw of a light of pmf 0,
+//!   or an index past the last light, fails outright), Sidak-corrected for
+//!   the cases;
 //! - `sample` returns the pmf that `pmf` gives for the light it draws.
 
 use std::fmt::Write;
@@ -28,7 +35,8 @@ use crate::sweep::{declared, parameter_sweep_with, Variant};
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LightSamplerCheckConfig {
-    /// Random reference points per parameter setting.
+    /// Reference points per parameter setting: the [`PLACED_POINTS`],
+    /// then random ones.
     pub points: usize,
     /// Draws of `sample` per reference point.
     pub samples: usize,
@@ -216,7 +224,7 @@ pub fn check_light_sampler_with(
             match sampler {
                 Ok(sampler) => {
                     let seed = cfg.seed.wrapping_add(i as u64);
-                    check_case(sampler.as_ref(), lights.len(), &ctx, cfg, seed, &mut result);
+                    check_case(sampler.as_ref(), &lights, &ctx, cfg, seed, &mut result);
                 }
                 Err(e) => match unmade(registry, &owner(name, variant), e) {
                     Ok(refusal) => result.refused = Some(refusal),
@@ -230,35 +238,55 @@ pub fn check_light_sampler_with(
     Ok(results)
 }
 
-/// Seeded points in a box around the stand-in lights, half of them on a
-/// surface (a random normal), half in free space (a zero normal).
+/// Reference points where samplers that weigh lights by place are apt to
+/// go wrong, as (point, surface normal): behind the one-sided stand-in
+/// quad, on it, and far from every light.
+pub const PLACED_POINTS: [(Vec3, Vec3); 3] = [
+    (Vec3::new(1.5, 3.5, -0.5), Vec3::Y),
+    (Vec3::new(1.5, 3.0, -0.5), Vec3::NEG_Y),
+    (Vec3::new(40.0, 30.0, -50.0), Vec3::ZERO),
+];
+
+/// The [`PLACED_POINTS`], then seeded points in a box around the stand-in
+/// lights, half of them on a surface (a random normal), half in free space
+/// (a zero normal).
 fn reference_points(cfg: &LightSamplerCheckConfig) -> Vec<LightSampleContext> {
     let mut rng = Pcg32::new(cfg.seed, 0x9017);
-    (0..cfg.points)
-        .map(|i| {
-            let mut coordinate = || 6.0 * rng.next_f32() - 3.0;
-            let p = Vec3::new(coordinate(), coordinate(), coordinate());
-            let n = if i % 2 == 0 {
-                warp::square_to_uniform_sphere(Vec2::new(rng.next_f32(), rng.next_f32()))
-            } else {
-                Vec3::ZERO
-            };
-            LightSampleContext {
-                point: SurfacePoint {
-                    p,
-                    p_error: Vec3::ZERO,
-                    n,
-                },
-                ns: n,
-            }
-        })
-        .collect()
+    let placed = PLACED_POINTS.iter().map(|&(p, n)| LightSampleContext {
+        point: SurfacePoint {
+            p,
+            p_error: Vec3::ZERO,
+            n,
+        },
+        ns: n,
+    });
+    let random = (PLACED_POINTS.len()..cfg.points).map(|i| {
+        let mut coordinate = || 6.0 * rng.next_f32() - 3.0;
+        let p = Vec3::new(coordinate(), coordinate(), coordinate());
+        let n = if i % 2 == 0 {
+            warp::square_to_uniform_sphere(Vec2::new(rng.next_f32(), rng.next_f32()))
+        } else {
+            Vec3::ZERO
+        };
+        LightSampleContext {
+            point: SurfacePoint {
+                p,
+                p_error: Vec3::ZERO,
+                n,
+            },
+            ns: n,
+        }
+    });
+    placed.chain(random).take(cfg.points).collect()
 }
+
+/// Light samples drawn from each light of pmf 0, to see that it is dark.
+const DARK_PROBES: u32 = 16;
 
 /// The pmf, the draws against it, and the pmf `sample` returns.
 fn check_case(
     sampler: &dyn LightSampler,
-    lights: usize,
+    stand_ins: &[Box<dyn Light>],
     ctx: &LightSampleContext,
     cfg: &LightSamplerCheckConfig,
     seed: u64,
@@ -269,6 +297,7 @@ fn check_case(
             problems.push(p);
         }
     };
+    let lights = stand_ins.len();
     let pmf: Vec<f32> = (0..lights as u32).map(|i| sampler.pmf(ctx, i)).collect();
     for (i, &p) in pmf.iter().enumerate() {
         if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
@@ -277,15 +306,36 @@ fn check_case(
     }
     result.pmf_sum = pmf.iter().map(|&p| f64::from(p)).sum();
     // False for a NaN sum too.
-    let sums_to_one = (result.pmf_sum - 1.0).abs() <= 1e-4;
-    if !sums_to_one {
+    let at_most_one = result.pmf_sum <= 1.0 + 1e-4;
+    if !at_most_one {
         note(
             &mut result.problems,
             format!(
-                "the pmf sums to {} over the {lights} lights, not 1",
+                "the pmf sums to {} over the {lights} lights, more than 1",
                 result.pmf_sum
             ),
         );
+    }
+    for (i, light) in stand_ins.iter().enumerate() {
+        if pmf[i] != 0.0 {
+            continue;
+        }
+        let lit = (0..DARK_PROBES * DARK_PROBES).find_map(|k| {
+            let u = Vec2::new(
+                ((k % DARK_PROBES) as f32 + 0.5) / DARK_PROBES as f32,
+                ((k / DARK_PROBES) as f32 + 0.5) / DARK_PROBES as f32,
+            );
+            light.sample_li(ctx, u).filter(|s| !s.l.is_black())
+        });
+        if let Some(s) = lit {
+            note(
+                &mut result.problems,
+                format!(
+                    "light {i} has pmf 0 but sends radiance {:?} along {} (it could never be sampled)",
+                    s.l, s.wi
+                ),
+            );
+        }
     }
     let mut rng = Pcg32::new(seed, 0x5a3b);
     let mut observed = vec![0u64; lights + 1];

@@ -20,6 +20,7 @@ pub mod guard;
 pub mod integrator;
 pub mod interaction;
 pub mod light;
+pub mod light_bounds;
 pub mod light_sampler;
 pub mod math;
 pub mod params;
@@ -40,6 +41,7 @@ pub use footprint::{PackedFootprint, PixelFootprint};
 pub use integrator::Integrator;
 pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use light::{Light, LightInput, LightKind, LightSample, LightShape};
+pub use light_bounds::{Aabb, DirectionCone, LightBounds};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;
 pub use params::{

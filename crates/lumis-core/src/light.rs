@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::interaction::LightSampleContext;
+use crate::light_bounds::LightBounds;
 use crate::ray::SurfacePoint;
 use crate::spectrum::Rgb;
 
@@ -110,6 +111,14 @@ pub trait Light: Send + Sync {
 
     /// Total emitted power (flux), for power-proportional light selection.
     fn power(&self) -> Rgb;
+
+    /// Where the light is and which way it emits, for light samplers that
+    /// weigh lights by their place (`bvh`). `None` (infinite lights, and
+    /// the default) leaves the light out of the tree: it is then picked
+    /// alongside, as an environment is, without regard to position.
+    fn bounds(&self) -> Option<LightBounds> {
+        None
+    }
 
     /// Lets infinite lights learn the scene's bounding sphere after loading.
     fn preprocess(&mut self, _scene_center: Vec3, _scene_radius: f32) {}

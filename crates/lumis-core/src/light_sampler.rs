@@ -11,6 +11,11 @@ pub struct SampledLight {
 }
 
 /// Picks one light for next-event estimation.
+///
+/// The pmf over all lights sums to 1, or less where the sampler knows some
+/// lights cannot reach `ctx`: it may leave those out, and `sample` then
+/// returns `None` with the probability left over. A light that sends any
+/// light to `ctx` must have a positive pmf there, or estimates are biased.
 pub trait LightSampler: Send + Sync {
     fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight>;
 

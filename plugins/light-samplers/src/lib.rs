@@ -1,8 +1,10 @@
 //! Standard light-selection strategies.
 
+mod bvh;
 mod power;
 mod uniform;
 
+pub use bvh::BvhLightSampler;
 pub use power::PowerLightSampler;
 pub use uniform::UniformLightSampler;
 
@@ -15,5 +17,8 @@ pub fn register(registry: &mut Registry) -> Result<()> {
     })?;
     registry.add_light_sampler(power::SPEC, |_p, lights| {
         Ok(Box::new(PowerLightSampler::new(lights)))
+    })?;
+    registry.add_light_sampler(bvh::SPEC, |_p, lights| {
+        Ok(Box::new(BvhLightSampler::new(lights)))
     })
 }

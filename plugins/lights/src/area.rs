@@ -7,8 +7,8 @@ use std::sync::Arc;
 
 use lumis_core::params::Textured;
 use lumis_core::{
-    Light, LightKind, LightSample, ParamChoice, Params, PluginParams, Result, Rgb, Texture,
-    TexturedRgb, Vec2, Vec3,
+    Aabb, Light, LightBounds, LightKind, LightSample, ParamChoice, Params, PluginParams, Result,
+    Rgb, Texture, TexturedRgb, Vec2, Vec3,
 };
 
 /// The keys of every `emission = { ... }` table.
@@ -182,6 +182,9 @@ pub fn solid_angle_sample(
 pub trait PlanarShape: Send + Sync {
     fn area(&self) -> f32;
 
+    /// The box holding the shape.
+    fn bounds(&self) -> Aabb;
+
     /// Unit normal on the emitting (front) side.
     fn normal(&self) -> Vec3;
 
@@ -345,4 +348,18 @@ impl<S: PlanarShape> Light for AreaLight<S> {
     fn power(&self) -> Rgb {
         self.emission.power(self.shape.area())
     }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(planar_bounds(&self.shape, self.power(), &self.emission))
+    }
+}
+
+/// The bounds of a flat Lambertian emitter of total power `power`.
+pub fn planar_bounds<S: PlanarShape>(shape: &S, power: Rgb, emission: &Emission) -> LightBounds {
+    LightBounds::planar(
+        shape.bounds(),
+        shape.normal(),
+        power.luminance(),
+        emission.two_sided,
+    )
 }

@@ -3,8 +3,8 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
+    PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -83,6 +83,13 @@ impl Light for PointLight {
 
     fn power(&self) -> Rgb {
         self.intensity * (4.0 * std::f32::consts::PI)
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(LightBounds::isotropic_point(
+            self.position,
+            self.power().luminance(),
+        ))
     }
 }
 

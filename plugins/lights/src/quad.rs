@@ -5,7 +5,8 @@
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+    Aabb, Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2,
+    Vec3,
 };
 
 use lumis_sampling::{SphericalRectangle, MIN_SPHERICAL_SAMPLE_AREA};
@@ -105,6 +106,11 @@ impl QuadLight {
 impl PlanarShape for Quad {
     fn area(&self) -> f32 {
         self.area
+    }
+
+    fn bounds(&self) -> Aabb {
+        let (c, u, v) = (self.corner, self.edge_u, self.edge_v);
+        Aabb::of_points([c, c + u, c + v, c + u + v])
     }
 
     fn normal(&self) -> Vec3 {

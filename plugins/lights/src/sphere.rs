@@ -9,8 +9,8 @@ use std::f32::consts::PI;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, Params, PluginKind,
-    PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
+    Aabb, Error, Light, LightBounds, LightKind, LightSample, LightSampleContext, LightShape,
+    Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::real::{load, F32x8, Real, V3};
 use lumis_sampling::warp;
@@ -388,6 +388,19 @@ impl Light for SphereLight {
 
     fn power(&self) -> Rgb {
         self.emission.power(self.area())
+    }
+
+    /// Normals in every direction, each emitting over its hemisphere.
+    fn bounds(&self) -> Option<LightBounds> {
+        let r = Vec3::splat(self.radius);
+        Some(LightBounds {
+            bounds: Aabb::of_points([self.center - r, self.center + r]),
+            w: Vec3::Z,
+            phi: self.power().luminance(),
+            cos_theta_o: -1.0,
+            cos_theta_e: 0.0,
+            two_sided: self.emission.two_sided,
+        })
     }
 }
 

@@ -4,8 +4,8 @@
 use lumis_core::interaction::LightSampleContext;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
-    Result, Rgb, Vec2, Vec3,
+    Aabb, Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
+    PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -142,6 +142,27 @@ impl Light for SpotLight {
     fn power(&self) -> Rgb {
         let (a, b) = (self.cos_falloff_end, self.cos_falloff_start);
         self.intensity * (2.0 * std::f32::consts::PI * ((1.0 - b) + 0.5 * (b - a)))
+    }
+
+    /// A point whose "normals" fill the inner cone and emit up to the
+    /// falloff's width beyond it; the power is that of the intensity on
+    /// the axis in every direction, as pbrt-v4's `SpotLight::Bounds`.
+    fn bounds(&self) -> Option<LightBounds> {
+        let (a, b) = (self.cos_falloff_end, self.cos_falloff_start);
+        let mut cos_theta_e = (a.acos() - b.acos()).cos();
+        // Slack for rounding in the importance's cos theta', where the
+        // falloff has a width that rounds away.
+        if cos_theta_e == 1.0 && a != b {
+            cos_theta_e = 0.999;
+        }
+        Some(LightBounds {
+            bounds: Aabb::point(self.position),
+            w: self.axis,
+            phi: self.intensity.luminance() * 4.0 * std::f32::consts::PI,
+            cos_theta_o: b,
+            cos_theta_e,
+            two_sided: false,
+        })
     }
 }
 

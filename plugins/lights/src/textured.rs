@@ -6,10 +6,11 @@
 use std::sync::Arc;
 
 use lumis_core::{
-    Light, LightKind, LightSample, LightSampleContext, Rgb, Texture, TextureQuery, Vec2, Vec3,
+    Light, LightBounds, LightKind, LightSample, LightSampleContext, Rgb, Texture, TextureQuery,
+    Vec2, Vec3,
 };
 
-use crate::area::{AreaLight, PlanarShape};
+use crate::area::{planar_bounds, AreaLight, PlanarShape};
 
 /// An area light of white radiance, scaled by `texture` at each point.
 ///
@@ -72,6 +73,14 @@ impl<S: PlanarShape> Light for TexturedAreaLight<S> {
 
     fn power(&self) -> Rgb {
         self.mean * self.light.power()
+    }
+
+    fn bounds(&self) -> Option<LightBounds> {
+        Some(planar_bounds(
+            &self.light.shape,
+            self.power(),
+            &self.light.emission,
+        ))
     }
 }
 

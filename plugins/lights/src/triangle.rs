@@ -4,7 +4,8 @@
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2, Vec3,
+    Aabb, Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2,
+    Vec3,
 };
 use lumis_sampling::{
     warp, SphericalTriangle, MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA,
@@ -109,6 +110,10 @@ impl Triangle {
 impl PlanarShape for Triangle {
     fn area(&self) -> f32 {
         self.area
+    }
+
+    fn bounds(&self) -> Aabb {
+        Aabb::of_points(self.p)
     }
 
     fn normal(&self) -> Vec3 {

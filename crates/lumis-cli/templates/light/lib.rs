@@ -17,8 +17,8 @@ use std::f32::consts::PI;
 use lumis_core::math::gamma;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
-    Error, Light, LightKind, LightSample, LightSampleContext, LightShape, Params, PluginKind,
-    PluginParams, PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
+    Aabb, Error, Light, LightBounds, LightKind, LightSample, LightSampleContext, LightShape,
+    Params, PluginKind, PluginParams, PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -184,5 +184,18 @@ impl Light for QuadEmitter {
     /// `pi L A`: the radiant flux of a Lambertian emitter (one side).
     fn power(&self) -> Rgb {
         self.radiance * (PI * self.area)
+    }
+
+    /// Where the quad is and which way it emits, so that the `bvh` light
+    /// sampler can weigh it by its place (without bounds a light is picked
+    /// as an environment is, wherever the shading point).
+    fn bounds(&self) -> Option<LightBounds> {
+        let (c, u, v) = (self.corner, self.edge_u, self.edge_v);
+        Some(LightBounds::planar(
+            Aabb::of_points([c, c + u, c + v, c + u + v]),
+            self.normal,
+            self.power().luminance(),
+            false,
+        ))
     }
 }
