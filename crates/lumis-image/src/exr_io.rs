@@ -117,9 +117,9 @@ pub fn stage_exr_with_layers(
     })
 }
 
-/// The text attributes of an EXR file's header (not its pixels).
-pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
-    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| match e {
+/// `e`, from reading the EXR file `path`, as an [`ImageError`].
+fn unreadable_exr(path: &Path, e: exr::error::Error) -> ImageError {
+    match e {
         exr::error::Error::Io(source) => ImageError::Io {
             path: path.to_path_buf(),
             source,
@@ -128,7 +128,13 @@ pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
             path: path.to_path_buf(),
             message: format!("not a readable EXR: {e}"),
         },
-    })?;
+    }
+}
+
+/// The text attributes of an EXR file's header (not its pixels).
+pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| unreadable_exr(path, e))?;
     let mut out = ExrMetadata::new();
     for header in &meta.headers {
         let attributes = header
@@ -149,16 +155,8 @@ pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
 /// Every channel of an EXR file's layers, by full name (`R`,
 /// `albedo.G`), row-major, converted to `f32`.
 pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
-    let image = exr::image::read::read_all_flat_layers_from_file(path).map_err(|e| match e {
-        exr::error::Error::Io(source) => ImageError::Io {
-            path: path.to_path_buf(),
-            source,
-        },
-        e => ImageError::Format {
-            path: path.to_path_buf(),
-            message: format!("not a readable EXR: {e}"),
-        },
-    })?;
+    let image = exr::image::read::read_all_flat_layers_from_file(path)
+        .map_err(|e| unreadable_exr(path, e))?;
     let mut out = Vec::new();
     for layer in &image.layer_data {
         let prefix = layer
