@@ -107,11 +107,11 @@ pub fn bias_variance(renders: &[&Image], reference: &Image) -> Result<BiasVarian
     let (mut rel_bias2, mut rel_variance) = (Moments::default(), Moments::default());
     let mut values = vec![0.0f64; renders.len()];
     for (p, r) in reference.pixels.iter().enumerate() {
-        for c in 0..3 {
+        for (c, &reference_value) in r.iter().enumerate() {
             for (v, image) in values.iter_mut().zip(renders) {
                 *v = image.pixels[p][c] as f64;
             }
-            let reference_value = r[c] as f64;
+            let reference_value = reference_value as f64;
             let mean = values.iter().sum::<f64>() / n;
             let s2 = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
             let b2 = (mean - reference_value).powi(2) - s2 / n;
