@@ -280,3 +280,58 @@ fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
     assert_eq!((meta.spp, meta.passes), (128, 4), "restarted from zero");
     assert_ne!(read(&path), read(&whole));
 }
+
+/// The committed bias-study variants (raw, adaptive, denoised, denoised +
+/// adaptive, clamped) run on their bench scenes, shrunk to 8x8, and each
+/// gets its error split.
+#[test]
+fn the_bias_study_variants_run_on_their_scenes() {
+    let tmp = scratch("bias-study");
+    let dir = tmp.path();
+    let registry = builtin_registry().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let small = "film.resolution=[8, 8]";
+    for name in ["cornell-box", "glossy-beckmann", "textured-gltf"] {
+        let scene = root.join(format!("scenes/bench/{name}.toml"));
+        let reference = dir.join(format!("{name}-reference.exr"));
+        render_scene_file(
+            &RenderArgs {
+                scene: scene.clone(),
+                spp: Some(64),
+                output: Some(reference.clone()),
+                set: vec![small.into()],
+                quiet: true,
+                ..Default::default()
+            },
+            &registry,
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        let args = ConvergeArgs {
+            scene,
+            reference,
+            variants: root.join(format!("scenes/variants/bias/{name}.toml")),
+            spp: vec![16],
+            seeds: 2,
+            time_budget: None,
+            set: vec![small.into()],
+            threads: 0,
+            out: dir.join(name),
+        };
+        let report = converge(&args, &registry, &AtomicBool::new(false))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let names: Vec<&str> = report.points.iter().map(|p| p.variant.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "raw",
+                "adaptive",
+                "denoised",
+                "denoised+adaptive",
+                "clamped"
+            ],
+            "{name}"
+        );
+        assert!(report.points.iter().all(|p| p.split.is_some()), "{name}");
+    }
+}
