@@ -37,6 +37,11 @@ pub struct ConvergeArgs {
     /// two or more split the error into bias² and variance.
     #[arg(long, default_value_t = 4)]
     pub seeds: u64,
+    /// The first seed: renders use seeds FIRST .. FIRST + --seeds. Keep
+    /// them apart from the reference's (a `lumis reference` of N passes
+    /// from seed S used S .. S + N), or the shared samples make bias² low.
+    #[arg(long, value_name = "FIRST", default_value_t = 0)]
+    pub first_seed: u64,
     /// Equal time instead of equal samples: each variant doubles its spp
     /// from the smallest --spp while one render fits in this many seconds.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
@@ -351,7 +356,7 @@ pub fn converge(
             bar.set_message(format!("{} @ {spp} spp", variant.name));
             let mut these = Vec::new();
             let mut images = Vec::new();
-            for s in 0..args.seeds {
+            for s in args.first_seed..args.first_seed + args.seeds {
                 if stop.load(Ordering::Relaxed) {
                     interrupted = true;
                     runs.extend(these);
@@ -441,6 +446,16 @@ fn reference_provenance(args: &ConvergeArgs) -> String {
         lumis_scene::scene_hash(&args.scene, &[]).is_ok_and(|hash| hash == meta.scene_file_hash);
     if !same_scene {
         out += "warning: the reference was rendered from a different version of the scene file\n";
+    }
+    let reference_seeds = meta.seed..meta.seed.saturating_add(meta.passes);
+    let seeds = args.first_seed..args.first_seed.saturating_add(args.seeds);
+    if reference_seeds.start < seeds.end && seeds.start < reference_seeds.end {
+        writeln!(
+            out,
+            "warning: the reference's seeds {reference_seeds:?} overlap the seeds measured {seeds:?}: \
+             their shared samples make the error, and bias², look smaller (see --first-seed)"
+        )
+        .unwrap();
     }
     out
 }

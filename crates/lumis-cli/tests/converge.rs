@@ -57,6 +57,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
         variants,
         spp: vec![1, 2, 4, 8, 16, 32, 64],
         seeds: 16,
+        first_seed: 0,
         time_budget: None,
         set: vec![TINY.into()],
         threads: 0,
@@ -120,12 +121,13 @@ fn a_denoised_variant_is_measured_and_the_error_is_split() {
     )
     .unwrap();
     let out = dir.join("out");
-    let args = ConvergeArgs {
+    let mut args = ConvergeArgs {
         scene: scene(),
         reference,
         variants,
         spp: vec![1, 4],
         seeds: 3,
+        first_seed: 0,
         time_budget: None,
         set: vec![TINY.into()],
         threads: 0,
@@ -169,6 +171,17 @@ fn a_denoised_variant_is_measured_and_the_error_is_split() {
     assert_eq!(json.matches("\"rel_mse_split\"").count(), 4, "{json}");
     assert!(report.table.contains("bias²") && report.table.contains("denoised"));
     assert!(out.join("renders/1-denoised.denoised.exr").is_file());
+    assert!(!report.table.contains("overlap"), "{}", report.table);
+    // The reference was rendered from seed 1000: measuring that seed again
+    // is warned about.
+    args.first_seed = 1000;
+    args.spp = vec![1];
+    let report = converge(&args, &registry, &AtomicBool::new(false)).unwrap();
+    assert!(
+        report.table.contains("overlap the seeds measured"),
+        "{}",
+        report.table
+    );
 }
 
 #[test]
@@ -190,6 +203,7 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
         variants: variants.clone(),
         spp: vec![1],
         seeds: 1,
+        first_seed: 0,
         time_budget: None,
         set: vec![TINY.into()],
         threads: 0,
@@ -298,6 +312,7 @@ fn the_bias_study_variants_run_on_their_scenes() {
             &RenderArgs {
                 scene: scene.clone(),
                 spp: Some(64),
+                seed: Some(1000),
                 output: Some(reference.clone()),
                 set: vec![small.into()],
                 quiet: true,
@@ -313,6 +328,7 @@ fn the_bias_study_variants_run_on_their_scenes() {
             variants: root.join(format!("scenes/variants/bias/{name}.toml")),
             spp: vec![16],
             seeds: 2,
+            first_seed: 0,
             time_budget: None,
             set: vec![small.into()],
             threads: 0,
