@@ -18,6 +18,7 @@ fn mis_is_more_efficient_than_either_single_strategy() {
         variants: scenes_dir().join("variants/strategies.toml"),
         spp: vec![4, 8],
         seeds: 2,
+        first_seed: 0,
         time_budget: None,
         // The Phong plugin is linked statically here.
         set: vec!["plugins.load=[]".into()],

@@ -2,8 +2,10 @@
 //! buys. Discrepancy ([`discrepancy`]), power spectra ([`spectrum`]),
 //! convergence on integrands with known integrals against Simpson's rule
 //! ([`convergence`], [`integrands`]), image error metrics against a
-//! reference ([`image_error`]), and the PNG plots ([`plot`]).
+//! reference ([`image_error`]) and its split into bias² and variance
+//! ([`bias_variance`]), and the PNG plots ([`plot`]).
 
+pub mod bias_variance;
 pub mod convergence;
 pub mod discrepancy;
 pub mod image_error;

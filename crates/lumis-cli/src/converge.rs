@@ -7,17 +7,17 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use lumis_analysis::bias_variance::{bias_variance, BiasVariance, Split};
 use lumis_analysis::convergence::loglog_slope;
 use lumis_analysis::image_error::{check_same_size, error_metrics};
 use lumis_analysis::plot::{self, Axes, Series};
 use lumis_core::doc::{self, Value};
 use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Registry, Result};
-use lumis_image::read_exr;
-use lumis_render::{render, RenderSettings};
+use lumis_image::{read_exr, Image};
 
 use crate::metadata::ImageMetadata;
-use crate::render::{load, RenderArgs};
+use crate::render::{render_scene_file, RenderArgs};
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct ConvergeArgs {
@@ -26,17 +26,24 @@ pub struct ConvergeArgs {
     /// The converged reference image (EXR) of the same scene.
     #[arg(long)]
     pub reference: PathBuf,
-    /// Variants (TOML: `[[variant]] name = "...", set = ["sampler.type=sobol", ...]`).
+    /// Variants (TOML: `[[variant]] name = "...", set = ["sampler.type=sobol", ...]`,
+    /// optionally `image = "denoised"`).
     #[arg(long, value_name = "variants.toml")]
     pub variants: PathBuf,
     /// Samples per pixel to measure, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2,4,8,16,32,64")]
     pub spp: Vec<u32>,
-    /// Seeds per (variant, spp): the spread gives the standard errors.
+    /// Seeds per (variant, spp): the spread gives the standard errors, and
+    /// two or more split the error into bias² and variance.
     #[arg(long, default_value_t = 4)]
     pub seeds: u64,
+    /// The first seed: renders use seeds FIRST .. FIRST + --seeds. Keep
+    /// them apart from the reference's (a `lumis reference` of N passes
+    /// from seed S used S .. S + N), or the shared samples make bias² low.
+    #[arg(long, value_name = "FIRST", default_value_t = 0)]
+    pub first_seed: u64,
     /// Equal time instead of equal samples: each variant doubles its spp
-    /// from 1 while one render fits in this many seconds.
+    /// from the smallest --spp while one render fits in this many seconds.
     #[arg(long, value_name = "SECONDS", value_parser = parse_seconds)]
     pub time_budget: Option<f64>,
     /// Overrides applied to every variant (like `lumis render --set`).
@@ -61,11 +68,35 @@ fn parse_seconds(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// One variant: a name and its scene overrides.
+/// Which image of a render a variant is measured on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MeasuredImage {
+    /// The film's image (`NAME.exr`).
+    #[default]
+    Raw,
+    /// The `[denoiser]`'s image (`NAME.denoised.exr`); the denoiser's time
+    /// counts in the variant's.
+    Denoised,
+}
+
+impl MeasuredImage {
+    const NAMES: &'static str = "\"raw\" or \"denoised\"";
+
+    fn parse(text: &str) -> Option<Self> {
+        match text {
+            "raw" => Some(Self::Raw),
+            "denoised" => Some(Self::Denoised),
+            _ => None,
+        }
+    }
+}
+
+/// One variant: a name, its scene overrides and the image measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
     pub name: String,
     pub set: Vec<String>,
+    pub image: MeasuredImage,
 }
 
 /// Reads `[[variant]]` tables, with located errors.
@@ -90,10 +121,10 @@ pub fn parse_variants(text: &str, path: &str) -> Result<Vec<Variant>> {
                 return Err(Error::at(&item.location, "each variant must be a table"));
             };
             for key in table.keys() {
-                if key != "name" && key != "set" {
+                if !["name", "set", "image"].contains(&key) {
                     return Err(Error::at(
                         &table.entry(key).unwrap().key_location,
-                        format!("unknown variant key '{key}'; accepted: name, set"),
+                        format!("unknown variant key '{key}'; accepted: name, set, image"),
                     ));
                 }
             }
@@ -118,9 +149,23 @@ pub fn parse_variants(text: &str, path: &str) -> Result<Vec<Variant>> {
                     }
                 }
             }
+            let image = match table.get("image") {
+                None => MeasuredImage::default(),
+                Some(node) => match &node.value {
+                    Value::String(text) => MeasuredImage::parse(text),
+                    _ => None,
+                }
+                .ok_or_else(|| {
+                    Error::at(
+                        &node.location,
+                        format!("variant \"{name}\": image must be {}", MeasuredImage::NAMES),
+                    )
+                })?,
+            };
             variants.push(Variant {
                 name: name.clone(),
                 set,
+                image,
             });
         }
     }
@@ -157,6 +202,9 @@ pub struct Point {
     pub rel_mse_max: f64,
     /// 1 / (relMSE x seconds).
     pub efficiency: f64,
+    /// The error split into bias² and variance across the seeds (with two
+    /// or more seeds).
+    pub split: Option<BiasVariance>,
 }
 
 fn mean_se(values: &[f64]) -> (f64, f64) {
@@ -169,7 +217,8 @@ fn mean_se(values: &[f64]) -> (f64, f64) {
     (mean, (var / n).sqrt())
 }
 
-fn summarise(runs: &[Run]) -> Point {
+/// Summarises the seeds of one (variant, spp), `images` their renders.
+fn summarise(runs: &[Run], images: &[Image], reference: &Image) -> Point {
     let rel: Vec<f64> = runs.iter().map(|r| r.rel_mse).collect();
     let mse: Vec<f64> = runs.iter().map(|r| r.mse).collect();
     let (rel_mse, rel_mse_se) = mean_se(&rel);
@@ -186,6 +235,7 @@ fn summarise(runs: &[Run]) -> Point {
         rel_mse_min: rel.iter().cloned().fold(f64::INFINITY, f64::min),
         rel_mse_max: rel.iter().cloned().fold(0.0, f64::max),
         efficiency: 1.0 / (rel_mse * seconds),
+        split: bias_variance(&images.iter().collect::<Vec<_>>(), reference).ok(),
     }
 }
 
@@ -217,7 +267,7 @@ pub fn converge(
     let variants_path = args.variants.display().to_string();
     let text = read_text_bounded(&args.variants, VARIANTS_FILE).map_err(Error::msg)?;
     let variants = parse_variants(&text, &variants_path)?;
-    if args.seeds == 0 || args.spp.contains(&0) {
+    if args.seeds == 0 || args.spp.is_empty() || args.spp.contains(&0) {
         return Err(Error::msg(
             "--seeds and every --spp value must be at least 1",
         ));
@@ -225,54 +275,62 @@ pub fn converge(
     std::fs::create_dir_all(&args.out)
         .map_err(|e| Error::msg(format!("{}: {e}", args.out.display())))?;
 
-    let render_once = |variant: &Variant, spp: u32, seed: u64| -> Result<Run> {
-        let mut set = args.set.clone();
-        set.extend(variant.set.iter().cloned());
-        let render_args = RenderArgs {
-            scene: args.scene.clone(),
-            spp: Some(spp),
-            seed: Some(seed),
-            threads: args.threads,
-            set,
-            ..Default::default()
+    // Each render goes through `lumis render` itself (adaptive sampling,
+    // clamping, the denoiser), one pass of all its samples; `renders/`
+    // keeps each variant's last render.
+    let renders = args.out.join("renders");
+    std::fs::create_dir_all(&renders)
+        .map_err(|e| Error::msg(format!("{}: {e}", renders.display())))?;
+    let never = AtomicBool::new(false);
+    let render_once =
+        |index: usize, variant: &Variant, spp: u32, seed: u64| -> Result<(Run, Image)> {
+            let mut set = args.set.clone();
+            set.extend(variant.set.iter().cloned());
+            let render_args = RenderArgs {
+                scene: args.scene.clone(),
+                spp: Some(spp),
+                seed: Some(seed),
+                threads: args.threads,
+                output: Some(renders.join(format!("{index}-{}.exr", file_stem(&variant.name)))),
+                set,
+                quiet: true,
+                no_checkpoint: true,
+                pass_spp: Some(spp),
+                ..Default::default()
+            };
+            let context = |e: Error| Error::msg(format!("variant \"{}\": {e}", variant.name));
+            let report = render_scene_file(&render_args, registry, &never).map_err(context)?;
+            // A loaded plugin that panicked answered with neutral values.
+            registry.faults().check()?;
+            let (image, seconds) = match (variant.image, report.denoised) {
+            (MeasuredImage::Raw, _) => (report.image, report.seconds),
+            (MeasuredImage::Denoised, Some(denoised)) => {
+                (denoised.image, report.seconds + denoised.seconds)
+            }
+            (MeasuredImage::Denoised, None) => return Err(context(Error::msg(
+                "image = \"denoised\" needs a [denoiser]; add \"denoiser.type=oidn\" to its set",
+            ))),
         };
-        let loaded = load(&render_args, registry)
-            .map_err(|e| Error::msg(format!("variant \"{}\": {e}", variant.name)))?;
-        let settings = RenderSettings {
-            spp,
-            seed,
-            threads: args.threads,
-            progress: false,
-            clamp: loaded.clamp,
+            check_same_size(&image, &reference).map_err(|e| {
+                Error::msg(format!(
+                    "variant \"{}\" vs {}: {e}",
+                    variant.name,
+                    args.reference.display()
+                ))
+            })?;
+            let m = error_metrics(&image, &reference, None);
+            let run = Run {
+                variant: variant.name.clone(),
+                spp,
+                seed,
+                seconds,
+                samples_per_second: report.stats.samples as f64 / report.seconds,
+                rays_per_second: report.stats.total_rays() as f64 / report.seconds,
+                mse: m.mse,
+                rel_mse: m.rel_mse,
+            };
+            Ok((run, image))
         };
-        let out = render(
-            &loaded.camera,
-            &loaded.scene,
-            loaded.integrator.as_ref(),
-            loaded.sampler.as_ref(),
-            &settings,
-        )?;
-        // A loaded plugin that panicked answered with neutral values.
-        registry.faults().check()?;
-        check_same_size(&out.image, &reference).map_err(|e| {
-            Error::msg(format!(
-                "variant \"{}\" vs {}: {e}",
-                variant.name,
-                args.reference.display()
-            ))
-        })?;
-        let m = error_metrics(&out.image, &reference, None);
-        Ok(Run {
-            variant: variant.name.clone(),
-            spp,
-            seed,
-            seconds: out.seconds,
-            samples_per_second: out.stats.samples as f64 / out.seconds,
-            rays_per_second: out.stats.total_rays() as f64 / out.seconds,
-            mse: m.mse,
-            rel_mse: m.rel_mse,
-        })
-    };
 
     let style = ProgressStyle::with_template("{msg:28} [{bar:40}] {pos}/{len} {elapsed}")
         .expect("valid template")
@@ -284,9 +342,9 @@ pub fn converge(
     let mut runs = Vec::new();
     let mut points = Vec::new();
     let mut interrupted = false;
-    'variants: for variant in &variants {
+    'variants: for (index, variant) in variants.iter().enumerate() {
         let mut spp_list: Vec<u32> = match args.time_budget {
-            Some(_) => vec![1],
+            Some(_) => args.spp.iter().min().into_iter().copied().collect(),
             None => args.spp.clone(),
         };
         let per_spp = args.seeds;
@@ -297,17 +355,20 @@ pub fn converge(
             let spp = spp_list[i];
             bar.set_message(format!("{} @ {spp} spp", variant.name));
             let mut these = Vec::new();
-            for s in 0..args.seeds {
+            let mut images = Vec::new();
+            for s in args.first_seed..args.first_seed + args.seeds {
                 if stop.load(Ordering::Relaxed) {
                     interrupted = true;
                     runs.extend(these);
                     bar.abandon();
                     break 'variants;
                 }
-                these.push(render_once(variant, spp, s)?);
+                let (run, image) = render_once(index, variant, spp, s)?;
+                these.push(run);
+                images.push(image);
                 bar.inc(1);
             }
-            let point = summarise(&these);
+            let point = summarise(&these, &images, &reference);
             runs.extend(these);
             if let Some(budget) = args.time_budget {
                 if point.seconds > budget && i > 0 {
@@ -357,6 +418,20 @@ pub fn converge(
     })
 }
 
+/// A variant's name as a file name: letters, digits, `-` and `_` kept,
+/// anything else `-`.
+fn file_stem(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect()
+}
+
 /// What the reference's metadata (in its EXR header) says, and a warning
 /// when it was rendered from another version of the scene file.
 fn reference_provenance(args: &ConvergeArgs) -> String {
@@ -371,6 +446,16 @@ fn reference_provenance(args: &ConvergeArgs) -> String {
         lumis_scene::scene_hash(&args.scene, &[]).is_ok_and(|hash| hash == meta.scene_file_hash);
     if !same_scene {
         out += "warning: the reference was rendered from a different version of the scene file\n";
+    }
+    let reference_seeds = meta.seed..meta.seed.saturating_add(meta.passes);
+    let seeds = args.first_seed..args.first_seed.saturating_add(args.seeds);
+    if reference_seeds.start < seeds.end && seeds.start < reference_seeds.end {
+        writeln!(
+            out,
+            "warning: the reference's seeds {reference_seeds:?} overlap the seeds measured {seeds:?}: \
+             their shared samples make the error, and bias², look smaller (see --first-seed)"
+        )
+        .unwrap();
     }
     out
 }
@@ -391,8 +476,8 @@ fn ranked_table(
         None => last.sort_by(|a, b| b.efficiency.total_cmp(&a.efficiency)),
     }
     let mut out = format!(
-        "{:20} {:>6} {:>9} {:>11} {:>10} {:>11} {:>8}\n",
-        "variant", "spp", "seconds", "relMSE", "+-se", "efficiency", "slope"
+        "{:20} {:>6} {:>9} {:>11} {:>10} {:>11} {:>11} {:>11} {:>8}\n",
+        "variant", "spp", "seconds", "relMSE", "+-se", "bias²", "variance", "efficiency", "slope"
     );
     for p in last {
         let slope = slopes
@@ -400,10 +485,24 @@ fn ranked_table(
             .find(|s| s.0 == p.variant)
             .and_then(|s| s.1)
             .map_or("-".into(), |s| format!("{s:+.2}"));
+        let (bias2, variance) = p.split.map_or(("-".into(), "-".into()), |s| {
+            (
+                format!("{:.4e}", s.rel_mse.bias2),
+                format!("{:.4e}", s.rel_mse.variance),
+            )
+        });
         writeln!(
             out,
-            "{:20} {:>6} {:>9.3} {:>11.4e} {:>10.2e} {:>11.1} {:>8}",
-            p.variant, p.spp, p.seconds, p.rel_mse, p.rel_mse_se, p.efficiency, slope
+            "{:20} {:>6} {:>9.3} {:>11.4e} {:>10.2e} {:>11} {:>11} {:>11.1} {:>8}",
+            p.variant,
+            p.spp,
+            p.seconds,
+            p.rel_mse,
+            p.rel_mse_se,
+            bias2,
+            variance,
+            p.efficiency,
+            slope
         )
         .unwrap();
     }
@@ -412,6 +511,8 @@ fn ranked_table(
         None => "(ranked by efficiency 1 / (relMSE x seconds) at the largest spp; slope: log-log relMSE vs spp)\n".to_string(),
     }
     .as_str();
+    out +=
+        "(bias² + variance: the relMSE of one render split over the seeds; they need 2 or more)\n";
     out
 }
 
@@ -423,18 +524,51 @@ fn write_text(path: &Path, text: &str) -> Result<()> {
     .map_err(|e| Error::msg(e.to_string()))
 }
 
+/// `{"bias2": .., "bias2_se": .., "variance": .., "variance_se": ..}`; the
+/// standard errors are over pixels (see [`lumis_analysis::bias_variance`]).
+fn split_json(s: &Split) -> String {
+    let number = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.6e}")
+        } else {
+            "null".into()
+        }
+    };
+    format!(
+        "{{\"bias2\": {}, \"bias2_se\": {}, \"variance\": {}, \"variance_se\": {}}}",
+        number(s.bias2),
+        number(s.bias2_se),
+        number(s.variance),
+        number(s.variance_se)
+    )
+}
+
 fn write_outputs(
     args: &ConvergeArgs,
     variants: &[Variant],
     runs: &[Run],
     points: &[Point],
 ) -> Result<()> {
-    let mut csv =
-        String::from("variant,spp,seed,seconds,samples_per_second,rays_per_second,mse,rel_mse\n");
+    let mut csv = String::from(
+        "variant,spp,seed,seconds,samples_per_second,rays_per_second,mse,rel_mse,\
+         bias2,variance,rel_bias2,rel_variance\n",
+    );
     for r in runs {
+        // The split belongs to the run's (variant, spp), repeated on each
+        // seed's row; empty with one seed.
+        let split = points
+            .iter()
+            .find(|p| p.variant == r.variant && p.spp == r.spp)
+            .and_then(|p| p.split)
+            .map_or(",,,".to_string(), |s| {
+                format!(
+                    "{:.6e},{:.6e},{:.6e},{:.6e}",
+                    s.mse.bias2, s.mse.variance, s.rel_mse.bias2, s.rel_mse.variance
+                )
+            });
         writeln!(
             csv,
-            "{},{},{},{:.6},{:.1},{:.1},{:.6e},{:.6e}",
+            "{},{},{},{:.6},{:.1},{:.1},{:.6e},{:.6e},{split}",
             r.variant,
             r.spp,
             r.seed,
@@ -451,8 +585,9 @@ fn write_outputs(
         .iter()
         .map(|p| {
             format!(
-                "    {{\"variant\": {:?}, \"spp\": {}, \"seconds\": {:.6}, \"mse\": {:.6e}, \"mse_se\": {:.6e}, \"rel_mse\": {:.6e}, \"rel_mse_se\": {:.6e}, \"efficiency\": {:.6e}}}",
-                p.variant, p.spp, p.seconds, p.mse, p.mse_se.max(0.0), p.rel_mse, p.rel_mse_se.max(0.0), p.efficiency
+                "    {{\"variant\": {:?}, \"spp\": {}, \"seconds\": {:.6}, \"mse\": {:.6e}, \"mse_se\": {:.6e}, \"rel_mse\": {:.6e}, \"rel_mse_se\": {:.6e}, \"efficiency\": {:.6e}{}}}",
+                p.variant, p.spp, p.seconds, p.mse, p.mse_se.max(0.0), p.rel_mse, p.rel_mse_se.max(0.0), p.efficiency,
+                p.split.map_or(String::new(), |s| format!(", \"mse_split\": {}, \"rel_mse_split\": {}", split_json(&s.mse), split_json(&s.rel_mse)))
             )
         })
         .collect();

@@ -27,7 +27,7 @@ pub fn claim_denoised_outputs(raw_exr: &Path) -> Result<Outputs> {
 }
 
 /// Denoises `color` (guided by the film's `albedo` and `normal`, when it
-/// made them) and writes the result to `outputs`. Called once the raw image
+/// made them), writes the result to `outputs` and returns it. Called once the raw image
 /// is on disk: an error here leaves it in place and says so.
 pub fn write_denoised(
     denoiser: &dyn Denoiser,
@@ -37,7 +37,7 @@ pub fn write_denoised(
     outputs: &Outputs,
     metadata: &ImageMetadata,
     raw_exr: &Path,
-) -> Result<()> {
+) -> Result<Image> {
     let input = DenoiseInput {
         width: color.width,
         height: color.height,
@@ -65,7 +65,8 @@ pub fn write_denoised(
         height: color.height,
         pixels,
     };
-    outputs.write(&denoised, &[], metadata).map_err(failed)
+    outputs.write(&denoised, &[], metadata).map_err(failed)?;
+    Ok(denoised)
 }
 
 #[cfg(test)]

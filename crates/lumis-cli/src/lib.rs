@@ -21,7 +21,9 @@ mod samplers_analyze;
 pub use assignments::{fixed_parameters, parameter_table};
 pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
 pub use checkpoint::{checkpoint_path, Checkpoint};
-pub use converge::{converge, parse_variants, ConvergeArgs, ConvergeReport, Point, Run, Variant};
+pub use converge::{
+    converge, parse_variants, ConvergeArgs, ConvergeReport, MeasuredImage, Point, Run, Variant,
+};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use integrator_check::{
     check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,
@@ -33,7 +35,8 @@ pub use metadata::ImageMetadata;
 pub use new_plugin::{new_plugin, NewPluginArgs, NewPluginKind};
 pub use reference::{render_reference, ReferenceArgs};
 pub use render::{
-    output_paths, render_scene_file, RenderArgs, RenderReport, DEFAULT_CHECKPOINT_SECONDS,
+    output_paths, render_scene_file, DenoisedReport, RenderArgs, RenderReport,
+    DEFAULT_CHECKPOINT_SECONDS,
 };
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
 

@@ -84,8 +84,8 @@ pub struct RenderReport {
     pub aovs: Vec<(Aov, Image)>,
     pub exr: PathBuf,
     pub png: PathBuf,
-    /// The denoised EXR, when the scene has a `[denoiser]`.
-    pub denoised: Option<PathBuf>,
+    /// The denoised image, when the scene has a `[denoiser]`.
+    pub denoised: Option<DenoisedReport>,
     pub spp: u32,
     /// Stopped by a signal: the image holds the passes finished before it.
     pub interrupted: bool,
@@ -119,10 +119,23 @@ impl RenderReport {
             self.stats.light_samples,
             self.exr.display(),
         ) + &match &self.denoised {
-            Some(path) => format!(", denoised -> {}", path.display()),
+            Some(denoised) => format!(
+                ", denoised in {:.2} s -> {}",
+                denoised.seconds,
+                denoised.exr.display()
+            ),
             None => String::new(),
         }
     }
+}
+
+/// The denoised image of a render and what making it cost.
+pub struct DenoisedReport {
+    pub image: Image,
+    pub exr: PathBuf,
+    /// Wall time of the denoiser and of writing its image, which a
+    /// comparison at equal time adds to the render's.
+    pub seconds: f64,
 }
 
 /// `PATH.exr` and `PATH.png` for an output argument given with `.exr`,
@@ -490,7 +503,8 @@ pub fn render_scene_file(
             // always makes) guide it.
             let aovs = state.film.aov_images();
             let guide = |wanted: Aov| aovs.iter().find(|(aov, _)| *aov == wanted).map(|(_, i)| i);
-            crate::denoise::write_denoised(
+            let start = Instant::now();
+            let image = crate::denoise::write_denoised(
                 denoiser.as_ref(),
                 &state.film.image(),
                 guide(Aov::Albedo),
@@ -499,7 +513,11 @@ pub fn render_scene_file(
                 &metadata(&state),
                 &exr,
             )?;
-            Some(denoised.exr.clone())
+            Some(DenoisedReport {
+                image,
+                exr: denoised.exr.clone(),
+                seconds: start.elapsed().as_secs_f64(),
+            })
         }
         _ => None,
     };

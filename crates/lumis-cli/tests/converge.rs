@@ -57,6 +57,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
         variants,
         spp: vec![1, 2, 4, 8, 16, 32, 64],
         seeds: 16,
+        first_seed: 0,
         time_budget: None,
         set: vec![TINY.into()],
         threads: 0,
@@ -89,6 +90,100 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
     assert!(report.table.contains("stratified"));
 }
 
+/// A raw and a denoised variant over two seeds: the split is in every
+/// output, and per (variant, spp) bias² + variance is the mean relMSE of
+/// its renders (the identity the split rests on).
+#[test]
+fn a_denoised_variant_is_measured_and_the_error_is_split() {
+    let tmp = scratch("split");
+    let dir = tmp.path();
+    let registry = builtin_registry().unwrap();
+    let reference = dir.join("reference.exr");
+    render_scene_file(
+        &RenderArgs {
+            scene: scene(),
+            spp: Some(256),
+            seed: Some(1000),
+            output: Some(reference.clone()),
+            set: vec![TINY.into()],
+            quiet: true,
+            ..Default::default()
+        },
+        &registry,
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    let variants = dir.join("variants.toml");
+    std::fs::write(
+        &variants,
+        "[[variant]]\nname = \"raw\"\n\n\
+         [[variant]]\nname = \"denoised\"\nset = [\"denoiser.type=oidn\"]\nimage = \"denoised\"\n",
+    )
+    .unwrap();
+    let out = dir.join("out");
+    let mut args = ConvergeArgs {
+        scene: scene(),
+        reference,
+        variants,
+        spp: vec![1, 4],
+        seeds: 3,
+        first_seed: 0,
+        time_budget: None,
+        set: vec![TINY.into()],
+        threads: 0,
+        out: out.clone(),
+    };
+    let report = converge(&args, &registry, &AtomicBool::new(false)).unwrap();
+    assert_eq!(report.points.len(), 4);
+    for point in &report.points {
+        let split = point.split.expect("3 seeds split the error");
+        let total = split.rel_mse.bias2 + split.rel_mse.variance;
+        assert!(
+            (total - point.rel_mse).abs() < 1e-4 * point.rel_mse,
+            "{} @ {}: {total} vs {}",
+            point.variant,
+            point.spp,
+            point.rel_mse
+        );
+    }
+    let rel = |name: &str| {
+        report
+            .points
+            .iter()
+            .find(|p| p.variant == name && p.spp == 1)
+            .unwrap()
+            .rel_mse
+    };
+    assert_ne!(
+        rel("raw"),
+        rel("denoised"),
+        "the denoised image was measured"
+    );
+    let csv = std::fs::read_to_string(out.join("converge.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.ends_with(",bias2,variance,rel_bias2,rel_variance"),
+        "{header}"
+    );
+    assert_eq!(csv.lines().count(), 1 + 2 * 2 * 3);
+    assert!(csv.lines().skip(1).all(|l| !l.ends_with(",,,")), "{csv}");
+    let json = std::fs::read_to_string(out.join("converge.json")).unwrap();
+    assert_eq!(json.matches("\"rel_mse_split\"").count(), 4, "{json}");
+    assert!(report.table.contains("bias²") && report.table.contains("denoised"));
+    assert!(out.join("renders/1-denoised.denoised.exr").is_file());
+    assert!(!report.table.contains("overlap"), "{}", report.table);
+    // The reference was rendered from seed 1000: measuring that seed again
+    // is warned about.
+    args.first_seed = 1000;
+    args.spp = vec![1];
+    let report = converge(&args, &registry, &AtomicBool::new(false)).unwrap();
+    assert!(
+        report.table.contains("overlap the seeds measured"),
+        "{}",
+        report.table
+    );
+}
+
 #[test]
 fn bad_variants_and_mismatched_reference_are_clear_errors() {
     let tmp = scratch("errors");
@@ -108,6 +203,7 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
         variants: variants.clone(),
         spp: vec![1],
         seeds: 1,
+        first_seed: 0,
         time_budget: None,
         set: vec![TINY.into()],
         threads: 0,
@@ -121,6 +217,26 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
         e.contains("variants.toml:3") && e.contains("key.path=value"),
         "{e}"
     );
+    std::fs::write(
+        &variants,
+        "[[variant]]\nname = \"a\"\nimage = \"blurred\"\n",
+    )
+    .unwrap();
+    let e = converge(&args, &registry, &AtomicBool::new(false))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("image must be \"raw\" or \"denoised\""), "{e}");
+    std::fs::write(
+        &variants,
+        "[[variant]]\nname = \"a\"\nimage = \"denoised\"\n",
+    )
+    .unwrap();
+    let e = converge(&args, &registry, &AtomicBool::new(false))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("needs a [denoiser]"), "{e}");
     std::fs::write(&variants, "[[variant]]\nname = \"a\"\nset = []\n").unwrap();
     let e = converge(&args, &registry, &AtomicBool::new(false))
         .err()
@@ -177,4 +293,61 @@ fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
     let (_, meta) = render_reference(&args(128, "resumed.exr", &forced), &registry, &stop).unwrap();
     assert_eq!((meta.spp, meta.passes), (128, 4), "restarted from zero");
     assert_ne!(read(&path), read(&whole));
+}
+
+/// The committed bias-study variants (raw, adaptive, denoised, denoised +
+/// adaptive, clamped) run on their bench scenes, shrunk to 8x8, and each
+/// gets its error split.
+#[test]
+fn the_bias_study_variants_run_on_their_scenes() {
+    let tmp = scratch("bias-study");
+    let dir = tmp.path();
+    let registry = builtin_registry().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let small = "film.resolution=[8, 8]";
+    for name in ["cornell-box", "glossy-beckmann", "textured-gltf"] {
+        let scene = root.join(format!("scenes/bench/{name}.toml"));
+        let reference = dir.join(format!("{name}-reference.exr"));
+        render_scene_file(
+            &RenderArgs {
+                scene: scene.clone(),
+                spp: Some(64),
+                seed: Some(1000),
+                output: Some(reference.clone()),
+                set: vec![small.into()],
+                quiet: true,
+                ..Default::default()
+            },
+            &registry,
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        let args = ConvergeArgs {
+            scene,
+            reference,
+            variants: root.join(format!("scenes/variants/bias/{name}.toml")),
+            spp: vec![16],
+            seeds: 2,
+            first_seed: 0,
+            time_budget: None,
+            set: vec![small.into()],
+            threads: 0,
+            out: dir.join(name),
+        };
+        let report = converge(&args, &registry, &AtomicBool::new(false))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let names: Vec<&str> = report.points.iter().map(|p| p.variant.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "raw",
+                "adaptive",
+                "denoised",
+                "denoised+adaptive",
+                "clamped"
+            ],
+            "{name}"
+        );
+        assert!(report.points.iter().all(|p| p.split.is_some()), "{name}");
+    }
 }
