@@ -36,6 +36,8 @@ impl Tabulated {
     pub fn new(grid: Grid, y: &[Vec<f32>]) -> Self {
         let w_edges: Arc<[f32]> = grid.w_edges().into();
         let phi_edges: Arc<[f32]> = grid.phi_edges().into();
+        // The uniform part sums to DEFENSIVE whatever the radial range.
+        let w_span = w_edges[grid.n_w] - w_edges[0];
         let rows = y
             .iter()
             .map(|row| {
@@ -48,7 +50,7 @@ impl Tabulated {
                         0.0
                     };
                     (1.0 - DEFENSIVE) * data
-                        + DEFENSIVE * (w_edges[a + 1] - w_edges[a]) / grid.n_phi as f32
+                        + DEFENSIVE * (w_edges[a + 1] - w_edges[a]) / (w_span * grid.n_phi as f32)
                 };
                 let marginal: Vec<f32> = (0..grid.n_w)
                     .map(|a| (0..grid.n_phi).map(|b| joint(a, b)).sum())
