@@ -18,7 +18,7 @@ use indicatif::ProgressBar;
 use lumis_analysis::image_error::error_metrics;
 use lumis_cli::{tabulate_bsdf, TabulateArgs};
 use lumis_core::{Bsdf, BsdfContext, Vec2, Vec3};
-use lumis_measured::grid::Grid;
+use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::MerlTable;
 use lumis_measured::precompute::{prepare, Plan};
 use lumis_sampling::Pcg32;
@@ -52,6 +52,7 @@ const GRID: Grid = Grid {
     n_w: 64,
     n_phi: 64,
     supersamples: 4,
+    parameterization: Parameterization::HalfDiff,
 };
 
 fn temp_dir(tag: &str) -> PathBuf {

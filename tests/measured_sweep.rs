@@ -5,7 +5,10 @@
 //! Sidak-corrected over all cases), pdf integral <= 1, sample_f consistent
 //! with f and pdf, albedo <= 1, reciprocity, finiteness, at cos theta_o =
 //! 1e-4, 0.01, 0.1, 0.5, 1 and -1e-4, -0.5, -1 (one-sided: no samples from
-//! behind).
+//! behind). The same kit on the projected-deviation-vector (`pdv`)
+//! parameterization of the factored and tabulated strategies: the
+//! conductor-0.2 table in the default tier, every table and term count in
+//! an ignored sweep.
 
 use lumis_check::bsdf_suite::{
     check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
@@ -64,4 +67,57 @@ fn every_strategy_passes_the_check_kit_down_to_grazing() {
     println!("{report}");
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(results.iter().all(|r| r.passed()), "{report}");
+}
+
+/// The check kit on the `pdv` parameterization of `materials`, for the
+/// factored strategy with each of `terms` and the tabulated one.
+fn check_pdv(tag: &str, materials: &[(&str, &str, &[&str])], terms: &[i64]) {
+    let dir = std::env::temp_dir().join(format!("lumis-measured-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut variants: Vec<Variant> = Vec::new();
+    for &(name, bsdf, set) in materials {
+        let file = tabulated(&dir, name, bsdf, set);
+        let file = file.display();
+        let mut add = |label: String, extra: &str| {
+            let toml = format!("file = \"{file}\"\nparameterization = \"pdv\"\n{extra}");
+            variants.push(variant(label, &toml).unwrap());
+        };
+        for &l in terms {
+            add(
+                format!("{name} pdv factored L={l}"),
+                &format!("sampling = \"factored\"\nterms = {l}\n"),
+            );
+        }
+        add(
+            format!("{name} pdv tabulated"),
+            "sampling = \"tabulated\"\n",
+        );
+    }
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let results = check_bsdf_variants(
+        &registry,
+        "measured",
+        &variants,
+        &BsdfCheckConfig::default(),
+    )
+    .unwrap();
+    let report = format_results(&results);
+    println!("{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(results.iter().all(|r| r.passed()), "{report}");
+}
+
+#[test]
+fn pdv_sampling_of_a_conductor_passes_the_check_kit_down_to_grazing() {
+    check_pdv("pdv", &MATERIALS[1..2], &[2]);
+}
+
+/// Fails, for now, in one case: the tabulated strategy on conductor-0.05
+/// at exactly normal incidence with the default 64 radial bins (sampled
+/// mass 0.983 against the pdf's 0.992; 32 or 128 bins passed), see
+/// docs/src/studies/measured.md.
+#[test]
+#[ignore = "every table and term count: about 4 minutes"]
+fn pdv_sampling_of_every_table_passes_the_check_kit_down_to_grazing() {
+    check_pdv("pdv-sweep", &MATERIALS, &[1, 2, 4]);
 }

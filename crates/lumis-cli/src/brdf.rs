@@ -7,8 +7,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use lumis_core::ParamChoice;
 use lumis_core::{Bsdf, Error, Location, PluginEntity, PluginKind, Registry, Result};
-use lumis_measured::grid::Grid;
+use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::{write_atomic, MerlTable, THETA_H_RES};
 use lumis_measured::precompute::{prepare, Plan};
 use lumis_measured::tabulate::tabulate;
@@ -44,6 +45,9 @@ pub struct PrecomputeArgs {
     /// Outgoing elevations, half-angle bins, azimuth bins.
     #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
     pub grid: Vec<usize>,
+    /// The coordinates of the grid: half-diff or pdv.
+    #[arg(long, default_value = "half-diff")]
+    pub parameterization: String,
 }
 
 /// `lumis brdf tabulate`: returns the summary line.
@@ -101,12 +105,14 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
             )))
         }
     };
+    let parameterization = parameterization(&args.parameterization)?;
     let grid = match args.grid.as_slice() {
         &[n_o, n_w, n_phi] if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n)) => Grid {
             n_o,
             n_w,
             n_phi,
             supersamples: 4,
+            parameterization,
         },
         g => {
             return Err(Error::msg(format!(
@@ -132,4 +138,14 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
     let _ = std::fs::remove_file(&cache);
     let (_, report) = prepare(&table, &args.table, plan, grid, true)?;
     Ok(report.message)
+}
+
+/// `--parameterization`: one of the grid's coordinates by name.
+fn parameterization(name: &str) -> Result<Parameterization> {
+    Parameterization::from_name(name).ok_or_else(|| {
+        Error::msg(format!(
+            "--parameterization must be one of {}, got \"{name}\"",
+            Parameterization::NAMES.join(", ")
+        ))
+    })
 }

@@ -63,6 +63,19 @@ fn tabulate_precompute_and_check_a_measured_table() {
     assert!(dir
         .join("gold.binary.factored-L2-32x64x64s4.lumis-cache")
         .exists());
+    let run = lumis(&[
+        "brdf",
+        "precompute",
+        &table_arg,
+        "--sampling",
+        "tabulated",
+        "--parameterization",
+        "pdv",
+    ]);
+    assert!(run.status.success(), "{}", text(&run));
+    assert!(dir
+        .join("gold.binary.tabulated-L0-32x64x64s4-pdv.lumis-cache")
+        .exists());
 
     // The check kit over the plugin's own parameters, the table held fixed.
     let file = format!("file={table_arg}");
@@ -82,6 +95,7 @@ fn tabulate_precompute_and_check_a_measured_table() {
     for want in [
         "sampling = \"cosine\"",
         "sampling = \"tabulated\"",
+        "parameterization = \"pdv\"",
         "terms = 16",
         "passed, 0 failed",
     ] {
@@ -116,6 +130,13 @@ fn bad_requests_fail_with_the_reason() {
     let run = lumis(&["brdf", "precompute", &out, "--sampling", "cosine"]);
     assert!(
         text(&run).contains("needs no precomputation"),
+        "{}",
+        text(&run)
+    );
+    let run = lumis(&["brdf", "precompute", &out, "--parameterization", "polar"]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run).contains("--parameterization must be one of half-diff, pdv, got \"polar\""),
         "{}",
         text(&run)
     );

@@ -2,12 +2,14 @@
 //! directions, each with its density; random number generation; the
 //! low-discrepancy sequences and their randomisations; and the multiple
 //! importance sampling heuristics; piecewise-constant distributions; the
-//! half/difference parameterizations of direction pairs and their Jacobians.
+//! half/difference and projected-deviation parameterizations of direction
+//! pairs and their Jacobians.
 
 pub mod distribution;
 pub mod distribution2d;
 pub mod halfdiff;
 pub mod mis;
+pub mod pdv;
 pub mod permutation;
 pub mod poisson_disk;
 pub mod primes;

@@ -1,7 +1,8 @@
 //! The cache of a sampling precomputation, stored next to its table.
 //!
-//! `TABLE.STRATEGY-LL-NOxNWxNPHI.lumis-cache`: a header (magic, format
-//! version, the content hash of the table file, strategy, terms, grid) and
+//! `TABLE.STRATEGY-LL-NOxNWxNPHIsS[-pdv].lumis-cache`: a header (magic,
+//! format version, the content hash of the table file, strategy, terms,
+//! grid and its parameterization) and
 //! the precomputed numbers as little-endian f32, then an FNV-1a hash of
 //! the payload. A header that does not match (the table changed, another
 //! grid) or a damaged payload makes the caller recompute and replace it;
@@ -11,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use lumis_core::Result;
 
-use crate::grid::Grid;
+use crate::grid::{Grid, Parameterization};
 use crate::merl::{content_hash, write_atomic};
 
 const MAGIC: &[u8; 8] = b"LUMISMSC";
@@ -44,8 +45,12 @@ impl CacheKey {
             .file_name()
             .map(|n| n.to_os_string())
             .unwrap_or_default();
+        let coordinates = match g.parameterization {
+            Parameterization::HalfDiff => "",
+            Parameterization::Pdv => "-pdv",
+        };
         name.push(format!(
-            ".{}-L{}-{}x{}x{}s{}.lumis-cache",
+            ".{}-L{}-{}x{}x{}s{}{coordinates}.lumis-cache",
             self.strategy, self.terms, g.n_o, g.n_w, g.n_phi, g.supersamples
         ));
         table.with_file_name(name)
@@ -64,7 +69,10 @@ impl CacheKey {
             g.n_w as u32,
             g.n_phi as u32,
             g.supersamples as u32,
-            0,
+            match g.parameterization {
+                Parameterization::HalfDiff => 0,
+                Parameterization::Pdv => 1,
+            },
         ] {
             h.extend_from_slice(&v.to_le_bytes());
         }
@@ -145,6 +153,7 @@ mod tests {
                 n_w: 3,
                 n_phi: 4,
                 supersamples: 1,
+                parameterization: Parameterization::HalfDiff,
             },
         };
         let path = key.path(&table);
@@ -160,6 +169,18 @@ mod tests {
             ..key
         };
         assert_eq!(load(&path, &changed, 3), Err(Miss::Stale));
+        let pdv = CacheKey {
+            grid: Grid {
+                parameterization: Parameterization::Pdv,
+                ..key.grid
+            },
+            ..key
+        };
+        assert_eq!(
+            pdv.path(&table).file_name().unwrap(),
+            "t.binary.factored-L2-2x3x4s1-pdv.lumis-cache"
+        );
+        assert_eq!(load(&path, &pdv, 3), Err(Miss::Stale));
         let mut bytes = std::fs::read(&path).unwrap();
         bytes[HEADER_BYTES] ^= 1;
         std::fs::write(&path, &bytes).unwrap();

@@ -3,7 +3,8 @@
 //! Representation", SIGGRAPH).
 //!
 //! The matrix `Y[wo][cell]` of [`crate::grid`] (`f cos theta_i` over the
-//! half-vector cells of each outgoing elevation, each row scaled to sum 1)
+//! cells `(w, phi)` of each outgoing elevation, in the half-vector or the
+//! deviation-vector coordinates, each row scaled to sum 1)
 //! is approximated as
 //!
 //! ```text
@@ -24,12 +25,15 @@
 //! With `u_l` and `v_l` normalised to sum 1, `F_l(wo)` is the mass of term
 //! `l`, and sampling (section 5) picks `l` with probability `F_l / sum_j
 //! F_j`, draws `w` from `u_l` and `phi` from `v_l` (piecewise constant)
-//! and maps `(w, phi)` to `wi` through the half vector. Its density is
-//! evaluated the same way:
+//! and maps `(w, phi)` to `wi` through the grid's parameterization. Its
+//! density is evaluated the same way:
 //!
 //! ```text
-//! p(wi) = sum_l F_l / sum_j F_j  u_l(w) v_l(phi) / (4 <wo, h>)
+//! p(wi) = sum_l F_l / sum_j F_j  u_l(w) v_l(phi) / J,   J = d omega_i / (dw dphi)
 //! ```
+//!
+//! (`J = 4 <wo, h>` for the half vector, `1 / (2 cos theta_i)` for the
+//! deviation vector, [`crate::grid`]).
 //!
 //! with `u_l(w)`, `v_l(phi)` the densities of the 1D distributions. `F`
 //! is interpolated linearly in `theta_o` between rows, which keeps the
@@ -40,7 +44,6 @@
 
 use indicatif::ProgressBar;
 use lumis_core::Vec3;
-use lumis_sampling::halfdiff::{half_coords_from_wi, half_coords_jacobian, wi_from_half_coords};
 use lumis_sampling::{Distribution1D, Pcg32};
 
 use crate::grid::Grid;
@@ -364,7 +367,7 @@ impl Factored {
         (1.0 - t) * self.weights[k0 * self.terms + l] + t * self.weights[k1 * self.terms + l]
     }
 
-    /// Draws `wi` (or `None` when the half vector sends it below the
+    /// Draws `wi` (or `None` when the coordinates send it below the
     /// horizon or faces away from `wo`).
     #[inline]
     pub fn sample(&self, wo: Vec3, u1: f32, u2: lumis_core::Vec2) -> Option<Vec3> {
@@ -380,14 +383,14 @@ impl Factored {
         }
         let (w, _, _) = self.u[l].sample(u2.x);
         let (phi, _, _) = self.v[l].sample(u2.y);
-        let (wi, _) = wi_from_half_coords(wo, w, phi)?;
-        (wi.z > 0.0).then_some(wi)
+        let (wi, _) = self.grid.direction(wo, w, phi)?;
+        Some(wi)
     }
 
     /// The density of [`Self::sample`] w.r.t. solid angle of `wi`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((w, phi, wo_h)) = half_coords_from_wi(wo, wi) else {
+        let Some((w, phi, jacobian)) = self.grid.coordinates(wo, wi) else {
             return 0.0;
         };
         let (Some(a), Some(b)) = (self.u[0].bin(w), self.v[0].bin(phi)) else {
@@ -398,7 +401,7 @@ impl Factored {
         for l in 0..self.terms {
             p += self.weight(rows, l) * self.u[l].bin_pdf(a) * self.v[l].bin_pdf(b);
         }
-        p / half_coords_jacobian(wo_h)
+        p / jacobian
     }
 
     /// Bytes held (the bin edges once, they are shared).
@@ -426,6 +429,7 @@ mod tests {
             n_w: 8,
             n_phi: 5,
             supersamples: 1,
+            parameterization: crate::grid::Parameterization::HalfDiff,
         };
         // Y = sum of two separable terms with row weights that vary.
         let u = [

@@ -3,24 +3,45 @@
 //! Rows are outgoing elevations: an isotropic BRDF depends on `wo` only
 //! through `theta_o` once azimuths are measured from `phi_o`, so `n_o`
 //! rows at `theta_o = (k + 1/2) / n_o * pi/2` cover every `wo`. Columns are
-//! cells of the half-vector coordinates about `wo`, `(w, phi) = (1 - cos
-//! theta_h, phi_h - phi_o)` (Lawrence et al. 2004, section 4.1: centred on
-//! the specular peak, where a glossy lobe is compact and nearly the same
-//! for every `wo`, which is what makes the matrix low-rank). The `w` bins
-//! have edges at `theta_h = (a / n_w)^2 pi/2`, the square-root spacing of
-//! the MERL format: a 64-bin grid resolves a lobe of width 0.01 rad with
-//! 4 bins and still covers the horizon. `phi` bins are uniform.
+//! cells of a radial coordinate `r` and an azimuth `phi` about `wo`, in one
+//! of two [`Parameterization`]s, both centred on the specular peak, where
+//! a glossy lobe is compact and nearly the same for every `wo`, which is
+//! what makes the matrix low-rank:
 //!
-//! Each entry is the integral of `f cos theta_i` over the cell, in solid
-//! angle of `wi` (`d omega_i = 4 <wo, h> dw dphi`), by `s x s` midpoints:
-//! the mass a sampler should give the cell.
+//! - half-diff: the half vector, `(r, phi) = (1 - cos theta_h, phi_h -
+//!   phi_o)` (Lawrence et al. 2004, section 4.1), `d omega_i = 4 <wo, h> dr
+//!   dphi`; `r` bins have edges at `theta_h = (a / n_w)^2 pi/2`, the
+//!   square-root spacing of the MERL format: a 64-bin grid resolves a lobe
+//!   of width 0.01 rad with 4 bins and still covers the horizon.
+//! - pdv: the projected deviation vector `(rho, phi)` of
+//!   [`lumis_sampling::pdv`], with `r = rho^2`, which is equal-area for the
+//!   deviation (`rho d rho dphi = dr dphi / 2`) so that a piecewise-constant
+//!   density stays finite at the mirror direction `rho = 0`: `d omega_i =
+//!   dr dphi / (2 cos theta_i)`. Edges at `rho = 2 (a / n_w)^2` (the same
+//!   square-root spacing; `rho <= 1 + sin theta_o <= 2`).
+//!
+//! `phi` bins are uniform. Each entry is the integral of `f cos theta_i`
+//! over the cell, in solid angle of `wi`, by `s x s` midpoints: the mass a
+//! sampler should give the cell.
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
 use indicatif::ProgressBar;
-use lumis_core::{Rgb, Vec3};
-use lumis_sampling::halfdiff::{half_coords_jacobian, spherical_direction, wi_from_half_coords};
+use lumis_core::{ParamChoice, Rgb, Vec3};
+use lumis_sampling::halfdiff::{
+    half_coords_from_wi, half_coords_jacobian, spherical_direction, wi_from_half_coords,
+};
+use lumis_sampling::pdv::{pdv_from_w, w_from_pdv};
 use rayon::prelude::*;
+
+/// The coordinates of `wi` about `wo` that the grid's columns cut.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum Parameterization {
+    /// The half vector (Lawrence et al. 2004).
+    HalfDiff,
+    /// The projected deviation vector, `rho^2` and its azimuth.
+    Pdv,
+}
 
 /// Resolution of the precomputation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +54,8 @@ pub struct Grid {
     pub n_phi: usize,
     /// Midpoints per cell and axis for the cell integrals.
     pub supersamples: usize,
+    /// The coordinates of the columns.
+    pub parameterization: Parameterization,
 }
 
 impl Grid {
@@ -40,16 +63,56 @@ impl Grid {
         self.n_w * self.n_phi
     }
 
-    /// `w = 1 - cos theta_h` at the edges `theta_h = (a / n_w)^2 pi/2`.
+    /// The edges of the radial coordinate: `1 - cos theta_h` at `theta_h =
+    /// (a / n_w)^2 pi/2`, or `rho^2` at `rho = 2 (a / n_w)^2`.
     pub fn w_edges(&self) -> Vec<f32> {
         (0..=self.n_w)
             .map(|a| {
                 let t = a as f64 / self.n_w as f64;
-                let theta = t * t * std::f64::consts::FRAC_PI_2;
-                // 1 - cos = 2 sin^2(theta / 2), exact near 0.
-                (2.0 * (0.5 * theta).sin().powi(2)) as f32
+                match self.parameterization {
+                    Parameterization::HalfDiff => {
+                        let theta = t * t * std::f64::consts::FRAC_PI_2;
+                        // 1 - cos = 2 sin^2(theta / 2), exact near 0.
+                        (2.0 * (0.5 * theta).sin().powi(2)) as f32
+                    }
+                    Parameterization::Pdv => (4.0 * t.powi(4)) as f32,
+                }
             })
             .collect()
+    }
+
+    /// `wi` at coordinates `(r, phi)` about `wo` and `d omega_i / (dr
+    /// dphi)`; `None` where no `wi` of the upper hemisphere has them.
+    #[inline]
+    pub fn direction(&self, wo: Vec3, r: f32, phi: f32) -> Option<(Vec3, f32)> {
+        let (wi, jacobian) = match self.parameterization {
+            Parameterization::HalfDiff => {
+                let (wi, wo_h) = wi_from_half_coords(wo, r, phi)?;
+                (wi, half_coords_jacobian(wo_h))
+            }
+            Parameterization::Pdv => {
+                let (wi, _) = w_from_pdv(wo, r.max(0.0).sqrt(), phi)?;
+                (wi, 0.5 / wi.z)
+            }
+        };
+        (wi.z > 0.0).then_some((wi, jacobian))
+    }
+
+    /// The inverse of [`Self::direction`]: `(r, phi, d omega_i / (dr
+    /// dphi))`, `phi` in `[0, 2 pi)`; `None` for `wi` the coordinates do
+    /// not reach.
+    #[inline]
+    pub fn coordinates(&self, wo: Vec3, wi: Vec3) -> Option<(f32, f32, f32)> {
+        match self.parameterization {
+            Parameterization::HalfDiff => {
+                let (w, phi, wo_h) = half_coords_from_wi(wo, wi)?;
+                Some((w, phi, half_coords_jacobian(wo_h)))
+            }
+            Parameterization::Pdv => {
+                let (rho, phi, _) = pdv_from_w(wo, wi)?;
+                Some((rho * rho, phi, 0.5 / wi.z))
+            }
+        }
     }
 
     pub fn phi_edges(&self) -> Vec<f32> {
@@ -89,14 +152,11 @@ impl Grid {
                     let w = w0 + (w1 - w0) * ((sa as f32 + 0.5) / s as f32);
                     for sb in 0..s {
                         let phi = p0 + (p1 - p0) * ((sb as f32 + 0.5) / s as f32);
-                        let Some((wi, wo_h)) = wi_from_half_coords(wo, w, phi) else {
+                        let Some((wi, jacobian)) = self.direction(wo, w, phi) else {
                             continue;
                         };
-                        if wi.z <= 0.0 {
-                            continue;
-                        }
                         let value = f(wo, wi).luminance().max(0.0);
-                        sum += (value * wi.z * half_coords_jacobian(wo_h)) as f64;
+                        sum += (value * wi.z * jacobian) as f64;
                     }
                 }
                 let area = ((w1 - w0) * (p1 - p0)) as f64 / (s * s) as f64;
@@ -148,11 +208,21 @@ mod tests {
             n_w: 32,
             n_phi: 32,
             supersamples: 4,
+            parameterization: Parameterization::HalfDiff,
         };
         let f = |_: Vec3, _: Vec3| Rgb::splat(std::f32::consts::FRAC_1_PI);
-        for k in 0..grid.n_o {
-            let sum: f32 = grid.row(k, &f).iter().sum();
-            assert!((sum - 1.0).abs() < 0.02, "row {k}: {sum}");
+        for parameterization in [Parameterization::HalfDiff, Parameterization::Pdv] {
+            let grid = Grid {
+                parameterization,
+                ..grid
+            };
+            for k in 0..grid.n_o {
+                let sum: f32 = grid.row(k, &f).iter().sum();
+                assert!(
+                    (sum - 1.0).abs() < 0.02,
+                    "{parameterization:?} row {k}: {sum}"
+                );
+            }
         }
     }
 
@@ -163,6 +233,7 @@ mod tests {
             n_w: 64,
             n_phi: 16,
             supersamples: 1,
+            parameterization: Parameterization::HalfDiff,
         };
         let e = grid.w_edges();
         assert_eq!(e[0], 0.0);
@@ -179,5 +250,42 @@ mod tests {
             grid.rows(Vec3::new(1.0, 0.0, 1e-4).normalize()),
             (7, 7, 0.0)
         );
+    }
+
+    #[test]
+    fn coordinates_invert_direction_in_both_parameterizations() {
+        let mut rng = lumis_sampling::Pcg32::new(3, 11);
+        for parameterization in [Parameterization::HalfDiff, Parameterization::Pdv] {
+            let grid = Grid {
+                n_o: 8,
+                n_w: 64,
+                n_phi: 16,
+                supersamples: 1,
+                parameterization,
+            };
+            let edges = grid.w_edges();
+            let mut checked = 0;
+            for _ in 0..1000 {
+                let wo = spherical_direction(rng.next_f32() * 1.57, rng.next_f32() * 2.0 * PI);
+                let r = rng.next_f32() * edges[grid.n_w];
+                let phi = rng.next_f32() * 2.0 * PI;
+                let Some((wi, jacobian)) = grid.direction(wo, r, phi) else {
+                    continue;
+                };
+                let (r2, phi2, jacobian2) = grid.coordinates(wo, wi).unwrap();
+                assert!(
+                    (r2 - r).abs() < 1e-4 * r.max(1.0),
+                    "{parameterization:?}: r {r} {r2}"
+                );
+                let dphi = (phi2 - phi).rem_euclid(2.0 * PI);
+                assert!(
+                    dphi.min(2.0 * PI - dphi) < 1e-3,
+                    "{parameterization:?}: phi {phi} {phi2}"
+                );
+                assert!((jacobian2 - jacobian).abs() <= 1e-3 * jacobian);
+                checked += 1;
+            }
+            assert!(checked > 200, "{parameterization:?}: {checked} points");
+        }
     }
 }

@@ -10,7 +10,7 @@ use lumis_core::{
 };
 use lumis_sampling::warp;
 
-use crate::grid::Grid;
+use crate::grid::{Grid, Parameterization};
 use crate::merl::MerlTable;
 use crate::precompute::{prepare, Plan, PrecomputeReport, Prepared};
 
@@ -38,6 +38,11 @@ pub struct MeasuredParams {
     /// precomputation (factored, tabulated)
     #[param(default = [32, 64, 64])]
     pub grid: Vec<i64>,
+    /// the coordinates of wi about wo the precomputation tabulates
+    /// (factored, tabulated): half-diff (the half vector) or pdv (the
+    /// projected deviation vector, the tangent-plane part of wi + wo)
+    #[param(default = HalfDiff)]
+    pub parameterization: Parameterization,
     /// keep the precomputation next to the table
     /// (TABLE.STRATEGY-....lumis-cache), reused while the table is unchanged
     #[param(default = true)]
@@ -57,7 +62,7 @@ const SUPERSAMPLES: usize = 4;
 /// The largest grid accepted: 64 MB of f32 for the tabulated strategy.
 const MAX_GRID_CELLS: i64 = 1 << 24;
 
-fn checked_grid(grid: &[i64], params: &Params) -> Result<Grid> {
+fn checked_grid(grid: &[i64], parameterization: Parameterization, params: &Params) -> Result<Grid> {
     match grid {
         &[n_o, n_w, n_phi]
             if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n))
@@ -68,6 +73,7 @@ fn checked_grid(grid: &[i64], params: &Params) -> Result<Grid> {
                 n_w: n_w as usize,
                 n_phi: n_phi as usize,
                 supersamples: SUPERSAMPLES,
+                parameterization,
             })
         }
         _ => Err(params.error(
@@ -113,7 +119,7 @@ impl Measured {
         // A setting the strategy does not use is refused if given.
         let plan = match p.sampling {
             MeasuredSampling::Cosine => {
-                for unused in [keys.terms, keys.grid, keys.cache] {
+                for unused in [keys.terms, keys.grid, keys.cache, keys.parameterization] {
                     params.unread(unused);
                 }
                 None
@@ -127,7 +133,11 @@ impl Measured {
             }
         };
         let setup = match plan {
-            Some(plan) => Some((plan, checked_grid(&p.grid, params)?, p.cache)),
+            Some(plan) => Some((
+                plan,
+                checked_grid(&p.grid, p.parameterization, params)?,
+                p.cache,
+            )),
             None => None,
         };
         let table = Arc::new(MerlTable::read(&p.file).map_err(|e| params.error(keys.file, e))?);

@@ -1,5 +1,5 @@
 //! The reference strategy: for each outgoing elevation, the whole 2D
-//! table of `f cos theta_i` over the half-vector cells as a
+//! table of `f cos theta_i` over the grid's cells as a
 //! piecewise-constant distribution (a marginal over `w`, a conditional
 //! over `phi` per `w` bin; pbrt-v4 `PiecewiseConstant2D`). It follows the
 //! data as closely as the grid allows, at `n_o x n_w x n_phi` entries
@@ -14,7 +14,6 @@
 use std::sync::Arc;
 
 use lumis_core::{Vec2, Vec3};
-use lumis_sampling::halfdiff::{half_coords_from_wi, half_coords_jacobian, wi_from_half_coords};
 use lumis_sampling::Distribution1D;
 
 use crate::factored::DEFENSIVE;
@@ -37,6 +36,8 @@ impl Tabulated {
     pub fn new(grid: Grid, y: &[Vec<f32>]) -> Self {
         let w_edges: Arc<[f32]> = grid.w_edges().into();
         let phi_edges: Arc<[f32]> = grid.phi_edges().into();
+        // The uniform part sums to DEFENSIVE whatever the radial range.
+        let w_span = w_edges[grid.n_w] - w_edges[0];
         let rows = y
             .iter()
             .map(|row| {
@@ -49,7 +50,7 @@ impl Tabulated {
                         0.0
                     };
                     (1.0 - DEFENSIVE) * data
-                        + DEFENSIVE * (w_edges[a + 1] - w_edges[a]) / grid.n_phi as f32
+                        + DEFENSIVE * (w_edges[a + 1] - w_edges[a]) / (w_span * grid.n_phi as f32)
                 };
                 let marginal: Vec<f32> = (0..grid.n_w)
                     .map(|a| (0..grid.n_phi).map(|b| joint(a, b)).sum())
@@ -75,13 +76,13 @@ impl Tabulated {
         let row = &self.rows[if u1 < t { k1 } else { k0 }];
         let (w, _, a) = row.marginal.sample(u2.x);
         let (phi, _, _) = row.conditional[a].sample(u2.y);
-        let (wi, _) = wi_from_half_coords(wo, w, phi)?;
-        (wi.z > 0.0).then_some(wi)
+        let (wi, _) = self.grid.direction(wo, w, phi)?;
+        Some(wi)
     }
 
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((w, phi, wo_h)) = half_coords_from_wi(wo, wi) else {
+        let Some((w, phi, jacobian)) = self.grid.coordinates(wo, wi) else {
             return 0.0;
         };
         let (k0, k1, t) = self.grid.rows(wo);
@@ -91,7 +92,7 @@ impl Tabulated {
         };
         let density = |row: &Row| row.marginal.bin_pdf(a) * row.conditional[a].bin_pdf(b);
         let p = (1.0 - t) * density(first) + t * density(&self.rows[k1]);
-        p / half_coords_jacobian(wo_h)
+        p / jacobian
     }
 
     /// Bytes held (the shared bin edges once).
