@@ -74,7 +74,7 @@ fn unknown_plugin_type_lists_the_available_ones() {
         &[
             "bad.toml:15:8",
             "unknown bsdf type \"difuse\"",
-            "available: blinn, conductor, dielectric, diffuse, measured, mirror, plastic",
+            "available: blinn, conductor, dielectric, diffuse, measured, mirror, normalmap, plastic, twosided",
         ],
     );
 }
