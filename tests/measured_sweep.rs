@@ -112,10 +112,6 @@ fn pdv_sampling_of_a_conductor_passes_the_check_kit_down_to_grazing() {
     check_pdv("pdv", &MATERIALS[1..2], &[2]);
 }
 
-/// Fails, for now, in one case: the tabulated strategy on conductor-0.05
-/// at exactly normal incidence with the default 64 radial bins (sampled
-/// mass 0.983 against the pdf's 0.992; 32 or 128 bins passed), see
-/// docs/src/studies/measured.md.
 #[test]
 #[ignore = "every table and term count: about 4 minutes"]
 fn pdv_sampling_of_every_table_passes_the_check_kit_down_to_grazing() {

@@ -22,7 +22,9 @@
 //! Centre and width come from a pilot batch drawn with another seed, so
 //! the map does not depend on the samples it tests: the centre is where
 //! the pdf peaks among the pilot samples, the width the spread of the
-//! samples whose pdf is within a factor 100 of that peak.
+//! samples whose pdf is within a factor 100 of that peak. A lobe too wide
+//! to need magnifying but lying over a pole is still turned to the
+//! equator, unmagnified.
 
 use lumis_core::glam::DVec3;
 use lumis_core::{Vec2, Vec3};
@@ -36,7 +38,11 @@ const TARGET_WIDTH: f64 = 0.5;
 /// and the compression is reached at `RELAXED_WIDTHS`.
 const MAGNIFIED_WIDTHS: f64 = 2.0;
 const RELAXED_WIDTHS: f64 = 6.0;
-/// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are tested as they are.
+/// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are not magnified; those
+/// over a pole are still turned to the equator, since the grid's polar row
+/// (0.2 rad of the 100 bins in `cos theta`) is too coarse for the
+/// quadrature of a lobe's steps there (a tabulated density at normal
+/// incidence).
 const MIN_ZOOM: f64 = 4.0;
 const PILOT_SAMPLES: usize = 20_000;
 /// A peak holding less than this share of the pilot samples is not a lobe
@@ -84,6 +90,12 @@ impl LobeZoom {
             theta_2,
             s,
         }
+    }
+
+    /// Turns `centre` to the equator without magnifying: `k = s = 1` makes
+    /// `g` the identity whatever `theta_1 < theta_2`.
+    pub fn rotation(centre: Vec3) -> Self {
+        Self::new(centre, 1.0, 1.0, 2.0)
     }
 
     /// The magnification factor at the centre.
@@ -231,14 +243,18 @@ impl LobeZoom {
         angles.sort_by(f64::total_cmp);
         let width = angles[angles.len() * 9 / 10].max(1e-9);
         let k = (TARGET_WIDTH / width).min(1e6);
-        (k >= MIN_ZOOM).then(|| {
-            Self::new(
+        if k >= MIN_ZOOM {
+            Some(Self::new(
                 centre.as_vec3(),
                 k,
                 MAGNIFIED_WIDTHS * width,
                 RELAXED_WIDTHS * width,
-            )
-        })
+            ))
+        } else if Self::polar(centre).0.min(Self::polar(-centre).0) < width {
+            Some(Self::rotation(centre.as_vec3()))
+        } else {
+            None
+        }
     }
 }
 
