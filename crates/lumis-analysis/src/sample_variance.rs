@@ -44,7 +44,8 @@ impl SampleVariance {
     /// The effective degrees of freedom of `s^2`: `s^2 / sigma^2` is taken
     /// as `chi^2_d / d` with `d = 2 / Var(s^2 / sigma^2)` and
     /// `Var(s^2 / sigma^2) = (kurtosis - 1) / n + 2 / (n (n - 1))`
-    /// (Cramer 1946, section 27.4; Satterthwaite 1946). For normal estimates
+    /// (Cramer 1946, "Mathematical Methods of Statistics", ch. 27;
+    /// Satterthwaite 1946). For normal estimates
     /// (kurtosis 3) `d = n - 1`, the textbook chi-square interval; heavier
     /// tails (a stratum with one sample of a discontinuous integrand) give
     /// fewer degrees of freedom and a wider interval.

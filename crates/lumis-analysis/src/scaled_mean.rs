@@ -6,7 +6,7 @@
 //! variance `(N / (N + 1))^2 sigma^2 / N` and so
 //! `MSE = (I^2 + N sigma^2) / (N + 1)^2`; both vanish as `N` grows, so it is
 //! consistent (Owen 2013, "Monte Carlo theory, methods and examples",
-//! section 2.4; Veach 1997, thesis, section 2.4.3). Its MSE is below the
+//! ch. 2; Veach 1997, thesis, section 2.4.3). Its MSE is below the
 //! unbiased `sigma^2 / N` exactly when `N (I^2 - 2 sigma^2) < sigma^2`:
 //! always if `sigma^2 >= I^2 / 2`, otherwise for `N < sigma^2 / (I^2 - 2 sigma^2)`
 //! (shrinking towards zero trades a little bias for less variance).

@@ -5,12 +5,12 @@
 //! `sigma_i^2` the variance of `f` over it, the estimator
 //! `F = sum_i v_i (1/n_i) sum_j f(X_ij)` is unbiased with
 //! `Var F = sum_i v_i^2 sigma_i^2 / n_i` (Owen 2013, "Monte Carlo theory,
-//! methods and examples", section 8.4, eq. 8.8; Cochran 1977, "Sampling
+//! methods and examples", section 8.4; Cochran 1977, "Sampling
 //! Techniques", theorem 5.3). For a total of `N` samples it is smallest
-//! with Neyman's allocation `n_i ∝ v_i sigma_i` (Owen eq. 8.10), giving
+//! with Neyman's allocation `n_i ∝ v_i sigma_i` (Owen section 8.4), giving
 //! `(sum_i v_i sigma_i)^2 / N`; proportional allocation `n_i ∝ v_i` gives
 //! `sum_i v_i sigma_i^2 / N`, never more than plain Monte Carlo's
-//! `sigma^2 / N` (Owen eq. 8.9).
+//! `sigma^2 / N` (ibid.).
 
 use lumis_sampling::Pcg32;
 use rayon::prelude::*;
