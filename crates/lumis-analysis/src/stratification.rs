@@ -121,6 +121,25 @@ pub enum Allocation {
     Neyman,
 }
 
+impl Allocation {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Proportional => "proportional",
+            Self::Neyman => "neyman",
+        }
+    }
+
+    /// The counts of `total` samples over `strata`; `sigma` is the
+    /// per-stratum standard deviation Neyman's allocation weighs by.
+    pub fn counts(&self, strata: Strata, sigma: &[f64], total: usize) -> Option<Vec<usize>> {
+        let weights: Vec<f64> = match self {
+            Self::Proportional => vec![strata.volume(); strata.len()],
+            Self::Neyman => sigma.iter().map(|s| s * strata.volume()).collect(),
+        };
+        allocate(&weights, total)
+    }
+}
+
 /// `total` samples in proportion to `weights`, at least one per stratum
 /// (a stratum's mean needs a sample even when the pilot saw no variation
 /// in it); the remainders go to the largest fractional parts (Hamilton's
@@ -276,10 +295,9 @@ mod tests {
         let alpha = lumis_check::corrected_significance(0.01, tests);
         for (k, g) in integrands.iter().enumerate() {
             let moments = StratumMoments::of(g, strata, 256);
-            let proportional = allocate(&vec![strata.volume(); strata.len()], n).unwrap();
             let sigma = pilot_sigma(g, strata, 16, 99);
-            let weights: Vec<f64> = sigma.iter().map(|s| s * strata.volume()).collect();
-            let neyman = allocate(&weights, n).unwrap();
+            let proportional = Allocation::Proportional.counts(strata, &sigma, n).unwrap();
+            let neyman = Allocation::Neyman.counts(strata, &sigma, n).unwrap();
             let cases = [
                 ("plain", moments.total_variance() / n as f64, None),
                 (

@@ -12,7 +12,7 @@ use lumis_analysis::sample_points;
 use lumis_analysis::sample_variance::SampleVariance;
 use lumis_analysis::scaled_mean::ScaledMean;
 use lumis_analysis::stratification::{
-    allocate, pilot_sigma, plain_estimate, repeated, stratified_estimate, Strata, StratumMoments,
+    pilot_sigma, plain_estimate, repeated, stratified_estimate, Allocation, Strata, StratumMoments,
 };
 use lumis_core::{Error, Registry, Result, UVec2};
 
@@ -89,6 +89,16 @@ fn ratio_cell(s: &SampleVariance, predicted: f64) -> String {
     format!("{:.3}{mark}", s.variance / predicted)
 }
 
+/// One estimator at one N: its measured variance with the interval, and
+/// the formula's.
+#[derive(Clone)]
+struct VariancePoint {
+    n: f64,
+    measured: f64,
+    interval: (f64, f64),
+    formula: f64,
+}
+
 fn stratified_study(args: &LectureArgs) -> Result<String> {
     let mut report = format!(
         "Stratified sampling, {}x{} strata, {} runs per cell: variance measured | formula \
@@ -105,8 +115,6 @@ fn stratified_study(args: &LectureArgs) -> Result<String> {
         let g = integrand(name);
         let moments = StratumMoments::of(&g, STRATA, QUADRATURE);
         let sigma = pilot_sigma(&g, STRATA, PILOT_PER_STRATUM, args.seed + 7919);
-        let neyman_weights: Vec<f64> = sigma.iter().map(|s| s * STRATA.volume()).collect();
-        let proportional_weights = vec![STRATA.volume(); STRATA.len()];
         let optimal = moments
             .variance
             .iter()
@@ -128,17 +136,20 @@ fn stratified_study(args: &LectureArgs) -> Result<String> {
             "neyman"
         )
         .unwrap();
-        let methods = ["plain", "proportional", "neyman"];
-        // Per method: (N, measured variance, its interval, formula).
-        let mut measured: Vec<Vec<(f64, f64, (f64, f64), f64)>> = vec![Vec::new(); 3];
+        // `None` is plain Monte Carlo.
+        let methods = [
+            None,
+            Some(Allocation::Proportional),
+            Some(Allocation::Neyman),
+        ];
+        let mut measured: Vec<Vec<VariancePoint>> = vec![Vec::new(); 3];
         for (c, &n) in STRATIFIED_COUNTS.iter().enumerate() {
             write!(report, "{n:>6}").unwrap();
             for (m, method) in methods.iter().enumerate() {
-                let counts = match *method {
-                    "plain" => None,
-                    "proportional" => allocate(&proportional_weights, n),
-                    _ => allocate(&neyman_weights, n),
-                };
+                let counts = method.map(|a| {
+                    a.counts(STRATA, &sigma, n)
+                        .expect("every count is at least the number of strata")
+                });
                 let predicted = match &counts {
                     None => moments.total_variance() / n as f64,
                     Some(counts) => moments.stratified_variance(counts),
@@ -155,21 +166,31 @@ fn stratified_study(args: &LectureArgs) -> Result<String> {
                     ratio_cell(&s, predicted)
                 );
                 write!(report, " {cell:>30}").unwrap();
-                measured[m].push((n as f64, s.variance, s.variance_interval(ALPHA), predicted));
+                measured[m].push(VariancePoint {
+                    n: n as f64,
+                    measured: s.variance,
+                    interval: s.variance_interval(ALPHA),
+                    formula: predicted,
+                });
             }
             report.push('\n');
         }
         let mut series = Vec::new();
         for (m, method) in methods.iter().enumerate() {
+            let method = method.map_or("plain", |a| a.name());
             let rows = &measured[m];
             series.push(Series {
                 name: format!("{method}, measured"),
-                points: rows.iter().map(|r| (r.0, r.1)).collect(),
-                band: Some(rows.iter().map(|r| (r.0, r.2 .0, r.2 .1)).collect()),
+                points: rows.iter().map(|r| (r.n, r.measured)).collect(),
+                band: Some(
+                    rows.iter()
+                        .map(|r| (r.n, r.interval.0, r.interval.1))
+                        .collect(),
+                ),
             });
             series.push(Series {
                 name: format!("{method}, formula"),
-                points: rows.iter().map(|r| (r.0, r.3)).collect(),
+                points: rows.iter().map(|r| (r.n, r.formula)).collect(),
                 band: None,
             });
         }
