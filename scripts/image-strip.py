@@ -4,8 +4,9 @@ book's figures: one row, a 2-pixel white gap between panels.
 
     scripts/image-strip.py OUT.png X Y SIZE A.png B.png ...
 
-Each panel is the SIZE x SIZE square of its image at (X, Y). Needs numpy
-only (PNG is read and written with zlib).
+Each panel is the SIZE x SIZE square of its image at (X, Y), or with SIZE
+given as WIDTHxHEIGHT (e.g. 384x256) that rectangle. Needs numpy only (PNG
+is read and written with zlib).
 """
 
 import struct
@@ -80,9 +81,11 @@ def write_png(path, image):
 
 def main():
     out, x, y, size, *inputs = sys.argv[1:]
-    x, y, size = int(x), int(y), int(size)
-    panels = [read_png(p)[y : y + size, x : x + size] for p in inputs]
-    gap = np.full((size, 2, 3), 255, dtype=np.uint8)
+    width, _, height = size.partition("x")
+    x, y, width = int(x), int(y), int(width)
+    height = int(height) if height else width
+    panels = [read_png(p)[y : y + height, x : x + width] for p in inputs]
+    gap = np.full((height, 2, 3), 255, dtype=np.uint8)
     strip = [panels[0]]
     for panel in panels[1:]:
         strip += [gap, panel]

@@ -10,6 +10,7 @@ mod denoise;
 mod diff;
 mod integrator_check;
 mod interrupt;
+mod lecture;
 mod listing;
 mod metadata;
 mod new_plugin;
@@ -30,6 +31,7 @@ pub use integrator_check::{
     IntegratorTest, KNOWN_DEPTHS,
 };
 pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
+pub use lecture::{lecture, LectureArgs};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
 pub use metadata::ImageMetadata;
 pub use new_plugin::{new_plugin, NewPluginArgs, NewPluginKind};

@@ -15,10 +15,10 @@ use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
     analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
-    new_plugin, plugin_listing, plugin_markdown, precompute_table, registry_with_search_path,
-    render_reference, render_scene_file, stop_on_interrupt, tabulate_bsdf, AnalyzeArgs,
-    ConvergeArgs, DiffArgs, IntegratorCheckConfig, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
-    RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    lecture, new_plugin, plugin_listing, plugin_markdown, precompute_table,
+    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
+    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig, LectureArgs,
+    NewPluginArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -114,6 +114,12 @@ enum Command {
     /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling.
     #[command(subcommand)]
     Brdf(BrdfCommand),
+    /// The Monte Carlo lecture's experiments on test integrands and point
+    /// sets: variance of stratified sampling with proportional and Neyman
+    /// allocation against the formula, power spectra of 256-point
+    /// jittered, Poisson disk and white-noise sets, and the bias, variance
+    /// and MSE of the scaled mean N/(N+1) F_N; tables and PNGs.
+    Lecture(LectureArgs),
 }
 
 #[derive(Subcommand)]
@@ -248,6 +254,15 @@ fn main() -> ExitCode {
                 println!("{line}");
                 Outcome::Done
             })
+        }),
+        Command::Lecture(args) => plain(|| {
+            registry_with_search_path()
+                .and_then(|registry| lecture(&args, &registry))
+                .map(|report| {
+                    print!("{report}");
+                    println!("figures in {}", args.out.display());
+                    Outcome::Done
+                })
         }),
         Command::Samplers(SamplersCommand::Analyze(args)) => plain(|| {
             registry_with_search_path()

@@ -62,7 +62,7 @@ pub struct AnalyzeArgs {
 }
 
 /// A sampler plugin with `spp = count` and the user's parameters.
-fn make_sampler(
+pub(crate) fn make_sampler(
     registry: &Registry,
     name: &str,
     params: &[String],
@@ -114,7 +114,7 @@ fn dump_path(dump: &Path, name: &str, several: bool) -> PathBuf {
     dump.with_file_name(format!("{stem}-{name}.{ext}"))
 }
 
-fn progress_bar(len: u64, what: &str) -> ProgressBar {
+pub(crate) fn progress_bar(len: u64, what: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
     bar.set_style(
         ProgressStyle::with_template("{msg:24} [{bar:40}] {pos}/{len} {elapsed}")
@@ -123,6 +123,85 @@ fn progress_bar(len: u64, what: &str) -> ProgressBar {
     );
     bar.set_message(what.to_string());
     bar
+}
+
+/// The power spectrum pictures of a sampler's first `count` film samples:
+/// the periodogram averaged over `realizations` seeds from `seed`
+/// (`STEM-psd.png`) and its radial average (`STEM-radial-psd.png`).
+pub(crate) struct Spectrum {
+    pub count: u32,
+    pub seed: u64,
+    pub realizations: u32,
+    pub size: usize,
+}
+
+impl Spectrum {
+    /// Writes the two pictures into `out`; returns the radial average as a
+    /// series named `name`.
+    pub fn pictures(
+        &self,
+        sampler: &mut dyn Sampler,
+        name: &str,
+        out: &Path,
+        stem: &str,
+    ) -> Result<Series> {
+        let pixel = UVec2::new(0, 0);
+        let size = self.size.max(4);
+        let bar = progress_bar(self.realizations as u64, &format!("{name} spectrum"));
+        let mut psd = vec![0.0; size * size];
+        for r in 0..self.realizations {
+            let p = sample_points(sampler, self.count, 2, self.seed + r as u64, pixel).pair(0, 1);
+            for (acc, v) in psd.iter_mut().zip(periodogram(&p, size)) {
+                *acc += v / self.realizations as f64;
+            }
+            bar.inc(1);
+        }
+        bar.finish_and_clear();
+        let title = format!(
+            "{name}: power spectrum, {} points, {} scrambles",
+            self.count, self.realizations
+        );
+        let half = (size / 2) as i64;
+        let grid = plot::Grid {
+            width: size,
+            height: size,
+            origin: (-half, -half),
+            x_label: "k_x",
+            y_label: "k_y",
+            value_label: "log10 power",
+        };
+        plot::heat_map(
+            &out.join(format!("{stem}-psd.png")),
+            &title,
+            &psd,
+            &grid,
+            None,
+        )?;
+        let (radial, _) = radial_average(&psd, size);
+        let series = Series {
+            name: name.to_string(),
+            points: radial
+                .iter()
+                .enumerate()
+                .skip(1)
+                .map(|(r, v)| (r as f64, *v))
+                .collect(),
+            band: None,
+        };
+        let axes = Axes {
+            title: &format!("{name}: radially averaged power spectrum"),
+            x_label: "frequency |k|",
+            y_label: "power",
+            log_x: false,
+            log_y: false,
+        };
+        plot::line_plot(
+            &out.join(format!("{stem}-radial-psd.png")),
+            &axes,
+            std::slice::from_ref(&series),
+        )?;
+        Ok(series)
+    }
 }
 
 /// Convergence results of one sampler: RMSE per integrand and count.
@@ -182,61 +261,13 @@ pub fn analyze(args: &AnalyzeArgs, registry: &Registry) -> Result<String> {
             / args.discrepancy_seeds.max(1) as f64;
         writeln!(report, "  {name:14} {this:.3e} | {mean:.3e}").unwrap();
 
-        // Spectrum averaged over scrambles.
-        let size = args.spectrum_size.max(4);
-        let bar = progress_bar(args.realizations as u64, &format!("{name} spectrum"));
-        let mut psd = vec![0.0; size * size];
-        for r in 0..args.realizations {
-            let p = film(args.seed + r as u64, sampler.as_mut()).pair(0, 1);
-            for (acc, v) in psd.iter_mut().zip(periodogram(&p, size)) {
-                *acc += v / args.realizations as f64;
-            }
-            bar.inc(1);
-        }
-        bar.finish_and_clear();
-        let title = format!(
-            "{name}: power spectrum, {} points, {} scrambles",
-            args.count, args.realizations
-        );
-        let half = (size / 2) as i64;
-        let grid = plot::Grid {
-            width: size,
-            height: size,
-            origin: (-half, -half),
-            x_label: "k_x",
-            y_label: "k_y",
-            value_label: "log10 power",
+        let spectrum = Spectrum {
+            count: args.count,
+            seed: args.seed,
+            realizations: args.realizations,
+            size: args.spectrum_size,
         };
-        plot::heat_map(
-            &args.out.join(format!("{name}-psd.png")),
-            &title,
-            &psd,
-            &grid,
-            None,
-        )?;
-        let (radial, _) = radial_average(&psd, size);
-        let series = Series {
-            name: name.clone(),
-            points: radial
-                .iter()
-                .enumerate()
-                .skip(1)
-                .map(|(r, v)| (r as f64, *v))
-                .collect(),
-            band: None,
-        };
-        let axes = Axes {
-            title: &format!("{name}: radially averaged power spectrum"),
-            x_label: "frequency |k|",
-            y_label: "power",
-            log_x: false,
-            log_y: false,
-        };
-        plot::line_plot(
-            &args.out.join(format!("{name}-radial-psd.png")),
-            &axes,
-            std::slice::from_ref(&series),
-        )?;
+        let series = spectrum.pictures(sampler.as_mut(), name, &args.out, name)?;
         radial_series.push(series);
     }
     if names.len() > 1 {

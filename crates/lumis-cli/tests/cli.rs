@@ -390,6 +390,48 @@ fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
 }
 
 #[test]
+fn lecture_writes_its_figures_and_tables() {
+    let tmp = scratch("lecture");
+    let out = tmp.path().join("out");
+    let run = lumis(&[
+        "lecture",
+        "--runs",
+        "4",
+        "--realizations",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for file in [
+        "stratified-variance-gaussian.png",
+        "stratified-variance-disk.png",
+        "spectrum-stratified-points.png",
+        "spectrum-poisson-disk-psd.png",
+        "spectrum-independent-radial-psd.png",
+        "spectrum-radial.png",
+        "scaled-mean-gaussian-1d.png",
+        "scaled-mean-ratio.png",
+    ] {
+        assert!(out.join(file).is_file(), "{file} missing");
+    }
+    assert!(
+        stdout.contains("Stratified sampling")
+            && stdout.contains("Power spectra")
+            && stdout.contains("N < 4.09"),
+        "{stdout}"
+    );
+    let run = lumis(&["lecture", "--runs", "1", "--out", out.to_str().unwrap()]);
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--runs must be at least 2"));
+}
+
+#[test]
 fn samplers_analyze_rejects_unknown_sampler_and_bad_parameters() {
     let tmp = scratch("analyze-errors");
     let dir = tmp.path();
