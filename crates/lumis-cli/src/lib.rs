@@ -17,6 +17,7 @@ mod outputs;
 mod reference;
 mod render;
 mod samplers_analyze;
+mod slurm;
 
 pub use assignments::{fixed_parameters, parameter_table};
 pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
@@ -39,6 +40,10 @@ pub use render::{
     DEFAULT_CHECKPOINT_SECONDS,
 };
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
+pub use slurm::{
+    slurm_status, submit_slurm, Manifest as SlurmManifest, MergeState, PartState, SlurmArgs,
+    SlurmCommand, SlurmStatusArgs, SlurmSubmitArgs, StatusReport, Submission, MANIFEST_NAME,
+};
 
 use lumis_core::{Registry, Result};
 

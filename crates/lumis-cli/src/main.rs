@@ -16,9 +16,10 @@ use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, Sam
 use lumis_cli::{
     analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
     new_plugin, plugin_listing, plugin_markdown, precompute_table, registry_with_search_path,
-    render_reference, render_scene_file, stop_on_interrupt, tabulate_bsdf, AnalyzeArgs,
-    ConvergeArgs, DiffArgs, IntegratorCheckConfig, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
-    RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    render_reference, render_scene_file, slurm_status, stop_on_interrupt, submit_slurm,
+    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig, NewPluginArgs,
+    PrecomputeArgs, ReferenceArgs, RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs,
+    INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -108,6 +109,10 @@ enum Command {
     /// absolute and signed relative error, PSNR, per named region, and an
     /// optional false-colour error picture.
     Diff(DiffArgs),
+    /// Render SCENE as a Slurm job array of --tasks parts and a merge job
+    /// that waits for all of them (`lumis slurm SCENE --tasks N`), or report
+    /// and repair a run (`lumis slurm status DIR [--resubmit]`).
+    Slurm(SlurmArgs),
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
@@ -248,6 +253,19 @@ fn main() -> ExitCode {
                 println!("{line}");
                 Outcome::Done
             })
+        }),
+        Command::Slurm(args) => plain(|| {
+            match &args.command {
+                Some(SlurmCommand::Status(status)) => {
+                    print!("{}", slurm_status(&status.dir, status.resubmit)?)
+                }
+                None => {
+                    let lumis = std::env::current_exe()
+                        .map_err(|e| Error::msg(format!("the lumis executable: {e}")))?;
+                    println!("{}", submit_slurm(&args.submit, &lumis)?.summary());
+                }
+            }
+            Ok(Outcome::Done)
         }),
         Command::Samplers(SamplersCommand::Analyze(args)) => plain(|| {
             registry_with_search_path()
