@@ -10,6 +10,9 @@
 #   local-cluster.sh stop DIR    stop the daemons started in DIR
 #   local-cluster.sh env DIR     print `export SLURM_CONF=...` for DIR
 #
+# With LOCAL_CLUSTER_INSTALL=0 it never installs packages (a test's
+# choice: installing is for the machine's setup, e.g. .ci/run).
+#
 # Everything the cluster writes (key, state, spool, logs, pid files, socket)
 # lives under DIR. The daemons run as the calling user. Exit status 2 means
 # Slurm cannot run here (packages missing and not installable, a daemon
@@ -44,6 +47,7 @@ install_packages() {
     command -v "$tool" >/dev/null 2>&1 || PATH=$PATH:/usr/sbin command -v "$tool" >/dev/null 2>&1 || need+=("$tool")
   done
   [ ${#need[@]} -eq 0 ] && return 0
+  [ "${LOCAL_CLUSTER_INSTALL:-1}" = 0 ] && cannot_run "missing ${need[*]}: install the Debian packages slurm-wlm and munge"
   echo "local-cluster: missing ${need[*]}; installing slurm-wlm and munge" >&2
   command -v apt-get >/dev/null 2>&1 || cannot_run "missing ${need[*]} and no apt-get to install slurm-wlm and munge"
   [ "$(id -u)" -eq 0 ] || cannot_run "missing ${need[*]}; install slurm-wlm and munge (needs root)"

@@ -144,8 +144,14 @@ pub fn submit_slurm(args: &SlurmSubmitArgs, lumis: &Path) -> Result<Submission> 
         merge_jobs: Vec::new(),
     };
     for (name, text) in [
-        (scripts::RENDER_SCRIPT, scripts::render_script(&manifest, &dir)),
-        (scripts::MERGE_SCRIPT, scripts::merge_script(&manifest, &dir)),
+        (
+            scripts::RENDER_SCRIPT,
+            scripts::render_script(&manifest, &dir),
+        ),
+        (
+            scripts::MERGE_SCRIPT,
+            scripts::merge_script(&manifest, &dir),
+        ),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text).map_err(|e| Error::msg(format!("{}: {e}", path.display())))?;
@@ -191,6 +197,5 @@ fn submission_options(manifest: &Manifest) -> Vec<String> {
 /// `path` made absolute and free of `..`: the nodes do not share the
 /// submitter's working directory.
 fn absolute(path: &Path, what: &str) -> Result<PathBuf> {
-    std::fs::canonicalize(path)
-        .map_err(|e| Error::msg(format!("{what} {}: {e}", path.display())))
+    std::fs::canonicalize(path).map_err(|e| Error::msg(format!("{what} {}: {e}", path.display())))
 }

@@ -74,8 +74,12 @@ impl Manifest {
                 path.display()
             ))
         })?;
-        toml::from_str(&text)
-            .map_err(|e| Error::msg(format!("{}: not a lumis slurm manifest: {e}", path.display())))
+        toml::from_str(&text).map_err(|e| {
+            Error::msg(format!(
+                "{}: not a lumis slurm manifest: {e}",
+                path.display()
+            ))
+        })
     }
 
     /// Writes the manifest atomically, so an interrupted update leaves the

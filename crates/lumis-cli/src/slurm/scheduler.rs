@@ -81,8 +81,15 @@ pub fn job_states(dir: &Path, ids: &[String]) -> Result<HashMap<String, String>>
         Ok(listing) => listing,
         // Accounting is off (or sacct is absent): the controller's memory.
         Err(_) => {
-            let squeue = ["--noheader", "--array", "--states=all", "--format=%i|%T", "--jobs", &list]
-                .map(str::to_owned);
+            let squeue = [
+                "--noheader",
+                "--array",
+                "--states=all",
+                "--format=%i|%T",
+                "--jobs",
+                &list,
+            ]
+            .map(str::to_owned);
             run("squeue", &squeue, dir)?
         }
     };
@@ -143,7 +150,10 @@ mod tests {
         let error = run("lumis-no-such-command", &["--x".into()], Path::new("."))
             .unwrap_err()
             .to_string();
-        assert!(error.contains("`lumis-no-such-command --x` could not run"), "{error}");
+        assert!(
+            error.contains("`lumis-no-such-command --x` could not run"),
+            "{error}"
+        );
     }
 
     #[test]

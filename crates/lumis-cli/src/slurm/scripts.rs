@@ -2,10 +2,17 @@
 //! K renders part K, and the merge of the parts into the image.
 //!
 //! Both scripts name every file by its absolute path (a node's working
-//! directory need not be the submitter's) and write their image under a
-//! temporary name renamed on success, so the partial image of a task that
-//! fails or is killed (a checkpoint writes the image so far) is never
-//! taken for a finished part.
+//! directory need not be the submitter's). Neither needs a temporary name:
+//! a part is written only when its render finished (a part never
+//! checkpoints), and `lumis render` and `lumis merge` write their images
+//! under a temporary name renamed into place, so the image of a task that
+//! fails or is killed is never taken for a finished part.
+//!
+//! Each script first removes its output's lock (`PATH.exr.lock`): the lock
+//! names a process by its id, which means something only on the node that
+//! wrote it, so the lock a killed task left would stop the task that
+//! replaces it on another node. Slurm runs one task per part at a time
+//! (`lumis slurm status` resubmits only parts whose task ended).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -19,8 +26,7 @@ pub const MERGE_SCRIPT: &str = "merge.sbatch";
 /// Where the jobs' output goes, under the run directory.
 pub const LOG_DIR: &str = "logs";
 
-/// The job array: `#SBATCH --array=0-(N-1)`, each task renders
-/// `part-$SLURM_ARRAY_TASK_ID.exr`. A resubmission names its tasks with
+/// The job array: `#SBATCH --array=0-(N-1)`, task K renders `part-K.exr`. A resubmission names its tasks with
 /// `sbatch --array=...`, which overrides the script's line.
 pub fn render_script(manifest: &Manifest, dir: &Path) -> String {
     let mut render = format!(
@@ -40,7 +46,7 @@ pub fn render_script(manifest: &Manifest, dir: &Path) -> String {
     }
     // Without cgroups a task would see every core of the node; it uses
     // the ones Slurm gave it.
-    render.push_str(" --threads \"${SLURM_CPUS_ON_NODE:-0}\" --quiet -o \"$partial\"");
+    render.push_str(" --threads \"${SLURM_CPUS_ON_NODE:-0}\" --quiet -o \"part-$part.exr\"");
     format!(
         "#!/bin/sh\n\
          # Written by `lumis slurm`: task K renders part K of {parts}.\n\
@@ -50,9 +56,8 @@ pub fn render_script(manifest: &Manifest, dir: &Path) -> String {
          set -eu\n\
          cd {dir}\n\
          part=$SLURM_ARRAY_TASK_ID\n\
-         partial=part-$part.partial-$SLURM_JOB_ID.exr\n\
-         {render}\n\
-         mv -f \"$partial\" \"part-$part.exr\"\n",
+         rm -f \"part-$part.exr.lock\"\n\
+         {render}\n",
         parts = manifest.parts,
         name = job_name("render", &manifest.scene),
         last = manifest.parts - 1,
@@ -71,11 +76,11 @@ pub fn merge_script(manifest: &Manifest, dir: &Path) -> String {
          #SBATCH --output={LOG_DIR}/merge-%j.out\n\
          set -eu\n\
          cd {dir}\n\
-         partial=merge.partial-$SLURM_JOB_ID.exr\n\
-         {lumis} merge {parts} -o \"$partial\"\n\
-         mv -f \"$partial\" {image}\n",
+         rm -f {lock}\n\
+         {lumis} merge {parts} -o {image}\n",
         count = manifest.parts,
         image = quote(&manifest.image),
+        lock = quote(&format!("{}.lock", manifest.image)),
         name = job_name("merge", &manifest.scene),
         dir = quote(&dir.to_string_lossy()),
         lumis = quote(&manifest.lumis.to_string_lossy()),
@@ -154,7 +159,10 @@ mod tests {
     fn the_render_script_is_an_array_renaming_each_finished_part() {
         let script = render_script(&manifest(), Path::new("/shared/run"));
         assert!(script.contains("#SBATCH --array=0-3\n"), "{script}");
-        assert!(script.contains("#SBATCH --job-name=lumis-render-box\n"), "{script}");
+        assert!(
+            script.contains("#SBATCH --job-name=lumis-render-box\n"),
+            "{script}"
+        );
         assert!(
             script.contains(
                 "'/shared/bin/lumis' render '/shared/it'\\''s here/box.toml' --part \"$part/4\" \
@@ -163,7 +171,10 @@ mod tests {
             "{script}"
         );
         assert!(script.contains("cd '/shared/run'\n"), "{script}");
-        assert!(script.ends_with("mv -f \"$partial\" \"part-$part.exr\"\n"), "{script}");
+        assert!(
+            script.ends_with(" --quiet -o \"part-$part.exr\"\n"),
+            "{script}"
+        );
     }
 
     #[test]
@@ -171,11 +182,10 @@ mod tests {
         let script = merge_script(&manifest(), Path::new("/shared/run"));
         assert!(
             script.contains(
-                "'/shared/bin/lumis' merge part-0.exr part-1.exr part-2.exr part-3.exr -o \"$partial\"\n"
+                "'/shared/bin/lumis' merge part-0.exr part-1.exr part-2.exr part-3.exr -o 'box.exr'\n"
             ),
             "{script}"
         );
-        assert!(script.ends_with("mv -f \"$partial\" 'box.exr'\n"), "{script}");
     }
 
     #[test]

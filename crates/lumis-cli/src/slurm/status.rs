@@ -247,10 +247,16 @@ impl fmt::Display for StatusReport {
         match &self.merge {
             MergeState::Done => writeln!(f, "  image:   {}", self.dir.join(&m.image).display())?,
             MergeState::Active { job, state } => writeln!(f, "  merge:   job {job} {state}")?,
-            MergeState::Needed { last: Some((job, state)) } => writeln!(
+            MergeState::Needed {
+                last: Some((job, state)),
+            } => writeln!(
                 f,
                 "  merge:   job {job} ended {} without the image",
-                if state.is_empty() { "(forgotten by Slurm)" } else { state }
+                if state.is_empty() {
+                    "(forgotten by Slurm)"
+                } else {
+                    state
+                }
             )?,
             MergeState::Needed { last: None } => writeln!(f, "  merge:   never submitted")?,
         }
@@ -263,7 +269,10 @@ impl fmt::Display for StatusReport {
             )?;
         }
         if let Some(job) = &self.cancelled_merge {
-            writeln!(f, "cancelled merge job {job}, which waited for a failed part")?;
+            writeln!(
+                f,
+                "cancelled merge job {job}, which waited for a failed part"
+            )?;
         }
         if let Some(merge) = &self.new_merge {
             match &merge.dependency {
