@@ -109,6 +109,12 @@ pub fn submit_slurm(args: &SlurmSubmitArgs, lumis: &Path) -> Result<Submission> 
     if parts == 0 {
         return Err(Error::msg("--tasks: expected at least one part"));
     }
+    // Checked here too, not only by every task after its wait in the queue.
+    if let Some(spp) = args.spp.filter(|&spp| spp < parts) {
+        return Err(Error::msg(format!(
+            "--tasks {parts} parts of a {spp}-spp render would leave some empty; at most {spp} parts"
+        )));
+    }
     let scene = absolute(scene, "the scene")?;
     let lumis = absolute(lumis, "the lumis executable")?;
     let stem = scene
