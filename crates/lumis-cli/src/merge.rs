@@ -124,6 +124,17 @@ pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
     parts.sort_by_key(|(_, part)| part.film.start);
     check_coverage(&parts)?;
     let (exr, png) = output_paths(&args.output, "merged");
+    let same_file = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if let Some((part, _)) = parts.iter().find(|(p, _)| same_file(p, &exr)) {
+        return Err(Error::msg(format!(
+            "the output {} is the part '{}': give another -o",
+            exr.display(),
+            part.display()
+        )));
+    }
     if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
             return Err(Error::msg(format!(
@@ -156,7 +167,7 @@ fn append_all(parts: &[(PathBuf, Partial)]) -> Result<Film> {
     let mut film = Film::try_with_aovs(resolution, &first.aovs)?;
     for (path, part) in parts {
         film.append(&part.film)
-            .map_err(|e| Error::msg(format!("'{}': {e}", Path::new(path).display())))?;
+            .map_err(|e| Error::msg(format!("'{}': {e}", path.display())))?;
     }
     Ok(film)
 }

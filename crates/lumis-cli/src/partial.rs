@@ -190,10 +190,10 @@ impl Partial {
                 .map(|(_, v)| v)
                 .ok_or_else(|| not_partial(&format!("it has no channel {name}")))
         };
-        if channel(COUNT_CHANNEL)?.iter().any(|&n| n != slice.len()) {
+        if channel(COUNT_CHANNEL)?.iter().any(|&n| n != slice.spp()) {
             return Err(not_partial(&format!(
                 "its sample counts are not all {} ({slice})",
-                slice.len()
+                slice.spp()
             )));
         }
         for (name, _) in sum_components(&film) {

@@ -56,8 +56,8 @@ impl SampleSlice {
         })
     }
 
-    /// Samples per pixel in the slice.
-    pub fn len(&self) -> u32 {
+    /// Samples per pixel of the slice.
+    pub fn spp(&self) -> u32 {
         self.end - self.start
     }
 }
@@ -74,7 +74,7 @@ mod tests {
                 for k in 0..n {
                     let part = SampleSlice::parse_part(&format!("{k}/{n}"), total).unwrap();
                     assert_eq!(part.start, next);
-                    assert!(part.len() == total / n || part.len() == total / n + 1);
+                    assert!(part.spp() == total / n || part.spp() == total / n + 1);
                     next = part.end;
                 }
                 assert_eq!(next, total);
