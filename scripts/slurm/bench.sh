@@ -48,7 +48,7 @@ done
 image=$(since "$t")
 [ -n "$parts_done" ] || parts_done=$image
 # The parts' own render time, as their EXR headers record it.
-part_seconds=$(for p in "$out/run"/part-*.exr; do grep -a -o 'lumis.seconds[^0-9]*[0-9.]*' "$p" | grep -o '[0-9.]*$' | head -1; done | paste -sd+ | bc)
+part_seconds=$(for p in "$out/run"/part-*.exr; do grep -a -o 'lumis.seconds[^0-9]*[0-9.]*' "$p" | grep -a -o '[0-9.]*$' | head -1; done | paste -sd+ | bc)
 # The merge command alone, outside Slurm.
 parts=$(ls "$out/run"/part-*.exr)
 t=$(now)
@@ -66,5 +66,11 @@ printf 'lumis slurm returned after:  %8.2f s\n' "$submitted"
 printf 'submit -> all parts written: %8.2f s\n' "$parts_done"
 printf 'submit -> merged image:      %8.2f s\n' "$image"
 printf "parts' render time, summed:  %8.2f s\n" "$part_seconds"
+# The parts' time spread over the CPUs they ran on (one task per CPU):
+# what the array would take with no scheduler between the tasks.
+slots=$(( tasks < $(nproc) ? tasks : $(nproc) ))
+printf 'scheduler overhead:          %8.2f s (all parts written - summed / %s)\n' \
+  "$(echo "$parts_done - $part_seconds / $slots" | bc -l)" "$slots"
+printf 'merge job, parts -> image:   %8.2f s\n' "$(echo "$image - $parts_done" | bc -l)"
 printf 'lumis merge alone:           %8.2f s\n' "$merge"
 printf 'image equal to one process:  %s\n' "$equal"

@@ -156,7 +156,7 @@ mod tests {
     }
 
     #[test]
-    fn the_render_script_is_an_array_renaming_each_finished_part() {
+    fn the_render_script_is_an_array_whose_task_k_writes_part_k() {
         let script = render_script(&manifest(), Path::new("/shared/run"));
         assert!(script.contains("#SBATCH --array=0-3\n"), "{script}");
         assert!(
