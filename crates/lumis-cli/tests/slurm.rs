@@ -173,6 +173,39 @@ fn single_process_render(dir: &Path) -> PathBuf {
     PathBuf::from(out)
 }
 
+/// Without Slurm, and with a run already in the directory: clear errors
+/// naming the command or the file, before anything is submitted.
+#[test]
+fn submitting_without_slurm_or_over_a_run_is_a_clear_error() {
+    let work = scratch("slurm-errors");
+    let scene = scene("bench/cornell-box.toml");
+    let out = path_in(work.path(), "run");
+    let empty = work.path().join("no-tools");
+    std::fs::create_dir(&empty).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_lumis"))
+        .args(["slurm", &scene, "--tasks", "4", "--out", &out])
+        .env("PATH", &empty)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("`sbatch --parsable"), "{stderr}");
+    assert!(stderr.contains("sbatch is not on PATH"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+
+    // The first attempt left its manifest: a second submission into the
+    // same directory refuses and says how to follow the run.
+    let output = lumis(&["slurm", &scene, "--tasks", "4", "--out", &out]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(stderr.contains("already holds a run"), "{stderr}");
+    assert!(stderr.contains("lumis slurm status"), "{stderr}");
+
+    let output = lumis(&["slurm", &scene, "--tasks", "8", "--spp", "4", "--out", &out]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("at most 4 parts"), "{stderr}");
+}
+
 #[test]
 fn a_job_array_renders_the_image_of_one_process_and_resubmits_a_lost_part() {
     let cluster = match Cluster::start() {
@@ -184,6 +217,27 @@ fn a_job_array_renders_the_image_of_one_process_and_resubmits_a_lost_part() {
     };
     let work = scratch("slurm-runs");
     let single = single_process_render(work.path());
+
+    // sbatch's refusal is an error quoting it.
+    let scene = scene("bench/cornell-box.toml");
+    let rejected = path_in(work.path(), "rejected");
+    let output = cluster.lumis(&[
+        "slurm",
+        &scene,
+        "--tasks",
+        "2",
+        "--partition",
+        "nosuch",
+        "--out",
+        &rejected,
+    ]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("`sbatch --parsable --partition=nosuch render.sbatch` failed"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("invalid partition"), "{stderr}");
 
     // A whole run: four tasks, then the merge.
     let run = work.path().join("whole");
