@@ -81,9 +81,10 @@ write_config() {
   mkdir -p "$dir/etc" "$dir/state" "$dir/spool" "$dir/log" "$dir/run" "$dir/munge"
   chmod 0700 "$dir/munge"
   cat >"$conf" <<CONF
-# Written by local-cluster.sh: one node, no accounting, no cgroups.
+# Written by local-cluster.sh: one node, no accounting, no cgroups. The
+# daemons talk over 127.0.0.1, so the hostname need not resolve.
 ClusterName=lumis-local
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=$user
 SlurmdUser=$user
 SlurmctldPort=$ctld_port
@@ -109,7 +110,7 @@ SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 ReturnToService=2
 MinJobAge=3600
-NodeName=$host CPUs=$cpus State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
 PartitionName=local Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
 }
