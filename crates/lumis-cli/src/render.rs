@@ -361,9 +361,10 @@ fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Resul
 /// Renders a scene file and writes `PATH.exr` and `PATH.png`, in passes,
 /// saving a checkpoint as [`RenderArgs::checkpoint`] asks; with
 /// [`RenderArgs::part`] or [`RenderArgs::samples`], renders that slice of
-/// the sample indices to a partial EXR ([`Partial`](crate::Partial)) instead. Once `stop` is
-/// set (by the first Ctrl-C) the pass in flight is abandoned and the
-/// passes done are written, with their true sample count.
+/// the sample indices to a partial EXR ([`Partial`](crate::Partial))
+/// instead. Once `stop` is set (by the first Ctrl-C) the pass in flight is
+/// abandoned and the passes done are written, with their true sample
+/// count (a part writes nothing).
 pub fn render_scene_file(
     args: &RenderArgs,
     registry: &lumis_core::Registry,
