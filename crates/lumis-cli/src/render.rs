@@ -79,6 +79,13 @@ pub struct RenderArgs {
     /// samples per pixel, written as a partial EXR for `lumis merge`.
     #[arg(long, value_name = "A..B", conflicts_with_all = ["resume", "checkpoint"])]
     pub samples: Option<String>,
+    /// Render the whole image in this process, summed as N parts: each
+    /// slice `--part K/N` renders is summed on its own and added to the
+    /// slices before it, so the image is, bit for bit, what `lumis merge`
+    /// makes of the N parts (one plain run sums every sample in turn,
+    /// which rounds the sums differently in their last bits).
+    #[arg(long, value_name = "N", conflicts_with_all = ["part", "samples", "resume"])]
+    pub parts: Option<u32>,
 }
 
 /// Seconds between checkpoints when `--checkpoint` does not say.
@@ -387,13 +394,23 @@ pub fn render_scene_file(
         return Err(Error::msg("spp must be at least 1"));
     }
     let slice = sample_slice(args, spp)?;
-    if slice.is_some() && loaded.adaptive.is_some() {
+    if (slice.is_some() || args.parts.is_some()) && loaded.adaptive.is_some() {
         return Err(Error::msg(
-            "--part and --samples cannot split a render with [sampler] adaptive: which pixels \
-             still sample depends on all their earlier samples; remove the scene's \
-             sampler.adaptive to render it in parts",
+            "--part, --samples and --parts cannot split a render with [sampler] adaptive: \
+             which pixels still sample depends on all their earlier samples; remove the \
+             scene's sampler.adaptive to render it in parts",
         ));
     }
+    // With --parts, where each part's slice ends.
+    let part_ends = args
+        .parts
+        .map(|n| {
+            (0..n)
+                .map(|k| SampleSlice::part(k, n as u64, spp).map(|s| s.end))
+                .collect::<std::result::Result<Vec<u32>, String>>()
+                .map_err(|why| Error::msg(format!("--parts {n}: {why}")))
+        })
+        .transpose()?;
     // A part is short and cheap to redo: it never checkpoints.
     let every = match slice {
         Some(_) => CheckpointEvery::Never,
@@ -495,12 +512,32 @@ pub fn render_scene_file(
     let mut last_pass = None;
     let mut last_save = Instant::now();
     let mut interrupted = false;
+    // With --parts, the slice in flight, summed on its own until it ends.
+    let mut in_flight: Option<Film> = None;
     while state.film.samples < end {
-        let pass_spp = next_pass_spp(args, last_pass, end - state.film.samples);
-        let Some(pass) = render_pass(&ctx, &mut state.film, pass_spp)? else {
+        let (film, slice_end) = match &part_ends {
+            None => (&mut state.film, end),
+            Some(ends) => {
+                let from = state.film.samples;
+                let slice_end = ends.iter().copied().find(|&e| e > from).unwrap_or(end);
+                let film = match &mut in_flight {
+                    Some(film) => film,
+                    None => in_flight
+                        .insert(Film::try_with_aovs(resolution, &loaded.aovs)?.starting_at(from)),
+                };
+                (film, slice_end)
+            }
+        };
+        let pass_spp = next_pass_spp(args, last_pass, slice_end - film.samples);
+        let Some(pass) = render_pass(&ctx, film, pass_spp)? else {
             interrupted = true;
             break;
         };
+        if film.samples == slice_end {
+            if let Some(slice) = in_flight.take() {
+                state.film.append(&slice)?;
+            }
+        }
         // A loaded plugin that panicked answered with neutral values: the
         // pass is not the scene's, so nothing is saved, and the panic is the
         // error.
@@ -523,6 +560,10 @@ pub fn render_scene_file(
         if interrupted {
             break;
         }
+    }
+    // An interrupted --parts render keeps the samples of its last slice.
+    if let Some(slice) = in_flight.take().filter(|s| s.samples > s.start) {
+        state.film.append(&slice)?;
     }
     progress.finish();
     let profile = profile.map(Profile::finish);

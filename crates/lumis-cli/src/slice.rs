@@ -33,9 +33,7 @@ impl SampleSlice {
         Ok(Self { start, end, total })
     }
 
-    /// Part `K/N` of a render of `total` spp, 0-based: the slice
-    /// `[K total / N, (K + 1) total / N)` (integer division), so the `N`
-    /// parts cover `0..total` once, their sizes differing by at most one.
+    /// Part `K/N` of a render of `total` spp, 0-based ([`Self::part`]).
     pub fn parse_part(text: &str, total: u32) -> Result<Self, String> {
         let expected = || format!("'{text}': expected K/N, a part K of N parts with 0 <= K < N");
         let (k, n) = text.split_once('/').ok_or_else(expected)?;
@@ -43,15 +41,22 @@ impl SampleSlice {
             (Ok(k), Ok(n)) if k < n => (k, n),
             _ => return Err(expected()),
         };
+        Self::part(k as u32, n, total).map_err(|why| format!("'{text}': {why}"))
+    }
+
+    /// Part `k` of `n` (`k < n`) of a render of `total` spp: the slice
+    /// `[k total / n, (k + 1) total / n)` (integer division), so the `n`
+    /// parts cover `0..total` once, their sizes differing by at most one.
+    pub fn part(k: u32, n: u64, total: u32) -> Result<Self, String> {
         if n > total as u64 {
             return Err(format!(
-                "'{text}': {n} parts of a {total}-spp render would leave some empty; at most {total} parts"
+                "{n} parts of a {total}-spp render would leave some empty; at most {total} parts"
             ));
         }
         let bound = |k: u64| (k * total as u64 / n) as u32;
         Ok(Self {
-            start: bound(k),
-            end: bound(k + 1),
+            start: bound(k as u64),
+            end: bound(k as u64 + 1),
             total,
         })
     }

@@ -76,9 +76,10 @@ fn builtin_samplers() -> Vec<&'static str> {
 
 /// For every built-in sampler: three parts merged are, bit for bit, the
 /// same slices rendered in passes of one sample (each sample index a pass
-/// of its own) and merged, and agree with one plain render to within the
-/// rounding of the sums; one part of all the samples merged is the plain
-/// render, bit for bit.
+/// of its own) and merged, and the render of one process with the same
+/// slice boundaries (`--parts 3`); they agree with one plain render to
+/// within the rounding of the sums; one part of all the samples merged is
+/// the plain render, bit for bit.
 #[test]
 fn merged_parts_are_the_render_for_every_sampler() {
     let tmp = scratch("merge-samplers");
@@ -118,6 +119,17 @@ fn merged_parts_are_the_render_for_every_sampler() {
             merged_channels,
             all_channels(Path::new(&from_slices)),
             "{sampler}: the merged image depends on how the parts were split into passes"
+        );
+        let in_one_process = file(&format!("{sampler}-parts.exr"));
+        render(
+            sampler,
+            &in_one_process,
+            &["--parts", "3", "--pass-spp", "1"],
+        );
+        assert_eq!(
+            merged_channels,
+            all_channels(Path::new(&in_one_process)),
+            "{sampler}: the merged parts are not the render with the same slice boundaries"
         );
         assert_eq!(header(Path::new(&from_parts), "spp"), SPP);
         assert_eq!(header(Path::new(&from_parts), "command"), "render");
@@ -283,5 +295,7 @@ fn render_refuses_slices_it_cannot_render() {
     assert!(refusal(&["--samples", "4..7"]).contains("expected A..B"));
     assert!(refusal(&["--part", "0/2", "--resume"]).contains("--resume"));
     assert!(refusal(&["--part", "0/2", "--samples", "0..3"]).contains("--samples"));
+    assert!(refusal(&["--parts", "7"]).contains("at most 6 parts"));
+    assert!(refusal(&["--parts", "2", "--part", "0/2"]).contains("--part"));
     assert!(!Path::new(&out).exists());
 }
