@@ -150,18 +150,18 @@ fn manifest(run: &Path) -> SlurmManifest {
     toml::from_str(&text).unwrap()
 }
 
-/// One process, passes ending where the parts do.
+/// One process with the parts' slice boundaries (`--parts`).
 fn single_process_render(dir: &Path) -> PathBuf {
     let out = path_in(dir, "single.exr");
-    let pass_spp = (SPP.parse::<u32>().unwrap() / PARTS).to_string();
+    let parts = PARTS.to_string();
     let scene = scene("bench/cornell-box.toml");
     let args = [
         "render",
         &scene,
         "--spp",
         SPP,
-        "--pass-spp",
-        &pass_spp,
+        "--parts",
+        &parts,
         "--set",
         RESOLUTION,
         "-q",
