@@ -12,12 +12,16 @@ mod integrator_check;
 mod interrupt;
 mod lecture;
 mod listing;
+mod merge;
 mod metadata;
 mod new_plugin;
 mod outputs;
+mod partial;
 mod reference;
 mod render;
 mod samplers_analyze;
+mod slice;
+mod slurm;
 
 pub use assignments::{fixed_parameters, parameter_table};
 pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
@@ -33,14 +37,21 @@ pub use integrator_check::{
 pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
 pub use lecture::{lecture, LectureArgs};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};
+pub use merge::{merge, MergeArgs, MergeReport};
 pub use metadata::ImageMetadata;
 pub use new_plugin::{new_plugin, NewPluginArgs, NewPluginKind};
+pub use partial::Partial;
 pub use reference::{render_reference, ReferenceArgs};
 pub use render::{
     output_paths, render_scene_file, DenoisedReport, RenderArgs, RenderReport,
     DEFAULT_CHECKPOINT_SECONDS,
 };
 pub use samplers_analyze::{analyze as analyze_samplers, AnalyzeArgs};
+pub use slice::SampleSlice;
+pub use slurm::{
+    slurm_status, submit_slurm, Manifest as SlurmManifest, MergeState, PartState, SlurmArgs,
+    SlurmCommand, SlurmStatusArgs, SlurmSubmitArgs, StatusReport, Submission, MANIFEST_NAME,
+};
 
 use lumis_core::{Registry, Result};
 

@@ -15,10 +15,11 @@ use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
     analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
-    lecture, new_plugin, plugin_listing, plugin_markdown, precompute_table,
-    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
-    tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig, LectureArgs,
-    NewPluginArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    lecture, merge, new_plugin, plugin_listing, plugin_markdown, precompute_table,
+    registry_with_search_path, render_reference, render_scene_file, slurm_status,
+    stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs,
+    IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
+    RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -37,6 +38,11 @@ struct Cli {
 enum Command {
     /// Render a TOML scene to PATH.exr (linear float RGB) and PATH.png (sRGB).
     Render(RenderArgs),
+    /// Merge the partial images of a render split into parts (`render
+    /// --part K/N` or `--samples A..B`) into the image one render makes,
+    /// after checking they are parts of one render (scene, seed, spp) that
+    /// cover each sample index once.
+    Merge(MergeArgs),
     /// List every plugin (built-in, and libraries on LUMIS_PLUGIN_PATH or
     /// given with --load) with its parameters: name, type, default, meaning.
     Plugins {
@@ -108,6 +114,10 @@ enum Command {
     /// absolute and signed relative error, PSNR, per named region, and an
     /// optional false-colour error picture.
     Diff(DiffArgs),
+    /// Render SCENE as a Slurm job array of --tasks parts and a merge job
+    /// that waits for all of them (`lumis slurm SCENE --tasks N`), or report
+    /// and repair a run (`lumis slurm status DIR [--resubmit]`).
+    Slurm(SlurmArgs),
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
@@ -169,6 +179,18 @@ fn main() -> ExitCode {
                 println!("{line}");
             }
             Ok(Outcome::Done)
+        }),
+        Command::Merge(args) => plain(|| {
+            merge(&args).map(|report| {
+                println!(
+                    "{} spp from {} parts -> {} and {}",
+                    report.metadata.spp,
+                    args.parts.len(),
+                    report.exr.display(),
+                    report.png.display()
+                );
+                Outcome::Done
+            })
         }),
         Command::Reference(args) => interruptible(|stop| {
             let registry = registry_with_search_path()?;
@@ -263,6 +285,19 @@ fn main() -> ExitCode {
                     println!("figures in {}", args.out.display());
                     Outcome::Done
                 })
+        }),
+        Command::Slurm(args) => plain(|| {
+            match &args.command {
+                Some(SlurmCommand::Status(status)) => {
+                    print!("{}", slurm_status(&status.dir, status.resubmit)?)
+                }
+                None => {
+                    let lumis = std::env::current_exe()
+                        .map_err(|e| Error::msg(format!("the lumis executable: {e}")))?;
+                    println!("{}", submit_slurm(&args.submit, &lumis)?.summary());
+                }
+            }
+            Ok(Outcome::Done)
         }),
         Command::Samplers(SamplersCommand::Analyze(args)) => plain(|| {
             registry_with_search_path()

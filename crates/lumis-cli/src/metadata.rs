@@ -5,6 +5,8 @@ use std::path::Path;
 
 use lumis_core::{Error, Result};
 
+use crate::slice::SampleSlice;
+
 /// The `lumis.*` text attributes of a rendered EXR.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImageMetadata {
@@ -25,6 +27,9 @@ pub struct ImageMetadata {
     pub seconds: f64,
     /// The lumis version that wrote it.
     pub version: String,
+    /// For a part of a render split over processes (a partial image), the
+    /// sample indices it holds of how many; `None` for a whole image.
+    pub slice: Option<SampleSlice>,
 }
 
 const PREFIX: &str = "lumis.";
@@ -59,6 +64,12 @@ impl ImageMetadata {
             ("version", self.version.clone()),
         ]
         .into_iter()
+        .chain(self.slice.iter().flat_map(|slice| {
+            [
+                ("slice", format!("{}..{}", slice.start, slice.end)),
+                ("total_spp", slice.total.to_string()),
+            ]
+        }))
         .map(|(k, v)| (format!("{PREFIX}{k}"), v))
         .collect()
     }
@@ -100,6 +111,17 @@ impl ImageMetadata {
         let hash = |key: &str| -> Result<u64> {
             u64::from_str_radix(field(key)?, 16).map_err(|_| invalid(key, "a hexadecimal hash"))
         };
+        let slice = match get("slice") {
+            None => None,
+            Some(text) => {
+                let total = u32::try_from(number("total_spp")?)
+                    .map_err(|_| invalid("total_spp", "below 2^32"))?;
+                Some(
+                    SampleSlice::parse_range(text, total)
+                        .map_err(|why| invalid("slice", &format!("a slice A..B ({why})")))?,
+                )
+            }
+        };
         Ok(Some(Self {
             command: field("command")?.to_string(),
             spp: u32::try_from(number("spp")?).map_err(|_| invalid("spp", "below 2^32"))?,
@@ -111,6 +133,7 @@ impl ImageMetadata {
                 .parse()
                 .map_err(|_| invalid("seconds", "a number"))?,
             version: field("version")?.to_string(),
+            slice,
         }))
     }
 }
@@ -137,10 +160,21 @@ mod tests {
             scene_file_hash: 7,
             seconds: 1.5,
             version: lumis_version(),
+            slice: None,
         };
         let image = lumis_image::Image::new(1, 1);
         lumis_image::write_exr_with_metadata(&path, &image, &meta.attributes()).unwrap();
-        assert_eq!(ImageMetadata::read(&path).unwrap(), Some(meta));
+        assert_eq!(ImageMetadata::read(&path).unwrap(), Some(meta.clone()));
+        let part = ImageMetadata {
+            slice: Some(SampleSlice {
+                start: 16,
+                end: 48,
+                total: 512,
+            }),
+            ..meta
+        };
+        lumis_image::write_exr_with_metadata(&path, &image, &part.attributes()).unwrap();
+        assert_eq!(ImageMetadata::read(&path).unwrap(), Some(part));
         lumis_image::write_exr(&path, &image).unwrap();
         assert_eq!(ImageMetadata::read(&path).unwrap(), None);
     }

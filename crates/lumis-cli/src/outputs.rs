@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
-use lumis_image::{ExrLayer, Image, OutputLock};
+use lumis_image::{ExrLayer, ExrUintChannel, Image, OutputLock};
 use lumis_render::Aov;
 
 use crate::checkpoint::checkpoint_path;
@@ -53,6 +53,18 @@ impl Outputs {
         aovs: &[(Aov, Image)],
         metadata: &ImageMetadata,
     ) -> Result<()> {
+        self.write_with_channels(image, aovs, &[], &metadata.attributes())
+    }
+
+    /// [`Outputs::write`] with whole-number channels in the EXR too and
+    /// the header `attributes` as given (a partial image's).
+    pub fn write_with_channels(
+        &self,
+        image: &Image,
+        aovs: &[(Aov, Image)],
+        uints: &[ExrUintChannel],
+        attributes: &[(String, String)],
+    ) -> Result<()> {
         let png = match &self.png {
             Some(path) => Some(lumis_image::stage_png(path, image).map_err(image_error)?),
             None => None,
@@ -66,7 +78,7 @@ impl Outputs {
             })
             .collect();
         let exr =
-            lumis_image::stage_exr_with_layers(&self.exr, image, &layers, &metadata.attributes())
+            lumis_image::stage_exr_with_channels(&self.exr, image, &layers, uints, attributes)
                 .map_err(image_error)?;
         if let Some(png) = png {
             png.commit().map_err(image_error)?;

@@ -155,6 +155,7 @@ pub fn render_reference(
                 scene_file_hash: lumis_scene::scene_hash(&args.scene, &[])?,
                 seconds: 0.0,
                 version: lumis_version(),
+                slice: None,
             },
             None,
         ),

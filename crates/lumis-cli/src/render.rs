@@ -16,6 +16,8 @@ use lumis_scene::LoadedScene;
 use crate::checkpoint::{checkpoint_path, Checkpoint};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
+use crate::partial::Partial;
+use crate::slice::SampleSlice;
 
 /// What `lumis render` was asked to do; also its command-line flags.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -68,6 +70,22 @@ pub struct RenderArgs {
     /// The image does not depend on it.
     #[arg(long, value_name = "N")]
     pub pass_spp: Option<u32>,
+    /// Render part K (0-based) of N of the scene's samples per pixel: the
+    /// sample indices [K spp / N, (K + 1) spp / N), written as a partial
+    /// EXR that `lumis merge` adds to the other parts.
+    #[arg(long, value_name = "K/N", conflicts_with_all = ["samples", "resume", "checkpoint"])]
+    pub part: Option<String>,
+    /// Render sample indices A..B (half-open, B <= spp) of the scene's
+    /// samples per pixel, written as a partial EXR for `lumis merge`.
+    #[arg(long, value_name = "A..B", conflicts_with_all = ["resume", "checkpoint"])]
+    pub samples: Option<String>,
+    /// Render the whole image in this process, summed as N parts: each
+    /// slice `--part K/N` renders is summed on its own and added to the
+    /// slices before it, so the image is, bit for bit, what `lumis merge`
+    /// makes of the N parts (one plain run sums every sample in turn,
+    /// which rounds the sums differently in their last bits).
+    #[arg(long, value_name = "N", conflicts_with_all = ["part", "samples", "resume"])]
+    pub parts: Option<u32>,
 }
 
 /// Seconds between checkpoints when `--checkpoint` does not say.
@@ -328,15 +346,32 @@ fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) ->
     spp.clamp(1, remaining)
 }
 
+/// The slice of sample indices `--part` or `--samples` asks for, of a
+/// render of `spp` samples per pixel; `None` for a whole render.
+fn sample_slice(args: &RenderArgs, spp: u32) -> Result<Option<SampleSlice>> {
+    let slice = match (&args.part, &args.samples) {
+        (Some(part), _) => {
+            SampleSlice::parse_part(part, spp).map_err(|why| Error::msg(format!("--part {why}")))?
+        }
+        (None, Some(range)) => SampleSlice::parse_range(range, spp)
+            .map_err(|why| Error::msg(format!("--samples {why}")))?,
+        (None, None) => return Ok(None),
+    };
+    Ok(Some(slice))
+}
+
 /// Writes the film's colour and outputs.
 fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Result<()> {
     outputs.write(&film.image(), &film.aov_images(), metadata)
 }
 
 /// Renders a scene file and writes `PATH.exr` and `PATH.png`, in passes,
-/// saving a checkpoint as [`RenderArgs::checkpoint`] asks. Once `stop` is
-/// set (by the first Ctrl-C) the pass in flight is abandoned and the
-/// passes done are written, with their true sample count.
+/// saving a checkpoint as [`RenderArgs::checkpoint`] asks; with
+/// [`RenderArgs::part`] or [`RenderArgs::samples`], renders that slice of
+/// the sample indices to a partial EXR ([`Partial`](crate::Partial))
+/// instead. Once `stop` is set (by the first Ctrl-C) the pass in flight is
+/// abandoned and the passes done are written, with their true sample
+/// count (a part writes nothing).
 pub fn render_scene_file(
     args: &RenderArgs,
     registry: &lumis_core::Registry,
@@ -354,11 +389,40 @@ pub fn render_scene_file(
     if args.pass_spp == Some(0) {
         return Err(Error::msg("--pass-spp must be at least 1"));
     }
-    let every = CheckpointEvery::of(args)?;
-    let output = match (&args.output, &loaded.output) {
-        (Some(o), _) => o.clone(),
-        (None, Some(o)) => o.clone(),
-        (None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
+    let spp = loaded.sampler.samples_per_pixel();
+    if spp == 0 {
+        return Err(Error::msg("spp must be at least 1"));
+    }
+    let slice = sample_slice(args, spp)?;
+    if (slice.is_some() || args.parts.is_some()) && loaded.adaptive.is_some() {
+        return Err(Error::msg(
+            "--part, --samples and --parts cannot split a render with [sampler] adaptive: \
+             which pixels still sample depends on all their earlier samples; remove the \
+             scene's sampler.adaptive to render it in parts",
+        ));
+    }
+    // With --parts, where each part's slice ends.
+    let part_ends = args
+        .parts
+        .map(|n| {
+            (0..n)
+                .map(|k| SampleSlice::part(k, n as u64, spp).map(|s| s.end))
+                .collect::<std::result::Result<Vec<u32>, String>>()
+                .map_err(|why| Error::msg(format!("--parts {n}: {why}")))
+        })
+        .transpose()?;
+    // A part is short and cheap to redo: it never checkpoints.
+    let every = match slice {
+        Some(_) => CheckpointEvery::Never,
+        None => CheckpointEvery::of(args)?,
+    };
+    let output = match (&args.output, &loaded.output, slice) {
+        (Some(o), _, _) => o.clone(),
+        (None, _, Some(s)) => {
+            PathBuf::from(format!("{}.samples-{}-{}.exr", loaded.name, s.start, s.end))
+        }
+        (None, Some(o), None) => o.clone(),
+        (None, None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
     };
     let (exr, png) = output_paths(&output, &loaded.name);
     // Fail before rendering, not after, when the output cannot be written.
@@ -371,21 +435,32 @@ pub fn render_scene_file(
             )));
         }
     }
-    let outputs = Outputs::claim(&exr, Some(&png))?;
+    // A part writes its partial EXR only, and is not denoised (the merged
+    // image is the render).
+    let outputs = Outputs::claim(&exr, slice.is_none().then_some(png.as_path()))?;
     let denoised_outputs = loaded
         .denoiser
         .as_ref()
+        .filter(|_| slice.is_none())
         .map(|_| crate::denoise::claim_denoised_outputs(&exr))
         .transpose()?;
     crate::warn_if_threads_capped(args.threads);
-    let spp = loaded.sampler.samples_per_pixel();
-    if spp == 0 {
-        return Err(Error::msg("spp must be at least 1"));
-    }
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
     let checkpoint_file = checkpoint_path(&exr);
     let resolution = loaded.camera.resolution();
-    let mut state = starting_state(args, &checkpoint_file, scene_hash, &loaded)?;
+    let mut state = match slice {
+        Some(slice) => Checkpoint {
+            film: Film::try_with_aovs(resolution, &loaded.aovs)?.starting_at(slice.start),
+            spp,
+            passes: 0,
+            seed: loaded.seed,
+            scene_hash,
+            seconds: 0.0,
+        },
+        None => starting_state(args, &checkpoint_file, scene_hash, &loaded)?,
+    };
+    // The last sample index (exclusive) this run renders.
+    let end = slice.map_or(spp, |s| s.end);
     // With --stats the scene, its plugins and the sampler run inside the
     // profiling wrappers; the render itself is the same call.
     if args.stats {
@@ -402,7 +477,7 @@ pub fn render_scene_file(
     let pool = RenderPool::new(args.threads)?;
     let progress = RenderProgress::new(
         !args.quiet,
-        progress_units(resolution, spp - state.film.samples),
+        progress_units(resolution, end - state.film.samples),
     );
     let ctx = PassContext {
         camera: &loaded.camera,
@@ -418,13 +493,14 @@ pub fn render_scene_file(
     let scene_file_hash = lumis_scene::scene_hash(&args.scene, &[])?;
     let metadata = |state: &Checkpoint| ImageMetadata {
         command: "render".into(),
-        spp: state.film.samples,
+        spp: state.film.samples - state.film.start,
         passes: state.passes,
         seed: state.seed,
         scene_hash,
         scene_file_hash,
         seconds: state.seconds,
         version: lumis_version(),
+        slice,
     };
     let save = |state: &Checkpoint| -> Result<()> {
         state.write(&checkpoint_file)?;
@@ -436,12 +512,32 @@ pub fn render_scene_file(
     let mut last_pass = None;
     let mut last_save = Instant::now();
     let mut interrupted = false;
-    while state.film.samples < spp {
-        let pass_spp = next_pass_spp(args, last_pass, spp - state.film.samples);
-        let Some(pass) = render_pass(&ctx, &mut state.film, pass_spp)? else {
+    // With --parts, the slice in flight, summed on its own until it ends.
+    let mut in_flight: Option<Film> = None;
+    while state.film.samples < end {
+        let (film, slice_end) = match &part_ends {
+            None => (&mut state.film, end),
+            Some(ends) => {
+                let from = state.film.samples;
+                let slice_end = ends.iter().copied().find(|&e| e > from).unwrap_or(end);
+                let film = match &mut in_flight {
+                    Some(film) => film,
+                    None => in_flight
+                        .insert(Film::try_with_aovs(resolution, &loaded.aovs)?.starting_at(from)),
+                };
+                (film, slice_end)
+            }
+        };
+        let pass_spp = next_pass_spp(args, last_pass, slice_end - film.samples);
+        let Some(pass) = render_pass(&ctx, film, pass_spp)? else {
             interrupted = true;
             break;
         };
+        if film.samples == slice_end {
+            if let Some(slice) = in_flight.take() {
+                state.film.append(&slice)?;
+            }
+        }
         // A loaded plugin that panicked answered with neutral values: the
         // pass is not the scene's, so nothing is saved, and the panic is the
         // error.
@@ -465,15 +561,30 @@ pub fn render_scene_file(
             break;
         }
     }
+    // An interrupted --parts render keeps the samples of its last slice.
+    if let Some(slice) = in_flight.take().filter(|s| s.samples > s.start) {
+        state.film.append(&slice)?;
+    }
     progress.finish();
     let profile = profile.map(Profile::finish);
-    if interrupted && state.film.samples == 0 {
+    if interrupted && slice.is_some() {
+        return Err(Error::msg(format!(
+            "interrupted: a part is written only when finished, nothing written to {} (rerun the part)",
+            exr.display()
+        )));
+    }
+    if slice.is_some() {
+        Partial {
+            film: state.film.clone(),
+            metadata: metadata(&state),
+        }
+        .write(&outputs)?;
+    } else if interrupted && state.film.samples == 0 {
         return Err(Error::msg(format!(
             "interrupted before the first pass ended: nothing written to {}",
             exr.display()
         )));
-    }
-    if interrupted && state.film.samples < spp {
+    } else if interrupted && state.film.samples < spp {
         save(&state)?;
         eprintln!(
             "interrupted at {} of {spp} spp: {} holds the image so far; --resume continues it",
@@ -527,7 +638,7 @@ pub fn render_scene_file(
         exr,
         png,
         denoised,
-        spp: state.film.samples,
+        spp: state.film.samples - state.film.start,
         interrupted,
         seconds,
         stats,

@@ -51,12 +51,33 @@ pub fn stage_exr(
     stage_exr_with_layers(path, image, &[], metadata)
 }
 
+/// A channel of whole numbers written beside an EXR's colour, one per
+/// pixel, row-major: exact where a float channel would round (the bits of
+/// a double-precision sum, held in two such channels).
+#[derive(Debug, Clone, Copy)]
+pub struct ExrUintChannel<'a> {
+    pub name: &'a str,
+    pub values: &'a [u32],
+}
+
 /// [`stage_exr`] with `layers` beside the colour, each the size of
 /// `image`.
 pub fn stage_exr_with_layers(
     path: &Path,
     image: &Image,
     layers: &[ExrLayer],
+    metadata: &[(String, String)],
+) -> Result<StagedFile, ImageError> {
+    stage_exr_with_channels(path, image, layers, &[], metadata)
+}
+
+/// [`stage_exr_with_layers`] with whole-number channels too, each with a
+/// value per pixel of `image`.
+pub fn stage_exr_with_channels(
+    path: &Path,
+    image: &Image,
+    layers: &[ExrLayer],
+    uints: &[ExrUintChannel],
     metadata: &[(String, String)],
 ) -> Result<StagedFile, ImageError> {
     let format_err = |message: String| ImageError::Format {
@@ -91,6 +112,23 @@ pub fn stage_exr_with_layers(
                 .ok_or_else(|| format_err(format!("'{name}' is not an EXR channel name")))?;
             channels.push(AnyChannel::new(text, component(layer.image, c)));
         }
+    }
+    for channel in uints {
+        if channel.values.len() != image.width * image.height {
+            return Err(format_err(format!(
+                "channel '{}' has {} values, not one per pixel of a {}x{} image",
+                channel.name,
+                channel.values.len(),
+                image.width,
+                image.height
+            )));
+        }
+        let text = Text::new_or_none(channel.name)
+            .ok_or_else(|| format_err(format!("'{}' is not an EXR channel name", channel.name)))?;
+        channels.push(AnyChannel::new(
+            text,
+            FlatSamples::U32(channel.values.to_vec()),
+        ));
     }
     let channels = AnyChannels::sort(channels.into());
     let mut exr_image = exr::image::Image::from_channels((image.width, image.height), channels);
@@ -171,6 +209,27 @@ pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageEr
         }
     }
     Ok(out)
+}
+
+/// An EXR file's resolution `(width, height)` and its whole-number
+/// channels, by full name, exactly as written ([`ExrUintChannel`]); float
+/// channels are left out.
+pub type ExrUintChannels = ((usize, usize), Vec<(String, Vec<u32>)>);
+
+/// Reads the [`ExrUintChannels`] of an EXR file.
+pub fn read_exr_uint_channels(path: &Path) -> Result<ExrUintChannels, ImageError> {
+    let image = exr::image::read::read_all_flat_layers_from_file(path)
+        .map_err(|e| unreadable_exr(path, e))?;
+    let size = image.attributes.display_window.size;
+    let mut out = Vec::new();
+    for layer in &image.layer_data {
+        for channel in &layer.channel_data.list {
+            if let FlatSamples::U32(values) = &channel.sample_data {
+                out.push((channel.name.to_string(), values.clone()));
+            }
+        }
+    }
+    Ok(((size.width(), size.height()), out))
 }
 
 /// Reads the RGB channels of the first layer of an EXR file.
@@ -289,6 +348,27 @@ mod tests {
         .err()
         .unwrap();
         assert!(err.to_string().contains("layer 'spp'"), "{err}");
+    }
+
+    #[test]
+    fn whole_number_channels_round_trip_exactly() {
+        let tmp = tempfile::tempdir().unwrap();
+        let path = tmp.path().join("uint.exr");
+        let colour = Image::new(2, 1);
+        let values = [u32::MAX, 0x7ff8_0001];
+        let channels = [ExrUintChannel {
+            name: "bits.hi",
+            values: &values,
+        }];
+        stage_exr_with_channels(&path, &colour, &[], &channels, &[])
+            .unwrap()
+            .commit()
+            .unwrap();
+        assert_eq!(
+            read_exr_uint_channels(&path).unwrap(),
+            ((2, 1), vec![("bits.hi".to_string(), values.to_vec())])
+        );
+        assert_eq!(read_exr(&path).unwrap(), colour);
     }
 
     #[test]

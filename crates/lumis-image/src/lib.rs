@@ -12,8 +12,9 @@ mod process;
 
 pub use atomic::{remove_stale_temporaries, stage, write_atomically, StagedFile};
 pub use exr_io::{
-    read_exr, read_exr_channels, read_exr_metadata, stage_exr, stage_exr_with_layers, write_exr,
-    write_exr_with_metadata, ExrLayer, ExrMetadata,
+    read_exr, read_exr_channels, read_exr_metadata, read_exr_uint_channels, stage_exr,
+    stage_exr_with_channels, stage_exr_with_layers, write_exr, write_exr_with_metadata, ExrLayer,
+    ExrMetadata, ExrUintChannel, ExrUintChannels,
 };
 pub use hdr_io::{is_hdr, read_hdr};
 pub use output_lock::{lock_path, OutputLock};

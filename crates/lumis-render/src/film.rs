@@ -55,8 +55,12 @@ pub struct Film {
     pub aovs: Vec<Aov>,
     /// With adaptive sampling, the per-pixel counts and half-buffers.
     pub adaptive: Option<AdaptiveState>,
-    /// Sample indices `0..samples` of the sampler have been rendered: every
-    /// pixel has taken them all, or (adaptive sampling) stopped before.
+    /// The first sample index the sums hold: 0 for a whole render, `A` for
+    /// the slice `A..B` of a render split into parts.
+    pub start: u32,
+    /// Sample indices `start..samples` of the sampler have been rendered:
+    /// every pixel has taken them all, or (adaptive sampling) stopped
+    /// before.
     pub samples: u32,
 }
 
@@ -109,6 +113,7 @@ impl Film {
                 aovs
             },
             adaptive: None,
+            start: 0,
             samples: 0,
         })
     }
@@ -132,10 +137,74 @@ impl Film {
         self.adaptive.as_ref().is_none_or(|a| a.active[i])
     }
 
+    /// This empty film as the slice of sample indices starting at `start`
+    /// (a part of a render split over processes): its sums will hold
+    /// samples `start..` only, which [`Film::append`] adds to the slices
+    /// before them.
+    pub fn starting_at(mut self, start: u32) -> Self {
+        self.start = start;
+        self.samples = start;
+        self
+    }
+
     /// The samples pixel `i` has taken.
     #[inline]
     pub fn samples_of(&self, i: usize) -> u32 {
-        self.adaptive.as_ref().map_or(self.samples, |a| a.counts[i])
+        self.adaptive
+            .as_ref()
+            .map_or(self.samples - self.start, |a| a.counts[i])
+    }
+
+    /// Adds `slice`, the sums of the sample indices that follow this
+    /// film's, to this film's sums: a render split into slices (parts
+    /// rendered in other processes) is put together by appending them in
+    /// index order, each sum once, so the result does not depend on where
+    /// or in which order the parts ran. Adaptive sampling cannot be split
+    /// (which pixels still sample depends on all their earlier samples).
+    pub fn append(&mut self, slice: &Film) -> Result<()> {
+        if self.adaptive.is_some() || slice.adaptive.is_some() {
+            return Err(Error::msg(
+                "an adaptively sampled film cannot be split into slices",
+            ));
+        }
+        if slice.start != self.samples {
+            return Err(Error::msg(format!(
+                "the slice holds samples {}..{}, not the ones from {} on",
+                slice.start, slice.samples, self.samples
+            )));
+        }
+        if (slice.width, slice.height) != (self.width, self.height) || slice.aovs != self.aovs {
+            return Err(Error::msg(format!(
+                "the slice is a {}x{} film with outputs {:?}, not {}x{} with {:?}",
+                slice.width, slice.height, slice.aovs, self.width, self.height, self.aovs
+            )));
+        }
+        fn add<const N: usize>(to: &mut [[f64; N]], from: &[[f64; N]]) {
+            for (to, from) in to.iter_mut().zip(from) {
+                for c in 0..N {
+                    to[c] += from[c];
+                }
+            }
+        }
+        add(&mut self.sums, &slice.sums);
+        if let (Some(to), Some(from)) = (&mut self.squares, &slice.squares) {
+            add(to, from);
+        }
+        if let (Some(to), Some(from)) = (&mut self.first_hits, &slice.first_hits) {
+            for (to, from) in to.iter_mut().zip(from) {
+                add(
+                    std::slice::from_mut(&mut to.albedo),
+                    std::slice::from_ref(&from.albedo),
+                );
+                add(
+                    std::slice::from_mut(&mut to.normal),
+                    std::slice::from_ref(&from.normal),
+                );
+                to.depth += from.depth;
+            }
+        }
+        self.samples = slice.samples;
+        Ok(())
     }
 
     /// After `samples` sample indices: stops the pixels adaptive sampling
@@ -235,6 +304,7 @@ impl Film {
                     .flat_map(|row| a.active[row + x0..row + x1].iter().copied())
                     .collect(),
             }),
+            start: self.start,
             samples: self.samples,
         }
     }
@@ -375,6 +445,51 @@ mod tests {
         assert!((v[0] - 14.0 / 12.0).abs() < 1e-6, "{v:?}");
         assert!((v[1] - 4.0 * 14.0 / 12.0).abs() < 1e-5, "{v:?}");
         assert_eq!(v[2], 0.0);
+    }
+
+    #[test]
+    fn appended_slices_hold_each_sum_once_in_index_order() {
+        let aovs = [Aov::Variance, Aov::Depth];
+        let empty = || Film::try_with_aovs(UVec2::new(2, 1), &aovs).unwrap();
+        let hit = |depth| FirstHit {
+            albedo: lumis_core::Vec3::ONE,
+            normal: lumis_core::Vec3::Z,
+            depth,
+        };
+        // Sample k of pixel i has radiance 1/(k + 3 i + 1): sums that round.
+        let value = |i: usize, k: u32| 1.0 / (k as f32 + 3.0 * i as f32 + 1.0);
+        let slice = |range: std::ops::Range<u32>| {
+            let mut film = empty().starting_at(range.start);
+            for k in range.clone() {
+                for i in 0..2 {
+                    film.add_sample(i, k, Rgb::new(value(i, k), 1.0, 0.0));
+                    film.add_first_hit(i, &hit(k as f32));
+                }
+            }
+            film.samples = range.end;
+            film
+        };
+        let (first, second) = (slice(0..3), slice(3..7));
+        assert_eq!(second.samples_of(0), 4);
+        assert_eq!(second.image().pixels[0][1], 1.0);
+        let mut whole = empty();
+        whole.append(&first).unwrap();
+        whole.append(&second).unwrap();
+        assert_eq!(whole.samples, 7);
+        for i in 0..2 {
+            let sum = |range: std::ops::Range<u32>| range.map(|k| value(i, k) as f64).sum::<f64>();
+            assert_eq!(whole.sums[i][0], sum(0..3) + sum(3..7));
+            assert_eq!(whole.sums[i][1], 7.0);
+            assert_eq!(whole.first_hits.as_ref().unwrap()[i].depth, 21.0);
+        }
+        let err = whole.append(&first).unwrap_err().to_string();
+        assert!(
+            err.contains("samples 0..3, not the ones from 7 on"),
+            "{err}"
+        );
+        let mut other = Film::try_new(UVec2::new(2, 1)).unwrap();
+        let err = other.append(&first).unwrap_err().to_string();
+        assert!(err.contains("outputs"), "{err}");
     }
 
     #[test]

@@ -1,0 +1,301 @@
+//! `lumis render --part K/N` / `--samples A..B` and `lumis merge`: the parts
+//! of a render, merged, are the render; parts of different renders, gaps,
+//! overlaps and files that are not parts are refused by name.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+use lumis_core::PluginKind;
+
+const SPP: &str = "6";
+
+/// Every output beside the colour: their sums are split and merged too.
+const ALL_AOVS: &str = "film.aovs=[\"albedo\", \"normal\", \"depth\", \"variance\", \"spp\"]";
+
+/// The bits of every channel of an EXR (colour and outputs), by name.
+fn all_channels(path: &Path) -> Vec<(String, Vec<u32>)> {
+    let mut channels: Vec<(String, Vec<u32>)> = lumis_image::read_exr_channels(path)
+        .unwrap()
+        .into_iter()
+        .map(|(name, values)| (name, values.into_iter().map(f32::to_bits).collect()))
+        .collect();
+    channels.sort();
+    channels
+}
+
+/// `lumis render` of the small scene at 16x16 and [`SPP`] with every
+/// output and `sampler`, plus `extra` flags, to `out`; panics where it
+/// fails.
+fn render(sampler: &str, out: &str, extra: &[&str]) {
+    render_spp(sampler, out, SPP, extra)
+}
+
+/// [`render`] at `spp`.
+fn render_spp(sampler: &str, out: &str, spp: &str, extra: &[&str]) {
+    let sampler = format!("sampler.type=\"{sampler}\"");
+    let mut args = small_render(out, spp);
+    args.extend(["--set", "film.resolution=[16, 16]", "--set", ALL_AOVS]);
+    args.extend(["--set", &sampler]);
+    args.extend(extra);
+    let result = lumis(&args);
+    assert!(result.status.success(), "{args:?}: {result:?}");
+}
+
+fn merge(parts: &[&str], out: &str) -> std::process::Output {
+    let mut args = vec!["merge"];
+    args.extend(parts);
+    args.extend(["-o", out]);
+    lumis(&args)
+}
+
+fn merged(parts: &[&str], out: &str) {
+    let result = merge(parts, out);
+    assert!(result.status.success(), "{parts:?}: {result:?}");
+}
+
+fn merge_error(parts: &[&str], out: &str) -> String {
+    let result = merge(parts, out);
+    assert!(!result.status.success(), "{parts:?} merged");
+    String::from_utf8_lossy(&result.stderr).into_owned()
+}
+
+/// The names of the built-in samplers.
+fn builtin_samplers() -> Vec<&'static str> {
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let names: Vec<&'static str> = registry
+        .plugins()
+        .into_iter()
+        .filter(|p| p.spec.kind == PluginKind::Sampler)
+        .map(|p| p.spec.name)
+        .collect();
+    assert!(names.len() >= 7, "{names:?}");
+    names
+}
+
+/// For every built-in sampler: three parts merged are, bit for bit, the
+/// same slices rendered in passes of one sample (each sample index a pass
+/// of its own) and merged, and the render of one process with the same
+/// slice boundaries (`--parts 3`); they agree with one plain render to
+/// within the rounding of the sums; one part of all the samples merged is
+/// the plain render, bit for bit.
+#[test]
+fn merged_parts_are_the_render_for_every_sampler() {
+    let tmp = scratch("merge-samplers");
+    let file = |name: &str| path_in(tmp.path(), name);
+    for sampler in builtin_samplers() {
+        let whole = file(&format!("{sampler}-whole.exr"));
+        render(sampler, &whole, &[]);
+        let mut parts = Vec::new();
+        let mut slices = Vec::new();
+        for (k, range) in ["0..2", "2..4", "4..6"].into_iter().enumerate() {
+            let part = file(&format!("{sampler}-part-{k}.exr"));
+            render(sampler, &part, &["--part", &format!("{k}/3")]);
+            assert_eq!(header(Path::new(&part), "slice"), range);
+            assert_eq!(header(Path::new(&part), "total_spp"), SPP);
+            let slice = file(&format!("{sampler}-slice-{k}.exr"));
+            render(sampler, &slice, &["--samples", range, "--pass-spp", "1"]);
+            parts.push(part);
+            slices.push(slice);
+        }
+        // Given out of order: merge sorts them by their slices.
+        parts.swap(0, 2);
+        let from_parts = file(&format!("{sampler}-from-parts.exr"));
+        let from_slices = file(&format!("{sampler}-from-slices.exr"));
+        merged(
+            &parts.iter().map(String::as_str).collect::<Vec<_>>(),
+            &from_parts,
+        );
+        merged(
+            &slices.iter().map(String::as_str).collect::<Vec<_>>(),
+            &from_slices,
+        );
+        let (merged_channels, whole_channels) = (
+            all_channels(Path::new(&from_parts)),
+            all_channels(Path::new(&whole)),
+        );
+        assert_eq!(
+            merged_channels,
+            all_channels(Path::new(&from_slices)),
+            "{sampler}: the merged image depends on how the parts were split into passes"
+        );
+        let in_one_process = file(&format!("{sampler}-parts.exr"));
+        render(
+            sampler,
+            &in_one_process,
+            &["--parts", "3", "--pass-spp", "1"],
+        );
+        assert_eq!(
+            merged_channels,
+            all_channels(Path::new(&in_one_process)),
+            "{sampler}: the merged parts are not the render with the same slice boundaries"
+        );
+        assert_eq!(header(Path::new(&from_parts), "spp"), SPP);
+        assert_eq!(header(Path::new(&from_parts), "command"), "render");
+        // Within rounding: a sampler whose sample i depended on where its
+        // range started would differ by the Monte Carlo noise, far more.
+        for ((name, merged), (whole_name, whole)) in merged_channels.iter().zip(&whole_channels) {
+            assert_eq!(name, whole_name);
+            for (&a, &b) in merged.iter().zip(whole) {
+                let (a, b) = (f32::from_bits(a), f32::from_bits(b));
+                assert!(
+                    (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) + 1e-12,
+                    "{sampler}: channel {name} of the merged parts is {a}, of one render {b}"
+                );
+            }
+        }
+        let single = file(&format!("{sampler}-single.exr"));
+        render(sampler, &single, &["--part", "0/1"]);
+        let from_single = file(&format!("{sampler}-from-single.exr"));
+        merged(&[&single], &from_single);
+        assert_eq!(
+            all_channels(Path::new(&from_single)),
+            whole_channels,
+            "{sampler}: the one part of all samples, merged, is not the render"
+        );
+    }
+}
+
+/// Parts that do not make one render are refused, naming the files and
+/// what is wrong with them.
+#[test]
+fn merge_refuses_what_is_not_one_render_by_name() {
+    let tmp = scratch("merge-errors");
+    let file = |name: &str| path_in(tmp.path(), name);
+    let out = file("out.exr");
+    let (a, b, c) = (file("a.exr"), file("b.exr"), file("c.exr"));
+    render("independent", &a, &["--samples", "0..2"]);
+    render("independent", &b, &["--samples", "2..4"]);
+    render("independent", &c, &["--samples", "4..6"]);
+
+    let err = merge_error(&[&a, &c], &out);
+    assert!(
+        err.contains("samples 2..4 of 6 are in no part")
+            && err.contains("a.exr")
+            && err.contains("c.exr"),
+        "{err}"
+    );
+    let err = merge_error(&[&a, &b], &out);
+    assert!(err.contains("samples 4..6 of 6 are in no part"), "{err}");
+    let err = merge_error(&[&b, &c], &out);
+    assert!(err.contains("samples 0..2 of 6 are in no part"), "{err}");
+
+    let wide = file("wide.exr");
+    render("independent", &wide, &["--samples", "1..4"]);
+    let err = merge_error(&[&a, &wide, &c], &out);
+    assert!(
+        err.contains("a.exr")
+            && err.contains("wide.exr")
+            && err.contains("samples 1..2 are in both"),
+        "{err}"
+    );
+
+    let seeded = file("seeded.exr");
+    render(
+        "independent",
+        &seeded,
+        &["--samples", "2..4", "--seed", "7"],
+    );
+    let err = merge_error(&[&a, &seeded, &c], &out);
+    assert!(
+        err.contains("seeded.exr") && err.contains("a.exr") && err.contains("seed 7, not 0"),
+        "{err}"
+    );
+
+    let other_scene = file("other-scene.exr");
+    render(
+        "independent",
+        &other_scene,
+        &["--samples", "2..4", "--set", "integrator.max_depth=2"],
+    );
+    let err = merge_error(&[&a, &other_scene, &c], &out);
+    assert!(
+        err.contains("other-scene.exr") && err.contains("a different scene"),
+        "{err}"
+    );
+
+    let more_spp = file("more-spp.exr");
+    render_spp("independent", &more_spp, "8", &["--samples", "2..4"]);
+    let err = merge_error(&[&a, &more_spp, &c], &out);
+    assert!(
+        err.contains("more-spp.exr") && err.contains("8 spp in all, not 6"),
+        "{err}"
+    );
+
+    let plain = file("plain.exr");
+    render("independent", &plain, &[]);
+    let err = merge_error(&[&a, &plain], &out);
+    assert!(
+        err.contains("plain.exr") && err.contains("is not a lumis partial image"),
+        "{err}"
+    );
+    let text = file("text.exr");
+    std::fs::write(&text, "not an image").unwrap();
+    let err = merge_error(&[&a, &text], &out);
+    assert!(err.contains("text.exr"), "{err}");
+
+    let bytes = std::fs::read(&b).unwrap();
+    let truncated = file("truncated.exr");
+    std::fs::write(&truncated, &bytes[..bytes.len() / 2]).unwrap();
+    let err = merge_error(&[&a, &truncated, &c], &out);
+    assert!(err.contains("truncated.exr"), "{err}");
+    // One bit of one sum, the file otherwise as written: still a
+    // readable EXR, refused by its checksum.
+    let damaged = file("damaged.exr");
+    let attributes = lumis_image::read_exr_metadata(Path::new(&b)).unwrap();
+    let (_, mut channels) = lumis_image::read_exr_uint_channels(Path::new(&b)).unwrap();
+    let sum = channels
+        .iter_mut()
+        .find(|(n, _)| n == "partial.sum.G.lo")
+        .unwrap();
+    sum.1[17] ^= 1;
+    let uints: Vec<lumis_image::ExrUintChannel> = channels
+        .iter()
+        .map(|(name, values)| lumis_image::ExrUintChannel { name, values })
+        .collect();
+    let colour = lumis_image::read_exr(Path::new(&b)).unwrap();
+    lumis_image::stage_exr_with_channels(Path::new(&damaged), &colour, &[], &uints, &attributes)
+        .unwrap()
+        .commit()
+        .unwrap();
+    let err = merge_error(&[&a, &damaged, &c], &out);
+    assert!(
+        err.contains("damaged.exr") && err.contains("checksum"),
+        "{err}"
+    );
+    assert!(
+        !Path::new(&out).exists(),
+        "a refused merge wrote its output"
+    );
+}
+
+/// Adaptive sampling cannot be split; bad slices say what was expected;
+/// a part cannot be resumed.
+#[test]
+fn render_refuses_slices_it_cannot_render() {
+    let tmp = scratch("merge-refusals");
+    let out = path_in(tmp.path(), "part.exr");
+    let refusal = |extra: &[&str]| {
+        let mut args = small_render(&out, SPP);
+        args.extend(extra);
+        let result = lumis(&args);
+        assert!(!result.status.success(), "{extra:?} rendered");
+        String::from_utf8_lossy(&result.stderr).into_owned()
+    };
+    let err = refusal(&[
+        "--part",
+        "0/2",
+        "--set",
+        "sampler.adaptive={min_spp = 2, threshold = 0.1}",
+    ]);
+    assert!(err.contains("sampler.adaptive"), "{err}");
+    assert!(refusal(&["--part", "2/2"]).contains("expected K/N"));
+    assert!(refusal(&["--part", "0/7"]).contains("at most 6 parts"));
+    assert!(refusal(&["--samples", "4..7"]).contains("expected A..B"));
+    assert!(refusal(&["--part", "0/2", "--resume"]).contains("--resume"));
+    assert!(refusal(&["--part", "0/2", "--samples", "0..3"]).contains("--samples"));
+    assert!(refusal(&["--parts", "7"]).contains("at most 6 parts"));
+    assert!(refusal(&["--parts", "2", "--part", "0/2"]).contains("--part"));
+    assert!(!Path::new(&out).exists());
+}
