@@ -156,17 +156,7 @@ fn single_process_render(dir: &Path) -> PathBuf {
     let parts = PARTS.to_string();
     let scene = scene("bench/cornell-box.toml");
     let args = [
-        "render",
-        &scene,
-        "--spp",
-        SPP,
-        "--parts",
-        &parts,
-        "--set",
-        RESOLUTION,
-        "-q",
-        "-o",
-        &out,
+        "render", &scene, "--spp", SPP, "--parts", &parts, "--set", RESOLUTION, "-q", "-o", &out,
     ];
     let output = lumis(&args);
     assert!(output.status.success(), "{output:?}");
