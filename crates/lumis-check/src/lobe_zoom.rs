@@ -38,12 +38,16 @@ const TARGET_WIDTH: f64 = 0.5;
 /// and the compression is reached at `RELAXED_WIDTHS`.
 const MAGNIFIED_WIDTHS: f64 = 2.0;
 const RELAXED_WIDTHS: f64 = 6.0;
-/// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are not magnified; those
-/// over a pole are still turned to the equator, since the grid's polar row
-/// (0.2 rad of the 100 bins in `cos theta`) is too coarse for the
-/// quadrature of a lobe's steps there (a tabulated density at normal
-/// incidence).
+/// Lobes wider than `TARGET_WIDTH / MIN_ZOOM` are not magnified.
 const MIN_ZOOM: f64 = 4.0;
+/// Lobes too wide to magnify but narrower than this (radians) that lie
+/// over a pole are turned to the equator unmagnified: the grid's polar row
+/// (0.2 rad of the 100 bins in `cos theta`) is too coarse for the
+/// quadrature of their steps (a tabulated density at normal incidence).
+/// Wider lobes span enough rows as they are.
+const ROTATED_WIDTH: f64 = 0.5;
+/// A centre this close to a pole (cos of 0.01 rad) is taken to be it.
+const POLE_SNAP_COS: f64 = 0.99995;
 const PILOT_SAMPLES: usize = 20_000;
 /// A peak holding less than this share of the pilot samples is not a lobe
 /// to magnify (the `1 / <wo, h>` spike of a wide lobe at grazing angles),
@@ -250,7 +254,15 @@ impl LobeZoom {
                 MAGNIFIED_WIDTHS * width,
                 RELAXED_WIDTHS * width,
             ))
-        } else if Self::polar(centre).0.min(Self::polar(-centre).0) < width {
+        } else if width < ROTATED_WIDTH && Self::polar(centre).0.min(Self::polar(-centre).0) < width
+        {
+            // At normal incidence the centre is the pole itself: taking it
+            // exactly keeps the hemisphere's rim on bin edges.
+            let centre = if centre.z.abs() > POLE_SNAP_COS {
+                DVec3::Z * centre.z.signum()
+            } else {
+                centre
+            };
             Some(Self::rotation(centre.as_vec3()))
         } else {
             None
