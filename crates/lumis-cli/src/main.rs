@@ -14,11 +14,11 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
-    new_plugin, plugin_listing, plugin_markdown, precompute_table, registry_with_search_path,
-    render_reference, render_scene_file, stop_on_interrupt, tabulate_bsdf, AnalyzeArgs,
-    ConvergeArgs, DiffArgs, IntegratorCheckConfig, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
-    RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    analyze_samplers, check_integrator_with, compress_table, converge, diff_images,
+    format_integrator_results, new_plugin, plugin_listing, plugin_markdown, precompute_table,
+    registry_with_search_path, render_reference, render_scene_file, stop_on_interrupt,
+    tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig,
+    NewPluginArgs, PrecomputeArgs, ReferenceArgs, RenderArgs, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -111,7 +111,8 @@ enum Command {
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
-    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling.
+    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling,
+    /// compress a table into a tensor.
     #[command(subcommand)]
     Brdf(BrdfCommand),
 }
@@ -126,6 +127,10 @@ enum BrdfCommand {
     /// for a table (ignoring and replacing its cache); print its time and
     /// memory.
     Precompute(PrecomputeArgs),
+    /// Fit a rank-R tensor (CP) approximation of a table over a
+    /// parameterization; print its size and error against the table, and
+    /// write the factors with `-o`.
+    Compress(CompressArgs),
 }
 
 #[derive(Subcommand)]
@@ -246,6 +251,12 @@ fn main() -> ExitCode {
         Command::Brdf(BrdfCommand::Precompute(args)) => plain(|| {
             precompute_table(&args).map(|line| {
                 println!("{line}");
+                Outcome::Done
+            })
+        }),
+        Command::Brdf(BrdfCommand::Compress(args)) => plain(|| {
+            compress_table(&args).map(|report| {
+                println!("{report}");
                 Outcome::Done
             })
         }),

@@ -6,15 +6,19 @@
 //! tabulation of any lumis BSDF as a MERL table.
 
 pub mod cache;
+pub mod compress;
+pub mod cp;
 pub mod factored;
 pub mod grid;
 mod measured;
 pub mod merl;
 pub mod precompute;
+pub mod reflectance;
 pub mod tabulate;
 pub mod tabulated;
+pub mod tensor;
 
-pub use measured::{Measured, MeasuredParams, MeasuredSampling, SPEC};
+pub use measured::{Measured, MeasuredParams, MeasuredRepresentation, MeasuredSampling, SPEC};
 pub use merl::MerlTable;
 
 use std::sync::Arc;
