@@ -51,7 +51,7 @@ pub struct PrecomputeArgs {
     /// Outgoing elevations, half-angle bins, azimuth bins.
     #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
     pub grid: Vec<usize>,
-    /// The coordinates of the grid: half-diff or pdv.
+    /// The coordinates of the grid: half-diff, pdv or in-out.
     #[arg(long, default_value = "half-diff")]
     pub parameterization: String,
 }
