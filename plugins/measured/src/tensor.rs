@@ -35,7 +35,8 @@
 //! of products is the product of the linearly interpolated factors: `3 R`
 //! lerps per channel. `f = max(exp(y) - 1, 0)`. In pdv and in-out the
 //! coordinates are about `wo`, so the fitted model need not be reciprocal;
-//! [`TensorBrdf::eval`] averages both orders, which is.
+//! [`TensorBrdf::eval`] averages both orders, which is. In half-diff it is
+//! reciprocal but for rounding, and the pair is evaluated in a fixed order.
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
@@ -155,6 +156,13 @@ impl TensorBrdf {
     #[inline]
     pub fn eval(&self, wi: Vec3, wo: Vec3) -> Rgb {
         match self.parameterization {
+            // The model is symmetric in the pair, but the f32 rounding of
+            // phi_d is not, and near f = 0 the sum of R terms cancels to a
+            // few ulps: evaluating the pair in one fixed order makes f
+            // reciprocal to the last bit.
+            Parameterization::HalfDiff if [wi.z, wi.x, wi.y] < [wo.z, wo.x, wo.y] => {
+                self.eval_about(wi, wo)
+            }
             Parameterization::HalfDiff => self.eval_about(wo, wi),
             Parameterization::Pdv | Parameterization::InOut => {
                 (self.eval_about(wo, wi) + self.eval_about(wi, wo)) * 0.5
