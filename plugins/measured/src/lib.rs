@@ -2,8 +2,9 @@
 //! lookup), the `measured` BSDF plugin and its importance sampling
 //! strategies (cosine, the factored representation of Lawrence,
 //! Rusinkiewicz and Ramamoorthi 2004, a tabulated 2D distribution per
-//! outgoing elevation), the cache of their precomputation, and the
-//! tabulation of any lumis BSDF as a MERL table.
+//! outgoing elevation), the cache of their precomputation, the tensor
+//! (CP) approximation of a table the plugin can render from instead, and
+//! the tabulation of any lumis BSDF as a MERL table.
 
 pub mod cache;
 pub mod compress;
