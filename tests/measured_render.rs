@@ -12,6 +12,7 @@
 //! ```
 
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Instant;
 
 use indicatif::ProgressBar;
@@ -21,6 +22,7 @@ use lumis_core::{Bsdf, BsdfContext, Vec2, Vec3};
 use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::MerlTable;
 use lumis_measured::precompute::{prepare, Plan};
+use lumis_measured::reflectance::Reflectance;
 use lumis_sampling::Pcg32;
 use lumis_tests::{read_scene, render_toml_with, scenes_dir, tabulated};
 
@@ -215,20 +217,48 @@ fn the_cache_is_reused_and_invalidated_when_the_table_changes() {
     let file = tabulated(&dir, "c", "conductor", &["roughness=0.2"]);
     let table = MerlTable::read(&file).unwrap();
     let plan = Plan::Factored { terms: 2 };
-    let (_, first) = prepare(&table, &file, plan, GRID, true).unwrap();
+    let (_, first) = prepare(
+        &Reflectance::Table(Arc::new(table.clone())),
+        &file,
+        plan,
+        GRID,
+        true,
+    )
+    .unwrap();
     assert!(!first.from_cache, "{}", first.message);
-    let (_, second) = prepare(&table, &file, plan, GRID, true).unwrap();
+    let (_, second) = prepare(
+        &Reflectance::Table(Arc::new(table.clone())),
+        &file,
+        plan,
+        GRID,
+        true,
+    )
+    .unwrap();
     assert!(second.from_cache, "{}", second.message);
     // Another table at the same path: the old cache is stale.
     let file = tabulated(&dir, "c", "conductor", &["roughness=0.3"]);
     let table = MerlTable::read(&file).unwrap();
-    let (_, third) = prepare(&table, &file, plan, GRID, true).unwrap();
+    let (_, third) = prepare(
+        &Reflectance::Table(Arc::new(table.clone())),
+        &file,
+        plan,
+        GRID,
+        true,
+    )
+    .unwrap();
     assert!(
         !third.from_cache && third.message.contains("another version"),
         "{}",
         third.message
     );
-    let (_, tab) = prepare(&table, &file, Plan::Tabulated, GRID, true).unwrap();
+    let (_, tab) = prepare(
+        &Reflectance::Table(Arc::new(table.clone())),
+        &file,
+        Plan::Tabulated,
+        GRID,
+        true,
+    )
+    .unwrap();
     assert!(
         !tab.from_cache,
         "a different strategy has its own cache: {}",
@@ -368,14 +398,21 @@ fn measured_results_table() {
                 Some(plan) => {
                     let start = Instant::now();
                     let payload = lumis_measured::precompute::compute(
-                        &table,
+                        &|wo, wi| table.eval(wi, wo),
                         plan,
                         GRID,
                         &ProgressBar::hidden(),
                     );
                     let seconds = start.elapsed().as_secs_f64();
                     drop(payload);
-                    let (prepared, _) = prepare(&table, &file, plan, GRID, true).unwrap();
+                    let (prepared, _) = prepare(
+                        &Reflectance::Table(Arc::new(table.clone())),
+                        &file,
+                        plan,
+                        GRID,
+                        true,
+                    )
+                    .unwrap();
                     (seconds, prepared.memory_bytes())
                 }
                 None => (0.0, 0),

@@ -1,7 +1,9 @@
 //! `lumis brdf`: measured-BRDF tools. `tabulate` writes any lumis BSDF as
 //! a MERL table (a measured material with a known ground truth);
 //! `precompute` runs a sampling precomputation of a table, reports its
-//! time and memory and refreshes its cache.
+//! time and memory and refreshes its cache; `compress` fits (or loads from
+//! the `measured` plugin's cache) a tensor approximation of a table and
+//! reports its size and error.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -9,10 +11,14 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use lumis_core::ParamChoice;
 use lumis_core::{Bsdf, Error, Location, PluginEntity, PluginKind, Registry, Result};
+use lumis_measured::cache;
+use lumis_measured::compress::{cache_key, prepare_tensor};
 use lumis_measured::grid::{Grid, Parameterization};
-use lumis_measured::merl::{write_atomic, MerlTable, THETA_H_RES};
+use lumis_measured::merl::{write_atomic, MerlTable, SAMPLES, THETA_H_RES};
 use lumis_measured::precompute::{prepare, Plan};
+use lumis_measured::reflectance::Reflectance;
 use lumis_measured::tabulate::tabulate;
+use lumis_measured::tensor::{compression_error, DIMS};
 
 use crate::assignments::parameter_table;
 
@@ -45,10 +51,30 @@ pub struct PrecomputeArgs {
     /// Outgoing elevations, half-angle bins, azimuth bins.
     #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
     pub grid: Vec<usize>,
-    /// The coordinates of the grid: half-diff or pdv.
+    /// The coordinates of the grid: half-diff, pdv or in-out.
     #[arg(long, default_value = "half-diff")]
     pub parameterization: String,
 }
+
+#[derive(clap::Args, Debug, Clone)]
+pub struct CompressArgs {
+    /// The MERL table.
+    pub table: PathBuf,
+    /// The coordinates of the tensor's axes: half-diff, pdv or in-out.
+    #[arg(long, default_value = "half-diff")]
+    pub parameterization: String,
+    /// R, the rank-1 terms per colour channel.
+    #[arg(long, default_value_t = 8)]
+    pub rank: usize,
+    /// Write the factors here (the cache file format of the `measured`
+    /// plugin: a header, then per channel the three axes' n x R matrices
+    /// as little-endian f32, then a hash).
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<PathBuf>,
+}
+
+/// The largest rank `compress` and the plugin accept.
+pub const MAX_RANK: usize = 32;
 
 /// `lumis brdf tabulate`: returns the summary line.
 pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String> {
@@ -121,9 +147,10 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
         }
     };
     let table = MerlTable::read(&args.table)?;
+    let reflectance = Reflectance::Table(std::sync::Arc::new(table));
     // Remove the cache first so that the time is the computation's.
     let cache = lumis_measured::cache::CacheKey {
-        table_hash: table.hash(),
+        table_hash: reflectance.hash(),
         strategy: match plan {
             Plan::Factored { .. } => "factored",
             Plan::Tabulated => "tabulated",
@@ -136,8 +163,54 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
     }
     .path(&args.table);
     let _ = std::fs::remove_file(&cache);
-    let (_, report) = prepare(&table, &args.table, plan, grid, true)?;
+    let (_, report) = prepare(&reflectance, &args.table, plan, grid, true)?;
     Ok(report.message)
+}
+
+/// `lumis brdf compress`: returns the report (size, error, fit).
+pub fn compress_table(args: &CompressArgs) -> Result<String> {
+    let parameterization = parameterization(&args.parameterization)?;
+    if !(1..=MAX_RANK).contains(&args.rank) {
+        return Err(Error::msg(format!(
+            "--rank must be in [1, {MAX_RANK}], got {}",
+            args.rank
+        )));
+    }
+    let table = MerlTable::read(&args.table)?;
+    // Through the plugin's cache: a render with the same settings then
+    // loads these factors instead of fitting them again.
+    let (tensor, report) = prepare_tensor(&table, &args.table, parameterization, args.rank, true)?;
+    let error = compression_error(&table, &|wi, wo| tensor.eval(wi, wo));
+    let (table_floats, tensor_floats) = (3 * SAMPLES, tensor.payload().len());
+    let mut out = format!(
+        "{}: rank-{} CP tensor over {} ({} x {} x {} nodes per channel) of ln(1 + f)\n{}\n",
+        args.table.display(),
+        args.rank,
+        parameterization.name(),
+        DIMS[0],
+        DIMS[1],
+        DIMS[2],
+        report.message
+    );
+    out += &format!(
+        "size: table {table_floats} floats ({:.1} MB as f32), tensor {tensor_floats} floats ({:.1} KB as f32), {:.0}x smaller\n",
+        (4 * table_floats) as f64 / 1e6,
+        (4 * tensor_floats) as f64 / 1e3,
+        table_floats as f64 / tensor_floats as f64
+    );
+    out += &format!(
+        "error at the {} valid nodes of the table: relative RMSE of f {:.4}, PSNR of ln(1 + f) {:.2} dB",
+        error.nodes, error.relative_rmse, error.log_psnr_db
+    );
+    if let Some(output) = &args.output {
+        cache::store(
+            output,
+            &cache_key(&table, parameterization, args.rank),
+            &tensor.payload(),
+        )?;
+        out += &format!("\nfactors written to {}", output.display());
+    }
+    Ok(out)
 }
 
 /// `--parameterization`: one of the grid's coordinates by name.

@@ -186,6 +186,8 @@ pub struct Run {
     pub rays_per_second: f64,
     pub mse: f64,
     pub rel_mse: f64,
+    /// PSNR of the sRGB-encoded image ([`error_metrics`]).
+    pub psnr_db: f64,
 }
 
 /// The seeds of one (variant, spp), summarised.
@@ -200,6 +202,8 @@ pub struct Point {
     pub rel_mse_se: f64,
     pub rel_mse_min: f64,
     pub rel_mse_max: f64,
+    /// The mean PSNR of the seeds' renders, in dB.
+    pub psnr_db: f64,
     /// 1 / (relMSE x seconds).
     pub efficiency: f64,
     /// The error split into bias² and variance across the seeds (with two
@@ -234,6 +238,7 @@ fn summarise(runs: &[Run], images: &[Image], reference: &Image) -> Point {
         rel_mse_se,
         rel_mse_min: rel.iter().cloned().fold(f64::INFINITY, f64::min),
         rel_mse_max: rel.iter().cloned().fold(0.0, f64::max),
+        psnr_db: runs.iter().map(|r| r.psnr_db).sum::<f64>() / runs.len() as f64,
         efficiency: 1.0 / (rel_mse * seconds),
         split: bias_variance(&images.iter().collect::<Vec<_>>(), reference).ok(),
     }
@@ -328,6 +333,7 @@ pub fn converge(
                 rays_per_second: report.stats.total_rays() as f64 / report.seconds,
                 mse: m.mse,
                 rel_mse: m.rel_mse,
+                psnr_db: m.psnr_db,
             };
             Ok((run, image))
         };
@@ -550,7 +556,7 @@ fn write_outputs(
     points: &[Point],
 ) -> Result<()> {
     let mut csv = String::from(
-        "variant,spp,seed,seconds,samples_per_second,rays_per_second,mse,rel_mse,\
+        "variant,spp,seed,seconds,samples_per_second,rays_per_second,mse,rel_mse,psnr_db,\
          bias2,variance,rel_bias2,rel_variance\n",
     );
     for r in runs {
@@ -568,7 +574,7 @@ fn write_outputs(
             });
         writeln!(
             csv,
-            "{},{},{},{:.6},{:.1},{:.1},{:.6e},{:.6e},{split}",
+            "{},{},{},{:.6},{:.1},{:.1},{:.6e},{:.6e},{:.3},{split}",
             r.variant,
             r.spp,
             r.seed,
@@ -576,7 +582,8 @@ fn write_outputs(
             r.samples_per_second,
             r.rays_per_second,
             r.mse,
-            r.rel_mse
+            r.rel_mse,
+            r.psnr_db
         )
         .unwrap();
     }
@@ -585,8 +592,8 @@ fn write_outputs(
         .iter()
         .map(|p| {
             format!(
-                "    {{\"variant\": {:?}, \"spp\": {}, \"seconds\": {:.6}, \"mse\": {:.6e}, \"mse_se\": {:.6e}, \"rel_mse\": {:.6e}, \"rel_mse_se\": {:.6e}, \"efficiency\": {:.6e}{}}}",
-                p.variant, p.spp, p.seconds, p.mse, p.mse_se.max(0.0), p.rel_mse, p.rel_mse_se.max(0.0), p.efficiency,
+                "    {{\"variant\": {:?}, \"spp\": {}, \"seconds\": {:.6}, \"mse\": {:.6e}, \"mse_se\": {:.6e}, \"rel_mse\": {:.6e}, \"rel_mse_se\": {:.6e}, \"psnr_db\": {:.3}, \"efficiency\": {:.6e}{}}}",
+                p.variant, p.spp, p.seconds, p.mse, p.mse_se.max(0.0), p.rel_mse, p.rel_mse_se.max(0.0), p.psnr_db, p.efficiency,
                 p.split.map_or(String::new(), |s| format!(", \"mse_split\": {}, \"rel_mse_split\": {}", split_json(&s.mse), split_json(&s.rel_mse)))
             )
         })

@@ -24,7 +24,9 @@ mod slice;
 mod slurm;
 
 pub use assignments::{fixed_parameters, parameter_table};
-pub use brdf::{precompute_table, tabulate_bsdf, PrecomputeArgs, TabulateArgs};
+pub use brdf::{
+    compress_table, precompute_table, tabulate_bsdf, CompressArgs, PrecomputeArgs, TabulateArgs,
+};
 pub use checkpoint::{checkpoint_path, Checkpoint};
 pub use converge::{
     converge, parse_variants, ConvergeArgs, ConvergeReport, MeasuredImage, Point, Run, Variant,

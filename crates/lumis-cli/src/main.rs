@@ -14,12 +14,12 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, check_integrator_with, converge, diff_images, format_integrator_results,
-    lecture, merge, new_plugin, plugin_listing, plugin_markdown, precompute_table,
-    registry_with_search_path, render_reference, render_scene_file, slurm_status,
-    stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs, ConvergeArgs, DiffArgs,
-    IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs, PrecomputeArgs, ReferenceArgs,
-    RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    analyze_samplers, check_integrator_with, compress_table, converge, diff_images,
+    format_integrator_results, lecture, merge, new_plugin, plugin_listing, plugin_markdown,
+    precompute_table, registry_with_search_path, render_reference, render_scene_file, slurm_status,
+    stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs,
+    DiffArgs, IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs, PrecomputeArgs,
+    ReferenceArgs, RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -121,7 +121,8 @@ enum Command {
     /// Sample generators: compare where they put their points.
     #[command(subcommand)]
     Samplers(SamplersCommand),
-    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling.
+    /// Measured BRDFs: write a BSDF as a MERL table, precompute sampling,
+    /// compress a table into a tensor.
     #[command(subcommand)]
     Brdf(BrdfCommand),
     /// The Monte Carlo lecture's experiments on test integrands and point
@@ -142,6 +143,10 @@ enum BrdfCommand {
     /// for a table (ignoring and replacing its cache); print its time and
     /// memory.
     Precompute(PrecomputeArgs),
+    /// Fit a rank-R tensor (CP) approximation of a table over a
+    /// parameterization; print its size and error against the table, and
+    /// write the factors with `-o`.
+    Compress(CompressArgs),
 }
 
 #[derive(Subcommand)]
@@ -274,6 +279,12 @@ fn main() -> ExitCode {
         Command::Brdf(BrdfCommand::Precompute(args)) => plain(|| {
             precompute_table(&args).map(|line| {
                 println!("{line}");
+                Outcome::Done
+            })
+        }),
+        Command::Brdf(BrdfCommand::Compress(args)) => plain(|| {
+            compress_table(&args).map(|report| {
+                println!("{report}");
                 Outcome::Done
             })
         }),

@@ -1,5 +1,5 @@
-//! `lumis brdf tabulate`, `lumis brdf precompute` and `lumis check-plugin
-//! --set` on a measured table, as a user runs them.
+//! `lumis brdf tabulate`, `lumis brdf precompute`, `lumis brdf compress`
+//! and `lumis check-plugin --set` on a measured table, as a user runs them.
 
 use std::process::{Command, Output};
 
@@ -77,6 +77,38 @@ fn tabulate_precompute_and_check_a_measured_table() {
         .join("gold.binary.tabulated-L0-32x64x64s4-pdv.lumis-cache")
         .exists());
 
+    // The tensor approximation: its size, its error, its factors.
+    let factors = dir.join("gold.factors");
+    let factors_arg = factors.display().to_string();
+    let run = lumis(&[
+        "brdf",
+        "compress",
+        &table_arg,
+        "--rank",
+        "2",
+        "--parameterization",
+        "pdv",
+        "-o",
+        &factors_arg,
+    ]);
+    let out = text(&run);
+    assert!(run.status.success(), "{out}");
+    for want in [
+        "rank-2 CP tensor over pdv",
+        "table 4374000 floats",
+        "tensor 2160 floats",
+        "2025x smaller",
+        "relative RMSE of f",
+        "PSNR of ln(1 + f)",
+    ] {
+        assert!(out.contains(want), "missing {want}:\n{out}");
+    }
+    // Header, 2160 f32, hash.
+    assert_eq!(
+        std::fs::metadata(&factors).unwrap().len(),
+        56 + 4 * 2160 + 8
+    );
+
     // The check kit over the plugin's own parameters, the table held fixed.
     let file = format!("file={table_arg}");
     let run = lumis(&[
@@ -96,6 +128,8 @@ fn tabulate_precompute_and_check_a_measured_table() {
         "sampling = \"cosine\"",
         "sampling = \"tabulated\"",
         "parameterization = \"pdv\"",
+        "parameterization = \"in-out\"",
+        "representation = \"tensor\"",
         "terms = 16",
         "passed, 0 failed",
     ] {
@@ -136,7 +170,15 @@ fn bad_requests_fail_with_the_reason() {
     let run = lumis(&["brdf", "precompute", &out, "--parameterization", "polar"]);
     assert!(!run.status.success());
     assert!(
-        text(&run).contains("--parameterization must be one of half-diff, pdv, got \"polar\""),
+        text(&run)
+            .contains("--parameterization must be one of half-diff, pdv, in-out, got \"polar\""),
+        "{}",
+        text(&run)
+    );
+    let run = lumis(&["brdf", "compress", &out, "--rank", "0"]);
+    assert!(!run.status.success());
+    assert!(
+        text(&run).contains("--rank must be in [1, 32], got 0"),
         "{}",
         text(&run)
     );

@@ -1,6 +1,6 @@
 //! The cache of a sampling precomputation, stored next to its table.
 //!
-//! `TABLE.STRATEGY-LL-NOxNWxNPHIsS[-pdv].lumis-cache`: a header (magic,
+//! `TABLE.STRATEGY-LL-NOxNWxNPHIsS[-pdv|-in-out].lumis-cache`: a header (magic,
 //! format version, the content hash of the table file, strategy, terms,
 //! grid and its parameterization) and
 //! the precomputed numbers as little-endian f32, then an FNV-1a hash of
@@ -24,7 +24,7 @@ const HEADER_BYTES: usize = 8 + 4 + 8 + 4 * 7 + 8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CacheKey {
     pub table_hash: u64,
-    /// `"factored"` or `"tabulated"`.
+    /// `"factored"`, `"tabulated"` or `"tensor"`.
     pub strategy: &'static str,
     pub terms: usize,
     pub grid: Grid,
@@ -34,7 +34,8 @@ impl CacheKey {
     fn strategy_code(&self) -> u32 {
         match self.strategy {
             "factored" => 1,
-            _ => 2,
+            "tabulated" => 2,
+            _ => 3,
         }
     }
 
@@ -48,6 +49,7 @@ impl CacheKey {
         let coordinates = match g.parameterization {
             Parameterization::HalfDiff => "",
             Parameterization::Pdv => "-pdv",
+            Parameterization::InOut => "-in-out",
         };
         name.push(format!(
             ".{}-L{}-{}x{}x{}s{}{coordinates}.lumis-cache",
@@ -72,6 +74,7 @@ impl CacheKey {
             match g.parameterization {
                 Parameterization::HalfDiff => 0,
                 Parameterization::Pdv => 1,
+                Parameterization::InOut => 2,
             },
         ] {
             h.extend_from_slice(&v.to_le_bytes());

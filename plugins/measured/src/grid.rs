@@ -20,6 +20,13 @@
 //!   dr dphi / (2 cos theta_i)`. Edges at `rho = 2 (a / n_w)^2` (the same
 //!   square-root spacing; `rho <= 1 + sin theta_o <= 2`).
 //!
+//! - in-out: the incident direction itself, `(r, phi) = (1 - cos theta_i,
+//!   phi_i - phi_o)`, equal-area (`d omega_i = dr dphi`), edges uniform in
+//!   `r`. The specular peak is not at a pole here but at `(1 - cos
+//!   theta_o, pi)`, so a lobe moves across the grid with `wo`: the
+//!   baseline the other two are measured against (Lawrence et al. 2004,
+//!   figure 3).
+//!
 //! `phi` bins are uniform. Each entry is the integral of `f cos theta_i`
 //! over the cell, in solid angle of `wi`, by `s x s` midpoints: the mass a
 //! sampler should give the cell.
@@ -41,6 +48,8 @@ pub enum Parameterization {
     HalfDiff,
     /// The projected deviation vector, `rho^2` and its azimuth.
     Pdv,
+    /// The incident direction, `1 - cos theta_i` and its azimuth.
+    InOut,
 }
 
 /// Resolution of the precomputation.
@@ -64,7 +73,8 @@ impl Grid {
     }
 
     /// The edges of the radial coordinate: `1 - cos theta_h` at `theta_h =
-    /// (a / n_w)^2 pi/2`, or `rho^2` at `rho = 2 (a / n_w)^2`.
+    /// (a / n_w)^2 pi/2`, `rho^2` at `rho = 2 (a / n_w)^2`, or `1 - cos
+    /// theta_i` at `a / n_w`.
     pub fn w_edges(&self) -> Vec<f32> {
         (0..=self.n_w)
             .map(|a| {
@@ -76,6 +86,7 @@ impl Grid {
                         (2.0 * (0.5 * theta).sin().powi(2)) as f32
                     }
                     Parameterization::Pdv => (4.0 * t.powi(4)) as f32,
+                    Parameterization::InOut => t as f32,
                 }
             })
             .collect()
@@ -94,6 +105,12 @@ impl Grid {
                 let (wi, _) = w_from_pdv(wo, r.max(0.0).sqrt(), phi)?;
                 (wi, 0.5 / wi.z)
             }
+            Parameterization::InOut => {
+                let cos_theta = 1.0 - r;
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                let (s, c) = (wo.y.atan2(wo.x) + phi).sin_cos();
+                (Vec3::new(sin_theta * c, sin_theta * s, cos_theta), 1.0)
+            }
         };
         (wi.z > 0.0).then_some((wi, jacobian))
     }
@@ -111,6 +128,15 @@ impl Grid {
             Parameterization::Pdv => {
                 let (rho, phi, _) = pdv_from_w(wo, wi)?;
                 Some((rho * rho, phi, 0.5 / wi.z))
+            }
+            Parameterization::InOut => {
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                let phi = (wi.y.atan2(wi.x) - wo.y.atan2(wo.x)).rem_euclid(2.0 * PI);
+                // rem_euclid rounds up to 2 pi just below 0.
+                let phi = phi.min(2.0 * PI - f32::EPSILON * 8.0);
+                Some((1.0 - wi.z, phi, 1.0))
             }
         }
     }
@@ -211,7 +237,11 @@ mod tests {
             parameterization: Parameterization::HalfDiff,
         };
         let f = |_: Vec3, _: Vec3| Rgb::splat(std::f32::consts::FRAC_1_PI);
-        for parameterization in [Parameterization::HalfDiff, Parameterization::Pdv] {
+        for parameterization in [
+            Parameterization::HalfDiff,
+            Parameterization::Pdv,
+            Parameterization::InOut,
+        ] {
             let grid = Grid {
                 parameterization,
                 ..grid
@@ -253,9 +283,13 @@ mod tests {
     }
 
     #[test]
-    fn coordinates_invert_direction_in_both_parameterizations() {
+    fn coordinates_invert_direction_in_every_parameterization() {
         let mut rng = lumis_sampling::Pcg32::new(3, 11);
-        for parameterization in [Parameterization::HalfDiff, Parameterization::Pdv] {
+        for parameterization in [
+            Parameterization::HalfDiff,
+            Parameterization::Pdv,
+            Parameterization::InOut,
+        ] {
             let grid = Grid {
                 n_o: 8,
                 n_w: 64,

@@ -2,19 +2,24 @@
 //! lookup), the `measured` BSDF plugin and its importance sampling
 //! strategies (cosine, the factored representation of Lawrence,
 //! Rusinkiewicz and Ramamoorthi 2004, a tabulated 2D distribution per
-//! outgoing elevation), the cache of their precomputation, and the
-//! tabulation of any lumis BSDF as a MERL table.
+//! outgoing elevation), the cache of their precomputation, the tensor
+//! (CP) approximation of a table the plugin can render from instead, and
+//! the tabulation of any lumis BSDF as a MERL table.
 
 pub mod cache;
+pub mod compress;
+pub mod cp;
 pub mod factored;
 pub mod grid;
 mod measured;
 pub mod merl;
 pub mod precompute;
+pub mod reflectance;
 pub mod tabulate;
 pub mod tabulated;
+pub mod tensor;
 
-pub use measured::{Measured, MeasuredParams, MeasuredSampling, SPEC};
+pub use measured::{Measured, MeasuredParams, MeasuredRepresentation, MeasuredSampling, SPEC};
 pub use merl::MerlTable;
 
 use std::sync::Arc;

@@ -1,5 +1,6 @@
-//! `measured`: an isotropic BRDF tabulated in the MERL format, with a
-//! choice of importance sampling.
+//! `measured`: an isotropic BRDF tabulated in the MERL format, rendered
+//! from the table or from its tensor approximation, with a choice of
+//! importance sampling.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -10,14 +11,16 @@ use lumis_core::{
 };
 use lumis_sampling::warp;
 
+use crate::compress::prepare_tensor;
 use crate::grid::{Grid, Parameterization};
 use crate::merl::MerlTable;
 use crate::precompute::{prepare, Plan, PrecomputeReport, Prepared};
+use crate::reflectance::Reflectance;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
-    doc: "isotropic BRDF tabulated in the MERL format (trilinear f); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
+    doc: "isotropic BRDF tabulated in the MERL format (trilinear f, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
     params: MeasuredParams::SPECS,
 };
 
@@ -39,10 +42,19 @@ pub struct MeasuredParams {
     #[param(default = [32, 64, 64])]
     pub grid: Vec<i64>,
     /// the coordinates of wi about wo the precomputation tabulates
-    /// (factored, tabulated): half-diff (the half vector) or pdv (the
-    /// projected deviation vector, the tangent-plane part of wi + wo)
+    /// (factored, tabulated) and the tensor is fitted over: half-diff (the
+    /// half vector), pdv (the projected deviation vector, the tangent-plane
+    /// part of wi + wo) or in-out (wi itself)
     #[param(default = HalfDiff)]
     pub parameterization: Parameterization,
+    /// what f is rendered from: table (the MERL table, trilinear) or tensor
+    /// (rank terms of products of 1D factors per channel, fitted to ln(1 +
+    /// f); the sampling is built from it)
+    #[param(default = Table)]
+    pub representation: MeasuredRepresentation,
+    /// R, the rank-1 terms per colour channel of the tensor (tensor only)
+    #[param(default = 8, range = (1, 32))]
+    pub rank: i64,
     /// keep the precomputation next to the table
     /// (TABLE.STRATEGY-....lumis-cache), reused while the table is unchanged
     #[param(default = true)]
@@ -55,6 +67,13 @@ pub enum MeasuredSampling {
     Cosine,
     Factored,
     Tabulated,
+}
+
+/// The `representation` choice of `measured`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+pub enum MeasuredRepresentation {
+    Table,
+    Tensor,
 }
 
 /// Midpoints per cell and axis of the precomputation grid.
@@ -91,36 +110,43 @@ enum Strategy {
 
 #[derive(Debug, Clone)]
 pub struct Measured {
-    table: Arc<MerlTable>,
+    reflectance: Reflectance,
     strategy: Strategy,
 }
 
 impl Measured {
-    pub fn cosine(table: Arc<MerlTable>) -> Self {
+    pub fn cosine(reflectance: Reflectance) -> Self {
         Self {
-            table,
+            reflectance,
             strategy: Strategy::Cosine,
         }
     }
 
-    pub fn with_sampler(table: Arc<MerlTable>, prepared: Prepared) -> Self {
+    pub fn with_sampler(reflectance: Reflectance, prepared: Prepared) -> Self {
         Self {
-            table,
+            reflectance,
             strategy: Strategy::Prepared(prepared),
         }
     }
 
-    /// The BSDF and, for the precomputed strategies, how the precomputation
-    /// went (also printed to stderr by [`Self::from_params`]).
-    pub fn from_params_with_report(params: &Params) -> Result<(Self, Option<PrecomputeReport>)> {
+    /// The BSDF and how its precomputations went: the tensor fit and the
+    /// sampler's (also printed to stderr by [`Self::from_params`]).
+    pub fn from_params_with_report(params: &Params) -> Result<(Self, Vec<String>)> {
         // Settings first: a typo is reported before a 35 MB read.
         let p = MeasuredParams::read(params)?;
         let keys = MeasuredParams::KEYS;
         // A setting the strategy does not use is refused if given.
+        let tensor = p.representation == MeasuredRepresentation::Tensor;
+        if !tensor {
+            params.unread(keys.rank);
+        }
         let plan = match p.sampling {
             MeasuredSampling::Cosine => {
-                for unused in [keys.terms, keys.grid, keys.cache, keys.parameterization] {
-                    params.unread(unused);
+                params.unread(keys.terms);
+                params.unread(keys.grid);
+                if !tensor {
+                    params.unread(keys.cache);
+                    params.unread(keys.parameterization);
                 }
                 None
             }
@@ -140,18 +166,35 @@ impl Measured {
             )),
             None => None,
         };
-        let table = Arc::new(MerlTable::read(&p.file).map_err(|e| params.error(keys.file, e))?);
-        let Some((plan, grid, use_cache)) = setup else {
-            return Ok((Self::cosine(table), None));
+        let table = MerlTable::read(&p.file).map_err(|e| params.error(keys.file, e))?;
+        let mut messages = Vec::new();
+        let reflectance = if tensor {
+            let (tensor, report) = prepare_tensor(
+                &table,
+                &p.file,
+                p.parameterization,
+                p.rank as usize,
+                p.cache,
+            )?;
+            messages.push(report.message);
+            // The table is not needed any more: renders use the factors.
+            Reflectance::Tensor(Arc::new(tensor))
+        } else {
+            Reflectance::Table(Arc::new(table))
         };
-        let (prepared, report) = prepare(&table, &p.file, plan, grid, use_cache)?;
-        Ok((Self::with_sampler(table, prepared), Some(report)))
+        let Some((plan, grid, use_cache)) = setup else {
+            return Ok((Self::cosine(reflectance), messages));
+        };
+        let (prepared, report): (Prepared, PrecomputeReport) =
+            prepare(&reflectance, &p.file, plan, grid, use_cache)?;
+        messages.push(report.message);
+        Ok((Self::with_sampler(reflectance, prepared), messages))
     }
 
     pub fn from_params(params: &Params) -> Result<Self> {
-        let (bsdf, report) = Self::from_params_with_report(params)?;
-        if let Some(report) = report {
-            eprintln!("{}", report.message);
+        let (bsdf, messages) = Self::from_params_with_report(params)?;
+        for message in messages {
+            eprintln!("{message}");
         }
         Ok(bsdf)
     }
@@ -161,7 +204,7 @@ impl Measured {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::BLACK;
         }
-        self.table.eval(wi, wo)
+        self.reflectance.eval(wi, wo)
     }
 
     #[inline]

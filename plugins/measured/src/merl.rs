@@ -245,7 +245,7 @@ impl MerlTable {
 /// The two nodes around coordinate `x` on an axis of `n` nodes and the
 /// weight of the second; clamped at both ends (there is no node at `n`).
 #[inline]
-fn clamped_axis(x: f32, n: usize) -> (usize, usize, f32) {
+pub(crate) fn clamped_axis(x: f32, n: usize) -> (usize, usize, f32) {
     let x = x.clamp(0.0, (n - 1) as f32);
     let i0 = (x.floor() as usize).min(n - 1);
     let i1 = (i0 + 1).min(n - 1);

@@ -6,12 +6,12 @@ use std::path::Path;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use lumis_core::Result;
+use lumis_core::{Result, Rgb, Vec3};
 
 use crate::cache::{self, CacheKey, Miss};
 use crate::factored::{factorize, Factored, Factors, NMF_ITERATIONS, REFINE_ITERATIONS};
 use crate::grid::{normalize_rows, Grid};
-use crate::merl::MerlTable;
+use crate::reflectance::Reflectance;
 use crate::tabulated::Tabulated;
 
 /// What the strategy needs precomputed.
@@ -97,10 +97,14 @@ fn from_payload(plan: Plan, grid: Grid, data: &[f32]) -> Prepared {
     }
 }
 
-/// Computes the payload of `plan` for `table` (no cache).
-pub fn compute(table: &MerlTable, plan: Plan, grid: Grid, progress: &ProgressBar) -> Vec<f32> {
-    let f = |wo, wi| table.eval(wi, wo);
-    let mut rows = grid.rows_of(&f, progress);
+/// Computes the payload of `plan` for `f(wo, wi)` (no cache).
+pub fn compute(
+    f: &(dyn Fn(Vec3, Vec3) -> Rgb + Sync),
+    plan: Plan,
+    grid: Grid,
+    progress: &ProgressBar,
+) -> Vec<f32> {
+    let mut rows = grid.rows_of(f, progress);
     normalize_rows(&mut rows);
     match plan {
         Plan::Factored { terms } => {
@@ -112,16 +116,16 @@ pub fn compute(table: &MerlTable, plan: Plan, grid: Grid, progress: &ProgressBar
 }
 
 /// The sampler for `plan`, from the cache next to `table_path` if it holds
-/// this table's, else computed (and cached when `use_cache`).
+/// this source's, else computed (and cached when `use_cache`).
 pub fn prepare(
-    table: &MerlTable,
+    reflectance: &Reflectance,
     table_path: &Path,
     plan: Plan,
     grid: Grid,
     use_cache: bool,
 ) -> Result<(Prepared, PrecomputeReport)> {
     let key = CacheKey {
-        table_hash: table.hash(),
+        table_hash: reflectance.hash(),
         strategy: plan.name(),
         terms: plan.terms(),
         grid,
@@ -177,7 +181,7 @@ pub fn prepare(
         progress.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
-    let data = compute(table, plan, grid, &progress);
+    let data = compute(&|wo, wi| reflectance.eval(wi, wo), plan, grid, &progress);
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
     if use_cache {

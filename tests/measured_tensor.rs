@@ -1,0 +1,153 @@
+//! The tensor approximation of a measured BRDF (`representation =
+//! "tensor"`): its error against the table falls with the rank, its cache
+//! is reused, and the `measured` plugin rendering from it passes the check
+//! kit (chi-square of sample_f against pdf, pdf integral, consistency,
+//! albedo <= 1, reciprocity, finiteness) in the default case, and, ignored,
+//! over every table and parameterization at rank 8 and 16.
+
+use lumis_check::bsdf_suite::{
+    check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
+};
+use lumis_check::outcome::Outcome;
+use lumis_measured::compress::prepare_tensor;
+use lumis_measured::cp::AlsSettings;
+use lumis_measured::grid::Parameterization;
+use lumis_measured::merl::MerlTable;
+use lumis_measured::tensor::{compression_error, fit};
+use lumis_tests::tabulated;
+
+fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "lumis-measured-tensor-{tag}-{}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn the_error_falls_with_the_rank_on_a_tabulated_conductor() {
+    let dir = temp_dir("rank");
+    let file = tabulated(&dir, "gold", "conductor", &["roughness=0.2", "material=Au"]);
+    let table = MerlTable::read(&file).unwrap();
+    // Few sweeps: the test is about the ordering, not the last digit.
+    let settings = AlsSettings {
+        max_sweeps: 12,
+        ..AlsSettings::default()
+    };
+    let mut errors = Vec::new();
+    for rank in [1, 2, 4] {
+        let (tensor, fits) = fit(&table, Parameterization::HalfDiff, rank, settings, &|| {});
+        let residual: f64 = fits.iter().map(|f| f.residual).sum();
+        let error = compression_error(&table, &|wi, wo| tensor.eval(wi, wo));
+        errors.push((rank, residual, error));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    // What the fit minimises, the squared error of ln(1 + f) at the known
+    // nodes, and the PSNR of ln(1 + f) rendered through the interpolation:
+    // not the error of f itself, which the logarithm lets grow in the peak
+    // while it shrinks elsewhere (rank 2 can be worse than rank 1 there).
+    for pair in errors.windows(2) {
+        let ((r0, s0, e0), (r1, s1, e1)) = (pair[0], pair[1]);
+        assert!(
+            s1 < s0 && e1.log_psnr_db > e0.log_psnr_db,
+            "rank {r1} is no better than rank {r0}: {errors:?}"
+        );
+    }
+    // 4 terms of 360 numbers per channel hold this glossy table to a few
+    // percent (1000x smaller than the table).
+    let (_, _, last) = errors[2];
+    assert!(last.relative_rmse < 0.08, "{errors:?}");
+    assert!(last.nodes > 1_000_000, "{errors:?}");
+}
+
+#[test]
+fn the_tensor_representation_passes_the_check_kit_and_is_cached() {
+    let dir = temp_dir("check");
+    let file = tabulated(&dir, "gold", "conductor", &["roughness=0.2", "material=Au"]);
+    let table = MerlTable::read(&file).unwrap();
+    let (first, report) =
+        prepare_tensor(&table, &file, Parameterization::HalfDiff, 4, true).unwrap();
+    assert!(report.fits.is_some(), "{}", report.message);
+    let (second, report) =
+        prepare_tensor(&table, &file, Parameterization::HalfDiff, 4, true).unwrap();
+    assert!(
+        report.fits.is_none() && report.message.contains("loaded from"),
+        "{}",
+        report.message
+    );
+    assert_eq!(first.payload(), second.payload());
+    let toml = format!(
+        "file = \"{}\"\nrepresentation = \"tensor\"\nrank = 4\nsampling = \"factored\"\n",
+        file.display()
+    );
+    let variants = vec![variant("gold-0.2 tensor R=4", &toml).unwrap()];
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let results = check_bsdf_variants(
+        &registry,
+        "measured",
+        &variants,
+        &BsdfCheckConfig::default(),
+    )
+    .unwrap();
+    let report = format_results(&results);
+    println!("{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(results.iter().all(|r| r.passed()), "{report}");
+}
+
+/// The tables of the measured-results table (docs/src/studies/measured.md).
+const MATERIALS: [(&str, &str, &[&str]); 3] = [
+    (
+        "plastic-0.3",
+        "plastic",
+        &["roughness=0.3", "diffuse_reflectance=[0.6,0.3,0.1]"],
+    ),
+    (
+        "conductor-0.2",
+        "conductor",
+        &["roughness=0.2", "material=Au"],
+    ),
+    (
+        "conductor-0.05",
+        "conductor",
+        &["roughness=0.05", "material=Cu"],
+    ),
+];
+
+/// At rank 2 the approximation of the glossy tables creates energy (7 of
+/// the 72 cases had a directional albedo of 1.03 to 1.35, see
+/// docs/src/studies/measured.md): this sweep is over the ranks that hold
+/// `f` closely enough, the default 8 and 16.
+#[test]
+#[ignore = "every table and parameterization at rank 8 and 16: about 5 minutes on 2 cores"]
+fn the_tensor_representation_passes_the_check_kit_everywhere() {
+    let dir = temp_dir("sweep");
+    let mut variants: Vec<Variant> = Vec::new();
+    for (name, bsdf, set) in MATERIALS {
+        let file = tabulated(&dir, name, bsdf, set);
+        for parameterization in ["half-diff", "pdv", "in-out"] {
+            for rank in [8, 16] {
+                let toml = format!(
+                    "file = \"{}\"\nrepresentation = \"tensor\"\nrank = {rank}\nparameterization = \"{parameterization}\"\n",
+                    file.display()
+                );
+                variants.push(
+                    variant(format!("{name} {parameterization} tensor R={rank}"), &toml).unwrap(),
+                );
+            }
+        }
+    }
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let results = check_bsdf_variants(
+        &registry,
+        "measured",
+        &variants,
+        &BsdfCheckConfig::default(),
+    )
+    .unwrap();
+    let report = format_results(&results);
+    println!("{report}");
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(results.iter().all(|r| r.passed()), "{report}");
+}
