@@ -14,26 +14,7 @@ use lumis_check::bsdf_suite::{
     check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
 };
 use lumis_check::outcome::Outcome;
-use lumis_tests::tabulated;
-
-/// The three materials of the measured-results table.
-pub const MATERIALS: [(&str, &str, &[&str]); 3] = [
-    (
-        "plastic-0.3",
-        "plastic",
-        &["roughness=0.3", "diffuse_reflectance=[0.6,0.3,0.1]"],
-    ),
-    (
-        "conductor-0.2",
-        "conductor",
-        &["roughness=0.2", "material=Au"],
-    ),
-    (
-        "conductor-0.05",
-        "conductor",
-        &["roughness=0.05", "material=Cu"],
-    ),
-];
+use lumis_tests::{tabulated, MEASURED_MATERIALS as MATERIALS};
 
 #[test]
 fn every_strategy_passes_the_check_kit_down_to_grazing() {

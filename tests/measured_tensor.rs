@@ -14,7 +14,7 @@ use lumis_measured::cp::AlsSettings;
 use lumis_measured::grid::Parameterization;
 use lumis_measured::merl::MerlTable;
 use lumis_measured::tensor::{compression_error, fit};
-use lumis_tests::tabulated;
+use lumis_tests::{tabulated, MEASURED_MATERIALS as MATERIALS};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -95,25 +95,6 @@ fn the_tensor_representation_passes_the_check_kit_and_is_cached() {
     std::fs::remove_dir_all(&dir).unwrap();
     assert!(results.iter().all(|r| r.passed()), "{report}");
 }
-
-/// The tables of the measured-results table (docs/src/studies/measured.md).
-const MATERIALS: [(&str, &str, &[&str]); 3] = [
-    (
-        "plastic-0.3",
-        "plastic",
-        &["roughness=0.3", "diffuse_reflectance=[0.6,0.3,0.1]"],
-    ),
-    (
-        "conductor-0.2",
-        "conductor",
-        &["roughness=0.2", "material=Au"],
-    ),
-    (
-        "conductor-0.05",
-        "conductor",
-        &["roughness=0.05", "material=Cu"],
-    ),
-];
 
 /// At rank 2 the approximation of the glossy tables creates energy (7 of
 /// the 72 cases had a directional albedo of 1.03 to 1.35, see

@@ -205,6 +205,27 @@ fn two_sided_tail(z: f64) -> f64 {
         .exp()
 }
 
+/// The three tables of the measured-results table
+/// (docs/src/studies/measured.md): name, the BSDF `lumis brdf tabulate`
+/// writes, its parameters.
+pub const MEASURED_MATERIALS: [(&str, &str, &[&str]); 3] = [
+    (
+        "plastic-0.3",
+        "plastic",
+        &["roughness=0.3", "diffuse_reflectance=[0.6,0.3,0.1]"],
+    ),
+    (
+        "conductor-0.2",
+        "conductor",
+        &["roughness=0.2", "material=Au"],
+    ),
+    (
+        "conductor-0.05",
+        "conductor",
+        &["roughness=0.05", "material=Cu"],
+    ),
+];
+
 /// Writes the BSDF plugin `bsdf` with the `set` overrides as the MERL
 /// table `dir/name.binary`, as `lumis brdf tabulate` does.
 pub fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> std::path::PathBuf {

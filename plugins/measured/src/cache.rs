@@ -94,6 +94,20 @@ pub enum Miss {
     Damaged(String),
 }
 
+impl Miss {
+    /// What a report says of the cache at `path` it recomputed.
+    pub fn note(&self, path: &Path) -> String {
+        match self {
+            Miss::Absent => String::new(),
+            Miss::Stale => " (the cache was for another version of the table; replaced)".into(),
+            Miss::Damaged(why) => format!(
+                " (the cache {} was damaged: {why}; replaced)",
+                path.display()
+            ),
+        }
+    }
+}
+
 /// The `count` numbers cached at `path` for `key`.
 pub fn load(path: &Path, key: &CacheKey, count: usize) -> std::result::Result<Vec<f32>, Miss> {
     let bytes = match std::fs::read(path) {

@@ -8,7 +8,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use lumis_core::{Error, ParamChoice, Result};
 
-use crate::cache::{self, CacheKey, Miss};
+use crate::cache::{self, CacheKey};
 use crate::cp::{AlsReport, AlsSettings};
 use crate::grid::{Grid, Parameterization};
 use crate::merl::MerlTable;
@@ -105,16 +105,7 @@ pub fn prepare_tensor(
                     },
                 ));
             }
-            Err(Miss::Absent) => {}
-            Err(Miss::Stale) => {
-                note = " (the cache was for another version of the table; replaced)".into()
-            }
-            Err(Miss::Damaged(why)) => {
-                note = format!(
-                    " (the cache {} was damaged: {why}; replaced)",
-                    path.display()
-                )
-            }
+            Err(miss) => note = miss.note(&path),
         }
     }
     let (tensor, fits, seconds) = fit_with_progress(table, table_path, parameterization, rank);

@@ -8,7 +8,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use lumis_core::{Result, Rgb, Vec3};
 
-use crate::cache::{self, CacheKey, Miss};
+use crate::cache::{self, CacheKey};
 use crate::factored::{factorize, Factored, Factors, NMF_ITERATIONS, REFINE_ITERATIONS};
 use crate::grid::{normalize_rows, Grid};
 use crate::reflectance::Reflectance;
@@ -158,16 +158,7 @@ pub fn prepare(
                     },
                 ));
             }
-            Err(Miss::Absent) => {}
-            Err(Miss::Stale) => {
-                note = " (the cache was for another version of the table; replaced)".into()
-            }
-            Err(Miss::Damaged(why)) => {
-                note = format!(
-                    " (the cache {} was damaged: {why}; replaced)",
-                    path.display()
-                )
-            }
+            Err(miss) => note = miss.note(&path),
         }
     }
     let total = grid.n_o as u64
