@@ -30,9 +30,9 @@ trap stop EXIT
 now() { date +%s.%N; }
 since() { echo "$(now) - $1" | bc; }
 
-# One process, passes ending where the parts do.
+# One process with the parts' slice boundaries: the merge's image bit for bit.
 t=$(now)
-"$lumis" render "$scene" --spp "$spp" --pass-spp $((spp / tasks)) -q -o "$out/single.exr" >/dev/null
+"$lumis" render "$scene" --spp "$spp" --parts "$tasks" -q -o "$out/single.exr" >/dev/null
 single=$(since "$t")
 
 t=$(now)

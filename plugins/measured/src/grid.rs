@@ -165,7 +165,12 @@ impl Grid {
     /// Row `k`: the mass of `f cos theta_i` (luminance) in every cell,
     /// `a * n_phi + b` for `w` bin `a` and `phi` bin `b`.
     pub fn row(&self, k: usize, f: &(dyn Fn(Vec3, Vec3) -> Rgb + Sync)) -> Vec<f32> {
-        let wo = spherical_direction(self.theta_o(k), 0.0);
+        self.row_at(self.theta_o(k), f)
+    }
+
+    /// [`Self::row`] for the outgoing elevation `theta_o`.
+    pub fn row_at(&self, theta_o: f32, f: &(dyn Fn(Vec3, Vec3) -> Rgb + Sync)) -> Vec<f32> {
+        let wo = spherical_direction(theta_o, 0.0);
         let (w_edges, phi_edges) = (self.w_edges(), self.phi_edges());
         let s = self.supersamples;
         let mut out = vec![0.0f32; self.columns()];
