@@ -10,11 +10,8 @@
 //! conductor-0.2 table in the default tier, every table and term count in
 //! an ignored sweep.
 
-use lumis_check::bsdf_suite::{
-    check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
-};
-use lumis_check::outcome::Outcome;
-use lumis_tests::{tabulated, MEASURED_MATERIALS as MATERIALS};
+use lumis_check::bsdf_suite::{variant, Variant};
+use lumis_tests::{assert_measured_variants_pass, tabulated, MEASURED_MATERIALS as MATERIALS};
 
 #[test]
 fn every_strategy_passes_the_check_kit_down_to_grazing() {
@@ -36,18 +33,7 @@ fn every_strategy_passes_the_check_kit_down_to_grazing() {
         }
         add(format!("{name} tabulated"), "sampling = \"tabulated\"\n");
     }
-    let registry = lumis_cli::builtin_registry().unwrap();
-    let results = check_bsdf_variants(
-        &registry,
-        "measured",
-        &variants,
-        &BsdfCheckConfig::default(),
-    )
-    .unwrap();
-    let report = format_results(&results);
-    println!("{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert!(results.iter().all(|r| r.passed()), "{report}");
+    assert_measured_variants_pass(&variants, &dir);
 }
 
 /// The check kit on the `pdv` parameterization of `materials`, for the
@@ -74,18 +60,7 @@ fn check_pdv(tag: &str, materials: &[(&str, &str, &[&str])], terms: &[i64]) {
             "sampling = \"tabulated\"\n",
         );
     }
-    let registry = lumis_cli::builtin_registry().unwrap();
-    let results = check_bsdf_variants(
-        &registry,
-        "measured",
-        &variants,
-        &BsdfCheckConfig::default(),
-    )
-    .unwrap();
-    let report = format_results(&results);
-    println!("{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert!(results.iter().all(|r| r.passed()), "{report}");
+    assert_measured_variants_pass(&variants, &dir);
 }
 
 #[test]

@@ -5,16 +5,13 @@
 //! albedo <= 1, reciprocity, finiteness) in the default case, and, ignored,
 //! over every table and parameterization at rank 8 and 16.
 
-use lumis_check::bsdf_suite::{
-    check_bsdf_variants, format_results, variant, BsdfCheckConfig, Variant,
-};
-use lumis_check::outcome::Outcome;
+use lumis_check::bsdf_suite::{variant, Variant};
 use lumis_measured::compress::prepare_tensor;
 use lumis_measured::cp::AlsSettings;
 use lumis_measured::grid::Parameterization;
 use lumis_measured::merl::MerlTable;
 use lumis_measured::tensor::{compression_error, fit};
-use lumis_tests::{tabulated, MEASURED_MATERIALS as MATERIALS};
+use lumis_tests::{assert_measured_variants_pass, tabulated, MEASURED_MATERIALS as MATERIALS};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!(
@@ -82,18 +79,7 @@ fn the_tensor_representation_passes_the_check_kit_and_is_cached() {
         file.display()
     );
     let variants = vec![variant("gold-0.2 tensor R=4", &toml).unwrap()];
-    let registry = lumis_cli::builtin_registry().unwrap();
-    let results = check_bsdf_variants(
-        &registry,
-        "measured",
-        &variants,
-        &BsdfCheckConfig::default(),
-    )
-    .unwrap();
-    let report = format_results(&results);
-    println!("{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert!(results.iter().all(|r| r.passed()), "{report}");
+    assert_measured_variants_pass(&variants, &dir);
 }
 
 /// Rank 2, where the fit alone overshoots the glossy tables' albedo (up
@@ -117,16 +103,5 @@ fn the_tensor_representation_passes_the_check_kit_everywhere() {
             }
         }
     }
-    let registry = lumis_cli::builtin_registry().unwrap();
-    let results = check_bsdf_variants(
-        &registry,
-        "measured",
-        &variants,
-        &BsdfCheckConfig::default(),
-    )
-    .unwrap();
-    let report = format_results(&results);
-    println!("{report}");
-    std::fs::remove_dir_all(&dir).unwrap();
-    assert!(results.iter().all(|r| r.passed()), "{report}");
+    assert_measured_variants_pass(&variants, &dir);
 }

@@ -226,6 +226,21 @@ pub const MEASURED_MATERIALS: [(&str, &str, &[&str]); 3] = [
     ),
 ];
 
+/// The check kit on `variants` of the built-in `measured` BSDF: prints
+/// the table, removes `dir` (where the tables they name were written) and
+/// fails unless every case passed.
+pub fn assert_measured_variants_pass(variants: &[lumis_check::bsdf_suite::Variant], dir: &Path) {
+    use lumis_check::bsdf_suite::{check_bsdf_variants, format_results, BsdfCheckConfig};
+    use lumis_check::outcome::Outcome;
+    let registry = lumis_cli::builtin_registry().unwrap();
+    let results =
+        check_bsdf_variants(&registry, "measured", variants, &BsdfCheckConfig::default()).unwrap();
+    let report = format_results(&results);
+    println!("{report}");
+    std::fs::remove_dir_all(dir).unwrap();
+    assert!(results.iter().all(|r| r.passed()), "{report}");
+}
+
 /// Writes the BSDF plugin `bsdf` with the `set` overrides as the MERL
 /// table `dir/name.binary`, as `lumis brdf tabulate` does.
 pub fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> std::path::PathBuf {

@@ -135,15 +135,6 @@ pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
             part.display()
         )));
     }
-    if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(Error::msg(format!(
-                "output directory '{}' does not exist (for {})",
-                dir.display(),
-                exr.display()
-            )));
-        }
-    }
     let outputs = Outputs::claim(&exr, Some(&png))?;
     let film = append_all(&parts)?;
     let base = &parts[0].1.metadata;

@@ -23,9 +23,21 @@ fn image_error(e: lumis_image::ImageError) -> Error {
 }
 
 impl Outputs {
-    /// Locks the outputs (the lock is on the EXR: `PATH.exr.lock`) and
-    /// removes the temporary files that killed runs left beside them.
+    /// Checks the outputs' directory exists, locks the outputs (the lock is
+    /// on the EXR: `PATH.exr.lock`) and removes the temporary files that
+    /// killed runs left beside them.
     pub fn claim(exr: &Path, png: Option<&Path>) -> Result<Self> {
+        // Callers claim before they render: a missing directory is said
+        // now, not after the work.
+        if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if !dir.is_dir() {
+                return Err(Error::msg(format!(
+                    "output directory '{}' does not exist (for {})",
+                    dir.display(),
+                    exr.display()
+                )));
+            }
+        }
         let lock = OutputLock::acquire(exr).map_err(image_error)?;
         let checkpoint = checkpoint_path(exr);
         for path in [Some(exr), png, Some(checkpoint.as_path())]

@@ -425,16 +425,6 @@ pub fn render_scene_file(
         (None, None, None) => PathBuf::from(format!("{}.exr", loaded.name)),
     };
     let (exr, png) = output_paths(&output, &loaded.name);
-    // Fail before rendering, not after, when the output cannot be written.
-    if let Some(dir) = exr.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(Error::msg(format!(
-                "output directory '{}' does not exist (for {})",
-                dir.display(),
-                exr.display()
-            )));
-        }
-    }
     // A part writes its partial EXR only, and is not denoised (the merged
     // image is the render).
     let outputs = Outputs::claim(&exr, slice.is_none().then_some(png.as_path()))?;

@@ -264,6 +264,9 @@ fn merge_refuses_what_is_not_one_render_by_name() {
         err.contains("damaged.exr") && err.contains("checksum"),
         "{err}"
     );
+    let nowhere = path_in(tmp.path(), "missing/merged.exr");
+    let err = merge_error(&[&a, &b, &c], &nowhere);
+    assert!(err.contains("does not exist"), "{err}");
     assert!(
         !Path::new(&out).exists(),
         "a refused merge wrote its output"
