@@ -11,7 +11,7 @@
 //! cargo test -p lumis-tests --test measured_render measured_results_table -- --nocapture
 //! ```
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -21,7 +21,7 @@ use lumis_cli::{tabulate_bsdf, TabulateArgs};
 use lumis_core::{Bsdf, BsdfContext, Vec2, Vec3};
 use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::MerlTable;
-use lumis_measured::precompute::{prepare, Plan};
+use lumis_measured::precompute::{prepare, Plan, PrecomputeReport, Prepared};
 use lumis_measured::reflectance::Reflectance;
 use lumis_sampling::Pcg32;
 use lumis_tests::{read_scene, render_toml_with, scenes_dir, tabulated};
@@ -211,54 +211,33 @@ fn tabulate_refuses_what_the_format_cannot_hold() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The precomputation of `plan` for `table` (written at `file`), through
+/// its cache.
+fn prepare_cached(table: &MerlTable, file: &Path, plan: Plan) -> (Prepared, PrecomputeReport) {
+    let reflectance = Reflectance::Table(Arc::new(table.clone()));
+    prepare(&reflectance, file, plan, GRID, true).unwrap()
+}
+
 #[test]
 fn the_cache_is_reused_and_invalidated_when_the_table_changes() {
     let dir = temp_dir("cache");
     let file = tabulated(&dir, "c", "conductor", &["roughness=0.2"]);
     let table = MerlTable::read(&file).unwrap();
     let plan = Plan::Factored { terms: 2 };
-    let (_, first) = prepare(
-        &Reflectance::Table(Arc::new(table.clone())),
-        &file,
-        plan,
-        GRID,
-        true,
-    )
-    .unwrap();
+    let (_, first) = prepare_cached(&table, &file, plan);
     assert!(!first.from_cache, "{}", first.message);
-    let (_, second) = prepare(
-        &Reflectance::Table(Arc::new(table.clone())),
-        &file,
-        plan,
-        GRID,
-        true,
-    )
-    .unwrap();
+    let (_, second) = prepare_cached(&table, &file, plan);
     assert!(second.from_cache, "{}", second.message);
     // Another table at the same path: the old cache is stale.
     let file = tabulated(&dir, "c", "conductor", &["roughness=0.3"]);
     let table = MerlTable::read(&file).unwrap();
-    let (_, third) = prepare(
-        &Reflectance::Table(Arc::new(table.clone())),
-        &file,
-        plan,
-        GRID,
-        true,
-    )
-    .unwrap();
+    let (_, third) = prepare_cached(&table, &file, plan);
     assert!(
         !third.from_cache && third.message.contains("another version"),
         "{}",
         third.message
     );
-    let (_, tab) = prepare(
-        &Reflectance::Table(Arc::new(table.clone())),
-        &file,
-        Plan::Tabulated,
-        GRID,
-        true,
-    )
-    .unwrap();
+    let (_, tab) = prepare_cached(&table, &file, Plan::Tabulated);
     assert!(
         !tab.from_cache,
         "a different strategy has its own cache: {}",
@@ -405,14 +384,7 @@ fn measured_results_table() {
                     );
                     let seconds = start.elapsed().as_secs_f64();
                     drop(payload);
-                    let (prepared, _) = prepare(
-                        &Reflectance::Table(Arc::new(table.clone())),
-                        &file,
-                        plan,
-                        GRID,
-                        true,
-                    )
-                    .unwrap();
+                    let (prepared, _) = prepare_cached(&table, &file, plan);
                     (seconds, prepared.memory_bytes())
                 }
                 None => (0.0, 0),

@@ -21,12 +21,7 @@ fn fast() -> SamplerCheckConfig {
 #[test]
 fn every_builtin_sampler_passes_the_check_suite() {
     let registry = lumis_cli::builtin_registry().unwrap();
-    let names: Vec<&str> = registry
-        .plugins()
-        .into_iter()
-        .filter(|p| p.spec.kind == PluginKind::Sampler)
-        .map(|p| p.spec.name)
-        .collect();
+    let names = registry.names(PluginKind::Sampler);
     assert!(names.len() >= 7, "{names:?}");
     let mut failures = Vec::new();
     for name in names {

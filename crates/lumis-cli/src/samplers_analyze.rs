@@ -82,10 +82,9 @@ pub(crate) fn make_sampler(
 
 fn sampler_names(registry: &Registry, requested: &str) -> Result<Vec<String>> {
     let mut all: Vec<String> = registry
-        .plugins()
+        .names(PluginKind::Sampler)
         .into_iter()
-        .filter(|p| p.spec.kind == PluginKind::Sampler)
-        .map(|p| p.spec.name.to_string())
+        .map(str::to_string)
         .collect();
     all.sort();
     if requested == "all" {

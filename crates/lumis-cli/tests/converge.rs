@@ -18,6 +18,32 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml")
 }
 
+/// Renders `scene` with `set` at `spp` from seed 1000 (apart from the
+/// variants' seeds) to `out`, the reference the variants are measured
+/// against.
+fn reference_render(
+    registry: &lumis_core::Registry,
+    scene: &Path,
+    set: &str,
+    spp: u32,
+    out: &Path,
+) {
+    render_scene_file(
+        &RenderArgs {
+            scene: scene.to_path_buf(),
+            spp: Some(spp),
+            seed: Some(1000),
+            output: Some(out.to_path_buf()),
+            set: vec![set.into()],
+            quiet: true,
+            ..Default::default()
+        },
+        registry,
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+}
+
 const TINY: &str = "film.resolution=[16, 16]";
 
 /// relMSE of independent sampling falls as 1/spp: the fitted log-log slope
@@ -29,20 +55,7 @@ fn two_variants_produce_every_output_and_the_independent_slope_is_minus_one() {
     let dir = tmp.path();
     let registry = builtin_registry().unwrap();
     let reference = dir.join("reference.exr");
-    render_scene_file(
-        &RenderArgs {
-            scene: scene(),
-            spp: Some(8192),
-            seed: Some(1000),
-            output: Some(reference.clone()),
-            set: vec![TINY.into()],
-            quiet: true,
-            ..Default::default()
-        },
-        &registry,
-        &std::sync::atomic::AtomicBool::new(false),
-    )
-    .unwrap();
+    reference_render(&registry, &scene(), TINY, 8192, &reference);
     let variants = dir.join("variants.toml");
     std::fs::write(
         &variants,
@@ -99,20 +112,7 @@ fn a_denoised_variant_is_measured_and_the_error_is_split() {
     let dir = tmp.path();
     let registry = builtin_registry().unwrap();
     let reference = dir.join("reference.exr");
-    render_scene_file(
-        &RenderArgs {
-            scene: scene(),
-            spp: Some(256),
-            seed: Some(1000),
-            output: Some(reference.clone()),
-            set: vec![TINY.into()],
-            quiet: true,
-            ..Default::default()
-        },
-        &registry,
-        &AtomicBool::new(false),
-    )
-    .unwrap();
+    reference_render(&registry, &scene(), TINY, 256, &reference);
     let variants = dir.join("variants.toml");
     std::fs::write(
         &variants,
@@ -308,20 +308,7 @@ fn the_bias_study_variants_run_on_their_scenes() {
     for name in ["cornell-box", "glossy-beckmann", "textured-gltf"] {
         let scene = root.join(format!("scenes/bench/{name}.toml"));
         let reference = dir.join(format!("{name}-reference.exr"));
-        render_scene_file(
-            &RenderArgs {
-                scene: scene.clone(),
-                spp: Some(64),
-                seed: Some(1000),
-                output: Some(reference.clone()),
-                set: vec![small.into()],
-                quiet: true,
-                ..Default::default()
-            },
-            &registry,
-            &AtomicBool::new(false),
-        )
-        .unwrap();
+        reference_render(&registry, &scene, small, 64, &reference);
         let args = ConvergeArgs {
             scene,
             reference,

@@ -64,12 +64,7 @@ fn merge_error(parts: &[&str], out: &str) -> String {
 /// The names of the built-in samplers.
 fn builtin_samplers() -> Vec<&'static str> {
     let registry = lumis_cli::builtin_registry().unwrap();
-    let names: Vec<&'static str> = registry
-        .plugins()
-        .into_iter()
-        .filter(|p| p.spec.kind == PluginKind::Sampler)
-        .map(|p| p.spec.name)
-        .collect();
+    let names = registry.names(PluginKind::Sampler);
     assert!(names.len() >= 7, "{names:?}");
     names
 }

@@ -276,6 +276,15 @@ impl Registry {
         all
     }
 
+    /// The names of the plugins of `kind`, sorted.
+    pub fn names(&self, kind: PluginKind) -> Vec<&'static str> {
+        self.plugins()
+            .into_iter()
+            .filter(|p| p.spec.kind == kind)
+            .map(|p| p.spec.name)
+            .collect()
+    }
+
     /// Creates the plugin `entity` describes: looks it up by kind and
     /// `type`, checks its table against the plugin's declaration, calls the
     /// factory with `input` and rejects keys the plugin did not read. The

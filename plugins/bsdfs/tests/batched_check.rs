@@ -24,12 +24,7 @@ fn every_bsdf_passes_the_value_and_batch_checks() {
         },
         ..Default::default()
     };
-    let names: Vec<&str> = registry
-        .plugins()
-        .into_iter()
-        .filter(|p| p.spec.kind == PluginKind::Bsdf)
-        .map(|p| p.spec.name)
-        .collect();
+    let names = registry.names(PluginKind::Bsdf);
     assert!(names.contains(&"conductor") && names.contains(&"diffuse"));
     let mut failures = Vec::new();
     for name in names {
