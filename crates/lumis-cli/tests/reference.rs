@@ -171,7 +171,7 @@ fn a_reference_killed_at_random_moments_resumes_bit_for_bit() {
             "reference",
             &plates,
             "--set",
-            "film.resolution=[16, 16]",
+            "film.resolution=[48, 48]",
             "--threads",
             "2",
             "--spp",
@@ -194,17 +194,9 @@ fn a_reference_killed_at_random_moments_resumes_bit_for_bit() {
 
     let out = path_in(tmp.path(), "ref.exr");
     let exr = tmp.path().join("ref.exr");
-    let mut killed = 0;
-    for ms in kill_moments(3, duration_ms.max(1)) {
-        let args = args(&out);
-        let mut child = spawn(&args.iter().map(String::as_str).collect::<Vec<_>>());
-        std::thread::sleep(std::time::Duration::from_millis(ms));
-        if child.try_wait().unwrap().is_none() {
-            signal(child.id(), "KILL");
-            killed += 1;
-        }
-        child.wait().unwrap();
-    }
+    let argv = args(&out);
+    let argv: Vec<&str> = argv.iter().map(String::as_str).collect();
+    let killed = kill_after_progress(&argv, &exr, 3, duration_ms);
     assert!(killed > 0, "every run finished before its kill");
     let last = run(&out);
     assert!(last.status.success(), "{}", stderr_of(&last));

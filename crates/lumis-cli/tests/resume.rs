@@ -3,8 +3,6 @@
 
 mod common;
 
-use std::time::Duration;
-
 use common::*;
 
 const SPP: &str = "96";
@@ -59,20 +57,7 @@ fn killed_and_resumed_equals_uninterrupted(name: &str, kills: usize, sets: &[&st
         std::fs::remove_file(tmp.path().join(name)).unwrap();
     }
     let checkpoint = tmp.path().join("plates.checkpoint");
-    let mut killed_mid_render = 0;
-    for ms in kill_moments(kills, duration_ms.max(1)) {
-        let mut child = spawn(&args);
-        // After its first checkpoint (or the one it resumed from): then at
-        // a random moment.
-        wait_for(&mut child, &checkpoint);
-        std::thread::sleep(Duration::from_millis(ms / 2));
-        // It may have finished already: then there is nothing to kill.
-        if child.try_wait().unwrap().is_none() {
-            signal(child.id(), "KILL");
-            killed_mid_render += 1;
-        }
-        child.wait().unwrap();
-    }
+    let killed_mid_render = kill_after_progress(&args, &checkpoint, kills, duration_ms / 2);
     assert!(killed_mid_render > 0, "every run finished before its kill");
     let resumes = checkpoint.exists();
     let result = lumis(&args);

@@ -62,8 +62,31 @@ pub fn wait_for(child: &mut Child, path: &Path) {
                 path.display()
             );
         }
-        std::thread::sleep(std::time::Duration::from_millis(5));
+        std::thread::sleep(std::time::Duration::from_millis(1));
     }
+}
+
+/// Runs `args` once per moment of [`kill_moments`]`(count, max_ms)` and
+/// SIGKILLs each run once `progress` exists (its first checkpoint, or the
+/// one it resumes from) plus that moment; the first moment is zero, so at
+/// least one kill lands mid-render however fast the machine is. Returns
+/// how many runs were still going when their kill came.
+pub fn kill_after_progress(args: &[&str], progress: &Path, count: usize, max_ms: u64) -> usize {
+    let mut moments = kill_moments(count, max_ms.max(1));
+    moments[0] = 0;
+    let mut killed = 0;
+    for ms in moments {
+        let mut child = spawn(args);
+        wait_for(&mut child, progress);
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        // It may have finished already: then there is nothing to kill.
+        if child.try_wait().unwrap().is_none() {
+            signal(child.id(), "KILL");
+            killed += 1;
+        }
+        child.wait().unwrap();
+    }
+    killed
 }
 
 /// The value of `lumis.KEY` in the header of the EXR at `path`.
