@@ -3,7 +3,7 @@
 //! before it; its mistakes are located errors.
 
 use lumis_core::{Ray, Scene, Vec3};
-use lumis_tests::{f_at_hit, render_toml, scenes_dir};
+use lumis_tests::{f_at_hit, load_error, render_toml, scenes_dir};
 
 /// A diffuse quad seen from behind (its front faces away from the camera)
 /// under a light behind the camera, with `bsdfs` declared.
@@ -66,14 +66,6 @@ fn twosided_shows_the_back_of_a_one_sided_bsdf() {
     assert_eq!(both.image.pixels, flagged.image.pixels);
 }
 
-fn load_error(toml: &str) -> String {
-    let registry = lumis_cli::builtin_registry().unwrap();
-    match lumis_scene::load_str(toml, "bad.toml", "bad", &scenes_dir(), &[], &registry) {
-        Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
-        Err(e) => e.to_string(),
-    }
-}
-
 #[test]
 fn twosided_mistakes_are_located_errors() {
     let later =
@@ -115,7 +107,7 @@ fn normalmap_leans_toward_u_and_the_images_up_in_a_scene_file() {
     ] {
         let toml = normal_mapped(normals);
         let scene =
-            lumis_scene::load_str(&toml, "n.toml", "n", &scenes_dir(), &[], &registry).unwrap();
+            lumis_scene::load_str(&toml, &scenes_dir().join("n.toml"), &[], &registry).unwrap();
         let hit = scene
             .scene
             .intersect(&Ray::new(Vec3::new(0.2, 0.3, 1.0), Vec3::NEG_Z))

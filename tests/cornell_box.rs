@@ -110,9 +110,7 @@ fn concrete_and_dyn_scene_loops_agree() {
         overrides.extend(integrator.iter().map(|s| s.to_string()));
         let loaded = lumis_scene::load_str(
             scene,
-            "test.toml",
-            "test",
-            &scenes_dir(),
+            &scenes_dir().join("test.toml"),
             &overrides,
             &registry,
         )
@@ -162,9 +160,7 @@ fn stored_flat_frames_match_frames_computed_at_the_hit() {
     let load = |overrides: &[String]| {
         lumis_scene::load_str(
             &scene,
-            "test.toml",
-            "test",
-            &scenes_dir(),
+            &scenes_dir().join("test.toml"),
             overrides,
             &registry,
         )

@@ -40,7 +40,7 @@ fn test_dir(name: &str) -> tempfile::TempDir {
 
 fn try_load(dir: &Path, toml: &str) -> Result<LoadedScene, String> {
     let registry = lumis_cli::builtin_registry().unwrap();
-    lumis_scene::load_str(toml, "test.toml", "test", dir, &[], &registry).map_err(|e| e.to_string())
+    lumis_scene::load_str(toml, &dir.join("test.toml"), &[], &registry).map_err(|e| e.to_string())
 }
 
 fn load(dir: &Path, toml: &str) -> LoadedScene {

@@ -262,7 +262,7 @@ fn scene_errors_name_the_file() {
     let registry = lumis_cli::builtin_registry().unwrap();
     let text = read_scene("measured-sphere.toml");
     let load = |overrides: &[String]| {
-        lumis_scene::load_str(&text, "s.toml", "s", &scenes_dir(), overrides, &registry)
+        lumis_scene::load_str(&text, &scenes_dir().join("s.toml"), overrides, &registry)
             .err()
             .expect("scene must not load")
             .to_string()

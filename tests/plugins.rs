@@ -78,9 +78,7 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     // Without the plugin, the type is unknown.
     let err = lumis_scene::load_str(
         &scene("", 1),
-        "plugin.toml",
-        "plugin",
-        &scenes_dir(),
+        &scenes_dir().join("plugin.toml"),
         &[],
         &builtin,
     )
@@ -112,9 +110,7 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     // Loading it on top of the linked copy clashes, naming both sources.
     let err = lumis_scene::load_str(
         &scene(&plugins, 1),
-        "plugin.toml",
-        "plugin",
-        &scenes_dir(),
+        &scenes_dir().join("plugin.toml"),
         &[],
         &linked,
     )

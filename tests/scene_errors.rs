@@ -1,14 +1,6 @@
 //! Bad scenes get clear errors that name the file, line and key.
 
-use lumis_tests::scenes_dir;
-
-fn load(toml: &str) -> String {
-    let registry = lumis_cli::builtin_registry().unwrap();
-    match lumis_scene::load_str(toml, "bad.toml", "bad", &scenes_dir(), &[], &registry) {
-        Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
-        Err(e) => e.to_string(),
-    }
-}
+use lumis_tests::{load_error, scenes_dir};
 
 const BASE: &str = r#"[film]
 resolution = [8, 8]
@@ -47,7 +39,7 @@ fn base_scene_loads() {
     let toml = with(
         "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"white\"\n",
     );
-    lumis_scene::load_str(&toml, "ok.toml", "ok", &scenes_dir(), &[], &registry).unwrap();
+    lumis_scene::load_str(&toml, &scenes_dir().join("ok.toml"), &[], &registry).unwrap();
 }
 
 #[test]
@@ -62,13 +54,13 @@ fn missing_scene_file() {
 
 #[test]
 fn bad_toml() {
-    let err = load("[film]\nresolution = [8, 8\n");
+    let err = load_error("[film]\nresolution = [8, 8\n");
     assert_contains(&err, &["bad.toml:", "invalid TOML"]);
 }
 
 #[test]
 fn unknown_plugin_type_lists_the_available_ones() {
-    let err = load(&BASE.replace("type = \"diffuse\"", "type = \"difuse\""));
+    let err = load_error(&BASE.replace("type = \"diffuse\"", "type = \"difuse\""));
     assert_contains(
         &err,
         &[
@@ -81,7 +73,7 @@ fn unknown_plugin_type_lists_the_available_ones() {
 
 #[test]
 fn unknown_key_names_the_plugin_and_the_accepted_keys() {
-    let err = load(&BASE.replace("reflectance = 0.5", "reflectence = 0.5"));
+    let err = load_error(&BASE.replace("reflectance = 0.5", "reflectence = 0.5"));
     assert_contains(
         &err,
         &[
@@ -91,13 +83,13 @@ fn unknown_key_names_the_plugin_and_the_accepted_keys() {
             "reflectance, two_sided, sampling",
         ],
     );
-    let err = load(&with("[integrator2]\n"));
+    let err = load_error(&with("[integrator2]\n"));
     assert_contains(&err, &["unknown top-level key 'integrator2'"]);
 }
 
 #[test]
 fn wrong_type() {
-    let err = load(&BASE.replace("spp = 1", "spp = \"many\""));
+    let err = load_error(&BASE.replace("spp = 1", "spp = \"many\""));
     assert_contains(
         &err,
         &[
@@ -106,7 +98,7 @@ fn wrong_type() {
             "expected an integer, found a string",
         ],
     );
-    let err = load(&BASE.replace("resolution = [8, 8]", "resolution = 8"));
+    let err = load_error(&BASE.replace("resolution = [8, 8]", "resolution = 8"));
     assert_contains(
         &err,
         &["bad.toml:2:14", "'resolution'", "expected an array of 2"],
@@ -115,25 +107,25 @@ fn wrong_type() {
 
 #[test]
 fn out_of_range_values() {
-    let err = load(&with(
+    let err = load_error(&with(
         "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = -1.0\nbsdf = \"white\"\n",
     ));
     assert_contains(&err, &["bad.toml:20:10", "'radius'", "positive"]);
-    let err = load(&BASE.replace("fov = 40.0", "fov = 180.0"));
+    let err = load_error(&BASE.replace("fov = 40.0", "fov = 180.0"));
     assert_contains(&err, &["bad.toml:7:7", "'fov'", "(0, 180)"]);
-    let err = load(&BASE.replace("fov = 40.0", "fov = -3"));
+    let err = load_error(&BASE.replace("fov = 40.0", "fov = -3"));
     assert_contains(&err, &["'fov'", "(0, 180)"]);
-    let err = load(&BASE.replace("reflectance = 0.5", "reflectance = 1.5"));
+    let err = load_error(&BASE.replace("reflectance = 0.5", "reflectance = 1.5"));
     assert_contains(&err, &["bad.toml:16:15", "[0, 1]"]);
 }
 
 #[test]
 fn non_finite_numbers() {
-    let err = load(&BASE.replace("reflectance = 0.5", "reflectance = nan"));
+    let err = load_error(&BASE.replace("reflectance = 0.5", "reflectance = nan"));
     assert_contains(&err, &["bad.toml:16:15", "'reflectance'", "finite"]);
-    let err = load(&BASE.replace("fov = 40.0", "fov = inf"));
+    let err = load_error(&BASE.replace("fov = 40.0", "fov = inf"));
     assert_contains(&err, &["bad.toml:7:7", "'fov'", "finite"]);
-    let err = load(&with(
+    let err = load_error(&with(
         "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1e39, 0.0]]\nindices = [0, 1, 2]\nbsdf = \"white\"\n",
     ));
     assert_contains(
@@ -143,7 +135,7 @@ fn non_finite_numbers() {
     let dir = tempfile::tempdir().unwrap();
     let obj = dir.path().join("nan.obj");
     std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n").unwrap();
-    let err = load(&with(&format!(
+    let err = load_error(&with(&format!(
         "[[shape]]\ntype = \"obj\"\nfile = {:?}\nbsdf = \"white\"\n",
         obj.display().to_string()
     )));
@@ -155,7 +147,7 @@ fn non_finite_numbers() {
 
 #[test]
 fn mesh_index_out_of_range() {
-    let err = load(&with(
+    let err = load_error(&with(
         "[[shape]]\ntype = \"mesh\"\npositions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]\nindices = [0, 1, 3]\nbsdf = \"white\"\n",
     ));
     assert_contains(
@@ -166,7 +158,7 @@ fn mesh_index_out_of_range() {
 
 #[test]
 fn missing_obj_file_and_unknown_bsdf_name() {
-    let err = load(&with(
+    let err = load_error(&with(
         "[[shape]]\ntype = \"obj\"\nfile = \"nope.obj\"\nbsdf = \"white\"\n",
     ));
     assert_contains(
@@ -178,7 +170,7 @@ fn missing_obj_file_and_unknown_bsdf_name() {
             "No such file",
         ],
     );
-    let err = load(&with(
+    let err = load_error(&with(
         "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"whte\"\n",
     ));
     assert_contains(
@@ -193,7 +185,7 @@ fn missing_obj_file_and_unknown_bsdf_name() {
 
 #[test]
 fn setting_that_does_not_apply_is_rejected() {
-    let err = load(&BASE.replace(
+    let err = load_error(&BASE.replace(
         "type = \"path\"",
         "type = \"path\"\nheuristic = \"balance\"\nbeta = 3.0",
     ));
@@ -208,15 +200,15 @@ fn setting_that_does_not_apply_is_rejected() {
 
 #[test]
 fn missing_required_tables_and_keys() {
-    let err = load(&BASE.replace("[sampler]\ntype = \"independent\"\nspp = 1\n", ""));
+    let err = load_error(&BASE.replace("[sampler]\ntype = \"independent\"\nspp = 1\n", ""));
     assert_contains(&err, &["needs a [sampler] table"]);
-    let err = load(&BASE.replace("fov = 40.0\n", ""));
+    let err = load_error(&BASE.replace("fov = 40.0\n", ""));
     assert_contains(&err, &["needs 'fov'"]);
 }
 
 #[test]
 fn unknown_denoiser_types_and_parameters_are_named() {
-    let err = load(&with("[denoiser]\ntype = \"oidnn\"\n"));
+    let err = load_error(&with("[denoiser]\ntype = \"oidnn\"\n"));
     assert_contains(
         &err,
         &[
@@ -225,9 +217,9 @@ fn unknown_denoiser_types_and_parameters_are_named() {
             "available: oidn",
         ],
     );
-    let err = load(&with("[denoiser]\ntype = \"oidn\"\nqualty = \"fast\"\n"));
+    let err = load_error(&with("[denoiser]\ntype = \"oidn\"\nqualty = \"fast\"\n"));
     assert_contains(&err, &["bad.toml:19:1", "'qualty'", "quality"]);
-    let err = load(&with("[denoiser]\ntype = \"oidn\"\nquality = \"best\"\n"));
+    let err = load_error(&with("[denoiser]\ntype = \"oidn\"\nquality = \"best\"\n"));
     assert_contains(
         &err,
         &[

@@ -2,7 +2,7 @@
 //! untextured BSDF renders, to the bit; textured parameters of a scene and
 //! their errors name the file, key and what was expected.
 
-use lumis_tests::{render_toml, scenes_dir};
+use lumis_tests::{load_error, render_toml, scenes_dir};
 
 /// A diffuse quad filling the view under a quad light, its reflectance
 /// given by `reflectance` (with any `[[texture]]`s in `textures`).
@@ -96,14 +96,6 @@ fn a_checkerboard_changes_the_image_where_its_squares_are() {
     assert!(darker > n / 5 && darker < 4 * n / 5, "{darker} of {n}");
 }
 
-fn load_error(toml: &str) -> String {
-    let registry = lumis_cli::builtin_registry().unwrap();
-    match lumis_scene::load_str(toml, "bad.toml", "bad", &scenes_dir(), &[], &registry) {
-        Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
-        Err(e) => e.to_string(),
-    }
-}
-
 #[test]
 fn bad_texture_references_are_located_errors() {
     let err = load_error(&scene("", "{ texture = \"wood\" }"));
@@ -167,15 +159,7 @@ fn the_example_scene_loads() {
     let registry = lumis_cli::builtin_registry().unwrap();
     let text = lumis_tests::read_scene("textured-quads.toml");
     let path = scenes_dir().join("textured-quads.toml");
-    lumis_scene::load_str(
-        &text,
-        path.to_str().unwrap(),
-        "textured-quads",
-        &scenes_dir(),
-        &[],
-        &registry,
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
+    lumis_scene::load_str(&text, &path, &[], &registry).unwrap_or_else(|e| panic!("{e}"));
 }
 
 /// A floor receding to the horizon under a white sky, its reflectance an

@@ -11,15 +11,8 @@ use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scene
 fn load(name: &str, overrides: &[String]) -> LoadedScene {
     let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
     let path = scenes_dir().join(name);
-    lumis_scene::load_str(
-        &std::fs::read_to_string(&path).expect("scene file exists"),
-        name,
-        "test",
-        path.parent().expect("a scene file has a directory"),
-        overrides,
-        &registry,
-    )
-    .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
+    lumis_scene::load_file(&path, overrides, &registry)
+        .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
 }
 
 /// Renders `loaded` through [`Opaque`]: scalar scene queries, and the

@@ -26,15 +26,8 @@ pub fn render_toml_with(
     threads: usize,
 ) -> RenderOutput {
     let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    let loaded = lumis_scene::load_str(
-        toml,
-        "test.toml",
-        "test",
-        &scenes_dir(),
-        &overrides,
-        registry,
-    )
-    .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
+    let loaded = lumis_scene::load_str(toml, &scenes_dir().join("test.toml"), &overrides, registry)
+        .unwrap_or_else(|e| panic!("scene failed to load: {e}"));
     render_loaded(&loaded, threads)
 }
 
@@ -116,6 +109,16 @@ pub fn scenes_dir() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("..")
         .join("scenes")
+}
+
+/// The error loading `toml` gives, located in a scene file `bad.toml` of
+/// the working directory (the scene names no files); panics if it loads.
+pub fn load_error(toml: &str) -> String {
+    let registry = lumis_cli::builtin_registry().unwrap();
+    match lumis_scene::load_str(toml, Path::new("bad.toml"), &[], &registry) {
+        Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
+        Err(e) => e.to_string(),
+    }
 }
 
 pub fn read_scene(name: &str) -> String {

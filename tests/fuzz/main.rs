@@ -144,7 +144,7 @@ fn located(result: lumis_core::Result<lumis_scene::LoadedScene>, file: &str) -> 
 
 fn load_scene(text: &str, dir: &Path) -> lumis_core::Result<lumis_scene::LoadedScene> {
     let registry = lumis_cli::builtin_registry().unwrap();
-    lumis_scene::load_str(text, "fuzz.toml", "fuzz", dir, &[], &registry)
+    lumis_scene::load_str(text, &dir.join("fuzz.toml"), &[], &registry)
 }
 
 /// A scene around one mesh file, with `camera` for its camera table. An

@@ -361,7 +361,7 @@ fn settings(loaded: &lumis_scene::LoadedScene, seed: u64) -> RenderSettings {
 }
 
 fn load(registry: &Registry, toml: &str) -> Result<lumis_scene::LoadedScene> {
-    lumis_scene::load_str(toml, "check.toml", "check", Path::new("."), &[], registry)
+    lumis_scene::load_str(toml, Path::new("check.toml"), &[], registry)
 }
 
 /// Renders the scene `toml` with `integrator` in place of its own.

@@ -1,6 +1,7 @@
 //! Errors that point at the scene file, line and key that caused them.
 
 use std::fmt;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// Where a value came from: a line of a scene file, or a command-line override.
@@ -14,6 +15,22 @@ pub enum Location {
     Override(Arc<str>),
     /// Built into lumis (a parameter default, a programmatic table).
     Builtin,
+}
+
+impl Location {
+    /// A file path written here, resolved. A relative path is resolved
+    /// against the directory of the scene file that wrote it, so a scene and
+    /// its assets move together; given with `--set` (or built in), it is
+    /// relative to the working directory, as a path typed in a shell is.
+    pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
+        let path = path.as_ref();
+        match self {
+            Location::File { path: scene, .. } if path.is_relative() => Path::new(&**scene)
+                .parent()
+                .map_or(path.to_path_buf(), |dir| dir.join(path)),
+            _ => path.to_path_buf(),
+        }
+    }
 }
 
 impl fmt::Display for Location {

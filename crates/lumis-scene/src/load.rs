@@ -44,23 +44,13 @@ pub const SCENE_FILE: FileKind = FileKind::new("scene", 64 * MIB);
 /// Reads and loads a scene file.
 pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Result<LoadedScene> {
     let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".into());
-    load_str(
-        &text,
-        &path.display().to_string(),
-        &name,
-        dir,
-        overrides,
-        registry,
-    )
+    load_str(&text, path, overrides, registry)
 }
 
-/// Loads a scene from TOML text; `label` names it in error locations and
-/// relative paths resolve against `dir`.
+/// Loads a scene from TOML text as if it were the file at `path` (which
+/// need not exist): `path` names it in error locations, its directory
+/// resolves the relative paths the text writes, and its stem names the
+/// scene.
 ///
 /// The document is described (every key checked, nothing created), its
 /// plugins are created through the registry (extended with the libraries
@@ -68,23 +58,26 @@ pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Resu
 /// area lights; the light sampler comes last, over every light.
 pub fn load_str(
     text: &str,
-    label: &str,
-    name: &str,
-    dir: &Path,
+    path: &Path,
     overrides: &[String],
     registry: &Registry,
 ) -> Result<LoadedScene> {
+    let label = path.display().to_string();
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".into());
     let parse_start = Instant::now();
-    let mut root = doc::parse(text, label)?;
+    let mut root = doc::parse(text, &label)?;
     for assignment in overrides {
         doc::apply_override(&mut root, assignment)?;
     }
     let file = Location::File {
-        path: Arc::from(label),
+        path: Arc::from(label.as_str()),
         line: 1,
         column: 1,
     };
-    let description = SceneDescription::from_document(root, &file, dir)?;
+    let description = SceneDescription::from_document(root, &file)?;
     let report = LoadReport {
         parse: parse_start.elapsed(),
         ..LoadReport::default()
@@ -155,7 +148,7 @@ pub fn load_str(
         }
     }
     Ok(LoadedScene {
-        name: name.to_string(),
+        name,
         scene,
         camera: description.camera,
         sampler: plugins.sampler,

@@ -4,8 +4,10 @@
 //! It hashes the scene's meaning, not its text: the parsed document after
 //! `--set` overrides, tables with their keys in sorted order, so comments,
 //! whitespace, key order and number spelling (`1e3` or `1000.0`) do not
-//! count; and the bytes of every file the document names with a `file` key
-//! (meshes, glTF files, measured BRDF tables). It leaves out what a render
+//! count; and the bytes of every file the document names with a `file` or
+//! `filename` key (meshes, glTF files, measured BRDF tables, image textures,
+//! environment maps), found where the loader finds it
+//! ([`lumis_core::Location::resolve`]). It leaves out what a render
 //! records on its own or what does not change the image: `seed`,
 //! `sampler.spp` and `film.output`. Not covered: files that a named file
 //! itself refers to (a glTF's external buffers), and the code of plugin
@@ -15,7 +17,7 @@
 use std::io::{BufRead, Read};
 use std::path::Path;
 
-use lumis_core::doc::{self, Table, Value};
+use lumis_core::doc::{self, Node, Table, Value};
 use lumis_core::files::{open_bounded, read_text_bounded, FileKind, GIB};
 use lumis_core::{Error, Result};
 
@@ -79,9 +81,8 @@ pub fn scene_hash(path: &Path, overrides: &[String]) -> Result<u64> {
     for assignment in overrides {
         doc::apply_override(&mut root, assignment)?;
     }
-    let dir = path.parent().unwrap_or(Path::new("."));
     let mut hash = Fnv1a::default();
-    hash_table(&mut hash, &root, &[], dir)?;
+    hash_table(&mut hash, &root, &[])?;
     Ok(hash.finish())
 }
 
@@ -91,7 +92,7 @@ const HASHED_FILE: FileKind = FileKind::new("scene file's asset", 16 * GIB);
 /// Keys left out of the hash, by their path from the root.
 const NOT_HASHED: &[&[&str]] = &[&["seed"], &["sampler", "spp"], &["film", "output"]];
 
-fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str], dir: &Path) -> Result<()> {
+fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str]) -> Result<()> {
     let mut entries: Vec<_> = table.entries.iter().collect();
     entries.sort_by(|a, b| a.key.cmp(&b.key));
     let mut path = at.to_vec();
@@ -100,7 +101,7 @@ fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str], dir: &Path) -> Resul
         if !NOT_HASHED.contains(&path.as_slice()) {
             hash.write(b"k");
             hash.write_field(entry.key.as_bytes());
-            hash_value(hash, &entry.node.value, &path, dir)?;
+            hash_value(hash, &entry.node, &path)?;
         }
         path.pop();
     }
@@ -108,8 +109,8 @@ fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str], dir: &Path) -> Resul
     Ok(())
 }
 
-fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Result<()> {
-    match value {
+fn hash_value(hash: &mut Fnv1a, node: &Node, at: &[&str]) -> Result<()> {
+    match &node.value {
         Value::Bool(b) => hash.write(&[b'b', *b as u8]),
         Value::Int(i) => {
             hash.write(b"i");
@@ -123,8 +124,7 @@ fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Resul
             hash.write(b"s");
             hash.write_field(s.as_bytes());
             if names_a_file(at) {
-                let file = dir.join(s);
-                hash.write_file(&file).map_err(|e| {
+                hash.write_file(&node.location.resolve(s)).map_err(|e| {
                     Error::msg(format!(
                         "{e} (named by {} in the scene, to hash it)",
                         at.join(".")
@@ -136,12 +136,12 @@ fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Resul
             hash.write(b"a");
             hash.write(&(items.len() as u64).to_le_bytes());
             for item in items {
-                hash_value(hash, &item.value, at, dir)?;
+                hash_value(hash, item, at)?;
             }
         }
         Value::Table(table) => {
             hash.write(b"{");
-            hash_table(hash, table, at, dir)?;
+            hash_table(hash, table, at)?;
         }
         Value::Datetime(d) => {
             hash.write(b"d");
@@ -151,9 +151,11 @@ fn hash_value(hash: &mut Fnv1a, value: &Value, at: &[&str], dir: &Path) -> Resul
     Ok(())
 }
 
-/// Whether a string at this key path names a file whose bytes count.
+/// Whether a string at this key path names a file whose bytes count: a
+/// shape's, camera's or measured BSDF's `file`, an image texture's or
+/// environment map's `filename`.
 fn names_a_file(at: &[&str]) -> bool {
-    at.last() == Some(&"file")
+    matches!(at.last(), Some(&"file" | &"filename"))
 }
 
 #[cfg(test)]
@@ -217,5 +219,39 @@ mod tests {
             err.contains("mesh.obj") && err.contains("shape.file"),
             "{err}"
         );
+    }
+
+    /// An environment map's or image texture's `filename` counts like a
+    /// mesh's `file`.
+    #[test]
+    fn a_named_image_counts() {
+        let scene = "[[light]]\ntype = \"envmap\"\nfilename = \"sky.exr\"\n";
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("scene.toml");
+        std::fs::write(&path, scene).unwrap();
+        std::fs::write(dir.path().join("sky.exr"), b"one sky").unwrap();
+        let before = scene_hash(&path, &[]).unwrap();
+        std::fs::write(dir.path().join("sky.exr"), b"another sky").unwrap();
+        assert_ne!(before, scene_hash(&path, &[]).unwrap());
+    }
+
+    /// A path given with `--set` is hashed where the loader reads it: from
+    /// the working directory, not beside the scene file.
+    #[test]
+    fn an_overridden_path_is_hashed_where_it_is_read() {
+        let scene_dir = tempfile::tempdir().unwrap();
+        let path = scene_dir.path().join("scene.toml");
+        std::fs::write(&path, "[[shape]]\ntype = \"obj\"\nfile = \"x.obj\"\n").unwrap();
+        std::fs::write(scene_dir.path().join("mesh.obj"), b"v 0 0 0\n").unwrap();
+        let elsewhere = tempfile::tempdir().unwrap();
+        let absolute = elsewhere.path().join("mesh.obj");
+        std::fs::write(&absolute, b"v 0 0 1\n").unwrap();
+        let set = |file: &str| vec![format!("shape.0.file=\"{file}\"")];
+        // Relative: the working directory's file (there is none), not the
+        // one beside the scene.
+        let err = scene_hash(&path, &set("mesh.obj")).unwrap_err().to_string();
+        assert!(err.contains("mesh.obj"), "{err}");
+        assert!(!err.contains(&*scene_dir.path().to_string_lossy()), "{err}");
+        assert!(scene_hash(&path, &set(&absolute.to_string_lossy())).is_ok());
     }
 }

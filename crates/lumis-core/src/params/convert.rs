@@ -7,7 +7,6 @@ use glam::{UVec2, Vec2, Vec3};
 
 use super::ParamType;
 use crate::doc::{Node, Value};
-use crate::error::Location;
 use crate::spectrum::Rgb;
 
 /// A value that can be read from a document node.
@@ -175,24 +174,14 @@ impl FromParam for usize {
     }
 }
 
-/// A file path. A relative path is resolved against the directory of the
-/// scene file that wrote it, so a scene and its assets move together; given
-/// with `--set` (or built in), it is relative to the working directory.
+/// A file path, resolved as [`crate::Location::resolve`] says.
 impl FromParam for PathBuf {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
         let text = String::from_node(node)?;
         if text.is_empty() {
             return Err("expected a file path, found an empty string".into());
         }
-        let path = PathBuf::from(text);
-        Ok(match &node.location {
-            Location::File { path: scene, .. } if path.is_relative() => {
-                std::path::Path::new(&**scene)
-                    .parent()
-                    .map_or(path.clone(), |dir| dir.join(&path))
-            }
-            _ => path,
-        })
+        Ok(node.location.resolve(text))
     }
 }
 

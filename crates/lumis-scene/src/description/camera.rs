@@ -1,6 +1,6 @@
 //! `[camera]`: a perspective camera written out, or one of a glTF asset.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use lumis_core::doc::Table;
 use lumis_core::glam::Mat4;
@@ -34,7 +34,7 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
 const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
     ParamSpec::required(
         "file",
-        ParamType::String,
+        ParamType::Path,
         "glTF 2.0 asset (.gltf or .glb), relative to the scene file",
     ),
     ParamSpec::optional(
@@ -57,13 +57,12 @@ const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
 /// Reads `[camera]` for a film of `resolution`.
 pub(crate) fn camera(
     (table, location): Located<Table>,
-    dir: &Path,
     resolution: UVec2,
 ) -> Result<PerspectiveCamera> {
     let (kind, kind_location) = type_of(&table, &location, "[camera]")?;
     match kind {
         "perspective" => perspective(&table, location, resolution),
-        "gltf" => gltf_camera(&table, location, dir, resolution),
+        "gltf" => gltf_camera(&table, location, resolution),
         other => Err(Error::at(
             &kind_location,
             format!("unknown camera type \"{other}\"; available: perspective, gltf"),
@@ -97,12 +96,7 @@ fn perspective(table: &Table, location: Location, resolution: UVec2) -> Result<P
 
 /// `type = "gltf"`: the asset's camera, chosen by name or index, placed by
 /// its node and the optional `transform`.
-fn gltf_camera(
-    table: &Table,
-    location: Location,
-    dir: &Path,
-    resolution: UVec2,
-) -> Result<PerspectiveCamera> {
+fn gltf_camera(table: &Table, location: Location, resolution: UVec2) -> Result<PerspectiveCamera> {
     let owner = "[camera] (type = \"gltf\")";
     let params = Params::new(
         owner,
@@ -112,6 +106,7 @@ fn gltf_camera(
         &["type"],
     )?;
     let file: String = params.get("file")?;
+    let path: PathBuf = params.get("file")?;
     let base = match params.table("transform")? {
         Some((t, at)) => parse_transform(&format!("{owner} transform"), t, at)?,
         None => Mat4::IDENTITY,
@@ -124,8 +119,8 @@ fn gltf_camera(
         (None, Some(index)) => CameraChoice::Index(index),
         (None, None) => CameraChoice::First,
     };
-    let found = find_camera(&dir.join(&file), &file, &choice, base)
-        .map_err(|e| params.error(e.key, e.message))?;
+    let found =
+        find_camera(&path, &file, &choice, base).map_err(|e| params.error(e.key, e.message))?;
     // lumis's fov is the full angle of the smaller image axis; glTF's yfov
     // is vertical, and the film's aspect ratio decides the horizontal one.
     let (w, h) = (resolution.x as f32, resolution.y as f32);

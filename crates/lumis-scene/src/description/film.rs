@@ -1,7 +1,7 @@
 //! `[film]`: the image's size, where it goes, its pixel filter, and the
 //! outputs written beside the colour.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use lumis_core::doc::Table;
 use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2};
@@ -18,7 +18,7 @@ const FILM_PARAMS: &[ParamSpec] = &[
     ),
     ParamSpec::optional(
         "output",
-        ParamType::String,
+        ParamType::Path,
         "output EXR path, relative to the scene file",
     ),
     ParamSpec::optional(
@@ -37,25 +37,21 @@ const FILM_PARAMS: &[ParamSpec] = &[
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FilmDescription {
     pub resolution: UVec2,
-    /// `output`, resolved against the scene file's directory.
+    /// `output`, resolved as `Location::resolve` says.
     pub output: Option<PathBuf>,
     /// `aovs`, in the order written, each once.
     pub aovs: Vec<Aov>,
 }
 
 /// Reads `[film]` (all defaults when absent; `file` locates its absence).
-pub(crate) fn film(
-    table: Option<Located<Table>>,
-    file: &Location,
-    dir: &Path,
-) -> Result<FilmDescription> {
+pub(crate) fn film(table: Option<Located<Table>>, file: &Location) -> Result<FilmDescription> {
     let (table, location) = table.unwrap_or_else(|| (Table::default(), file.clone()));
     let film = Params::new("[film]", &table, location, FILM_PARAMS, &[])?;
     let resolution: UVec2 = film.get("resolution")?;
     if resolution.x == 0 || resolution.y == 0 {
         return Err(film.error("resolution", "width and height must be at least 1"));
     }
-    let output = film.get_opt::<String>("output")?.map(|o| dir.join(o));
+    let output = film.get_opt::<PathBuf>("output")?;
     if let Some((filter, location)) = film.table("filter")? {
         match type_of(filter, &location, "[film] filter")? {
             ("box", _) if filter.entries.len() == 1 => {}

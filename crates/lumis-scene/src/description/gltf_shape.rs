@@ -1,6 +1,6 @@
 //! `[[shape]] type = "gltf"`: the keys that say how to import an asset.
 
-use std::path::Path;
+use std::path::PathBuf;
 
 use lumis_core::doc::{Table, Value};
 use lumis_core::glam::Mat4;
@@ -14,7 +14,7 @@ use crate::gltf::{ImportRequest, MissingNormals};
 pub(crate) const GLTF_PARAMS: &[ParamSpec] = &[
     ParamSpec::required(
         "file",
-        ParamType::String,
+        ParamType::Path,
         "glTF 2.0 asset (.gltf with its buffers, or .glb), relative to the scene file",
     ),
     ParamSpec::optional(
@@ -43,13 +43,9 @@ pub(crate) const GLTF_PARAMS: &[ParamSpec] = &[
 
 /// What the importer is asked for; `params` is the shape's table checked
 /// against [`GLTF_PARAMS`].
-pub(crate) fn gltf_request(
-    owner: &str,
-    params: &Params,
-    table: &Table,
-    scene_dir: &Path,
-) -> Result<ImportRequest> {
+pub(crate) fn gltf_request(owner: &str, params: &Params, table: &Table) -> Result<ImportRequest> {
     let label: String = params.get("file")?;
+    let path: PathBuf = params.get("file")?;
     let transform = match params.table("transform")? {
         Some((t, at)) => parse_transform(&format!("{owner} transform"), t, at)?,
         None => Mat4::IDENTITY,
@@ -98,7 +94,7 @@ pub(crate) fn gltf_request(
     };
     Ok(ImportRequest {
         owner: owner.to_string(),
-        path: scene_dir.join(&label),
+        path,
         file_location: location_of(table, "file", &Location::Builtin),
         label,
         transform,

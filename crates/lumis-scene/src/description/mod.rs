@@ -20,8 +20,6 @@ mod plugin_libraries;
 mod shapes;
 mod transform;
 
-use std::path::Path;
-
 use lumis_core::doc::{Table, Value};
 use lumis_core::entity::TYPE_KEY;
 use lumis_core::{Error, Location, PluginEntity, PluginKind, Result};
@@ -81,17 +79,16 @@ pub(crate) struct SceneDescription {
 
 impl SceneDescription {
     /// Describes the scene `root` (the whole document, overrides applied);
-    /// `file` locates what the document lacks, relative paths resolve
-    /// against `dir`.
-    pub fn from_document(mut root: Table, file: &Location, dir: &Path) -> Result<Self> {
+    /// `file` locates what the document lacks; relative paths resolve as
+    /// [`Location::resolve`] says.
+    pub fn from_document(mut root: Table, file: &Location) -> Result<Self> {
         check_top_level_keys(&root)?;
         let seed = seed_of(&root)?;
         let plugin_libraries =
-            plugin_libraries::plugin_libraries(take_table(&mut root, "plugins")?, dir)?;
-        let film = film::film(take_table(&mut root, "film")?, file, dir)?;
+            plugin_libraries::plugin_libraries(take_table(&mut root, "plugins")?)?;
+        let film = film::film(take_table(&mut root, "film")?, file)?;
         let camera = camera::camera(
             take_required_table(&mut root, "camera", file)?,
-            dir,
             film.resolution,
         )?;
         let textures = named::named_plugins(
@@ -105,7 +102,7 @@ impl SceneDescription {
         let shapes = take_tables(&mut root, "shape")?
             .into_iter()
             .enumerate()
-            .map(|(i, table)| shapes::shape(i, table, dir))
+            .map(|(i, table)| shapes::shape(i, table))
             .collect::<Result<Vec<_>>>()?;
         let lights = take_tables(&mut root, "light")?
             .into_iter()

@@ -1,6 +1,6 @@
 //! `[plugins] load = [...]`: plugin libraries the scene needs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use lumis_core::doc::Table;
 use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result};
@@ -34,18 +34,15 @@ impl PluginLibraries {
 }
 
 /// Reads `[plugins]` (no libraries when absent).
-pub(crate) fn plugin_libraries(
-    table: Option<Located<Table>>,
-    dir: &Path,
-) -> Result<PluginLibraries> {
+pub(crate) fn plugin_libraries(table: Option<Located<Table>>) -> Result<PluginLibraries> {
     let Some((table, location)) = table else {
         return Ok(PluginLibraries::default());
     };
     let params = Params::new("[plugins]", &table, location.clone(), PLUGINS_PARAMS, &[])?;
-    let libraries: Vec<String> = params.get("load")?;
+    let paths: Vec<PathBuf> = params.get("load")?;
     params.finish()?;
     Ok(PluginLibraries {
-        paths: libraries.iter().map(|l| dir.join(l)).collect(),
+        paths,
         location: Some(
             table
                 .get("load")

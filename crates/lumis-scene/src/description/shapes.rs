@@ -1,7 +1,7 @@
 //! `[[shape]]` tables: quads, inline meshes, OBJ files, spheres and glTF
 //! assets, each to a [`ShapeEntity`].
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use lumis_core::doc::Table;
 use lumis_core::{
@@ -119,7 +119,7 @@ const MESH_PARAMS: &[ParamSpec] = shape_params![
 ];
 const OBJ_PARAMS: &[ParamSpec] = shape_params![ParamSpec::required(
     "file",
-    ParamType::String,
+    ParamType::Path,
     "Wavefront OBJ file, relative to the scene file; faces are triangulated"
 )];
 const SPHERE_PARAMS: &[ParamSpec] = shape_params![
@@ -136,11 +136,7 @@ const SHAPE_TYPES: &[(&str, &[ParamSpec])] = &[
 ];
 
 /// Describes the `index`-th (from 0) `[[shape]]`.
-pub(crate) fn shape(
-    index: usize,
-    (table, location): Located<Table>,
-    scene_dir: &Path,
-) -> Result<ShapeEntity> {
+pub(crate) fn shape(index: usize, (table, location): Located<Table>) -> Result<ShapeEntity> {
     // Numbered from 0, as `--set shape.N` addresses it.
     let owner = format!("[[shape]] #{index}");
     let (kind, kind_location) = type_of(&table, &location, &owner)?;
@@ -152,9 +148,9 @@ pub(crate) fn shape(
     let owner = format!("{owner} (type = \"{kind}\")");
     let params = Params::new(owner.clone(), &table, location.clone(), spec, &["type"])?;
     let source = match kind {
-        "gltf" => ShapeSource::Gltf(gltf_request(&owner, &params, &table, scene_dir)?),
+        "gltf" => ShapeSource::Gltf(gltf_request(&owner, &params, &table)?),
         surface_kind => {
-            let geometry = surface_geometry(surface_kind, &params, &table, scene_dir)?;
+            let geometry = surface_geometry(surface_kind, &params, &table)?;
             ShapeSource::Surface(surface(&owner, geometry, &params, &table)?)
         }
     };
@@ -163,16 +159,11 @@ pub(crate) fn shape(
 }
 
 /// The geometry keys of a surface shape of type `kind`.
-fn surface_geometry(
-    kind: &str,
-    params: &Params,
-    table: &Table,
-    scene_dir: &Path,
-) -> Result<SurfaceGeometry> {
+fn surface_geometry(kind: &str, params: &Params, table: &Table) -> Result<SurfaceGeometry> {
     match kind {
         "quad" => quad(params),
         "mesh" => mesh(params),
-        "obj" => obj(params, table, scene_dir),
+        "obj" => obj(params, table),
         "sphere" => Ok(SurfaceGeometry::Sphere {
             center: params.get("center")?,
             radius: params.get_positive("radius")?,
@@ -270,10 +261,9 @@ fn mesh(params: &Params) -> Result<SurfaceGeometry> {
     }))
 }
 
-fn obj(params: &Params, table: &Table, scene_dir: &Path) -> Result<SurfaceGeometry> {
-    let file: String = params.get("file")?;
+fn obj(params: &Params, table: &Table) -> Result<SurfaceGeometry> {
     Ok(SurfaceGeometry::Obj(ObjFile {
-        path: scene_dir.join(file),
+        path: params.get("file")?,
         location: location_of(table, "file", &Location::Builtin),
     }))
 }

@@ -1,7 +1,6 @@
 //! The description keeps every plugin as a located entity and fills in
 //! defaults as entities, never as TOML text.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use lumis_core::{Location, PluginKind};
@@ -29,7 +28,7 @@ fn describe(extra: &str) -> SceneDescription {
         line: 1,
         column: 1,
     };
-    SceneDescription::from_document(root, &file, Path::new(".")).unwrap()
+    SceneDescription::from_document(root, &file).unwrap()
 }
 
 #[test]
@@ -123,7 +122,7 @@ fn try_describe(text: &str) -> lumis_core::Result<SceneDescription> {
         line: 1,
         column: 1,
     };
-    SceneDescription::from_document(root, &file, Path::new("."))
+    SceneDescription::from_document(root, &file)
 }
 
 #[test]
