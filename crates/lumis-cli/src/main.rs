@@ -41,7 +41,8 @@ enum Command {
     /// Merge the partial images of a render split into parts (`render
     /// --part K/N` or `--samples A..B`) into the image one render makes,
     /// after checking they are parts of one render (scene, seed, spp) that
-    /// cover each sample index once.
+    /// cover each sample index once; denoise it as the render would when
+    /// its scene has a `[denoiser]`.
     Merge(MergeArgs),
     /// List every plugin (built-in, and libraries on LUMIS_PLUGIN_PATH or
     /// given with --load) with its parameters: name, type, default, meaning.
@@ -186,9 +187,14 @@ fn main() -> ExitCode {
             Ok(Outcome::Done)
         }),
         Command::Merge(args) => plain(|| {
-            merge(&args).map(|report| {
+            let registry = registry_with_search_path()?;
+            merge(&args, &registry).map(|report| {
+                let denoised = match &report.denoised {
+                    Some(exr) => format!(", denoised -> {}", exr.display()),
+                    None => String::new(),
+                };
                 println!(
-                    "{} spp from {} parts -> {} and {}",
+                    "{} spp from {} parts -> {} and {}{denoised}",
                     report.metadata.spp,
                     args.parts.len(),
                     report.exr.display(),
