@@ -7,6 +7,7 @@ mod brdf;
 mod checkpoint;
 mod converge;
 mod denoise;
+mod denoise_image;
 mod diff;
 mod integrator_check;
 mod interrupt;
@@ -31,6 +32,7 @@ pub use checkpoint::{checkpoint_path, Checkpoint};
 pub use converge::{
     converge, parse_variants, ConvergeArgs, ConvergeReport, MeasuredImage, Point, Run, Variant,
 };
+pub use denoise_image::{denoise_image, DenoiseArgs, DenoiseReport};
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use integrator_check::{
     check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,

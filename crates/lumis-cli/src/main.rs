@@ -14,12 +14,13 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, check_integrator_with, compress_table, converge, diff_images,
+    analyze_samplers, check_integrator_with, compress_table, converge, denoise_image, diff_images,
     format_integrator_results, lecture, merge, new_plugin, plugin_listing, plugin_markdown,
     precompute_table, registry_with_search_path, render_reference, render_scene_file, slurm_status,
     stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs,
-    DiffArgs, IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs, PrecomputeArgs,
-    ReferenceArgs, RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    DenoiseArgs, DiffArgs, IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs,
+    PrecomputeArgs, ReferenceArgs, RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs,
+    INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 
@@ -41,8 +42,14 @@ enum Command {
     /// Merge the partial images of a render split into parts (`render
     /// --part K/N` or `--samples A..B`) into the image one render makes,
     /// after checking they are parts of one render (scene, seed, spp) that
-    /// cover each sample index once.
+    /// cover each sample index once; denoise it as the render would when
+    /// its scene has a `[denoiser]`.
     Merge(MergeArgs),
+    /// Denoise an image on disk (an EXR, guided by the albedo and normal
+    /// layers a render writes) into IMAGE.denoised.exr and .png, with the
+    /// denoiser of its scene (`lumis.denoiser` in its header), else oidn,
+    /// or --denoiser TYPE.
+    Denoise(DenoiseArgs),
     /// List every plugin (built-in, and libraries on LUMIS_PLUGIN_PATH or
     /// given with --load) with its parameters: name, type, default, meaning.
     Plugins {
@@ -186,14 +193,26 @@ fn main() -> ExitCode {
             Ok(Outcome::Done)
         }),
         Command::Merge(args) => plain(|| {
-            merge(&args).map(|report| {
+            let registry = registry_with_search_path()?;
+            merge(&args, &registry).map(|report| {
+                let denoised = match &report.denoised {
+                    Some(exr) => format!(", denoised -> {}", exr.display()),
+                    None => String::new(),
+                };
                 println!(
-                    "{} spp from {} parts -> {} and {}",
+                    "{} spp from {} parts -> {} and {}{denoised}",
                     report.metadata.spp,
                     args.parts.len(),
                     report.exr.display(),
                     report.png.display()
                 );
+                Outcome::Done
+            })
+        }),
+        Command::Denoise(args) => plain(|| {
+            let registry = registry_with_search_path()?;
+            denoise_image(&args, &registry).map(|report| {
+                println!("{}", report.summary(&args.image));
                 Outcome::Done
             })
         }),

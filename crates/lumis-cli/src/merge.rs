@@ -2,13 +2,14 @@
 //! together, after checking that they are the parts of one render and
 //! cover each of its sample indices once.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use lumis_core::{Error, Result};
+use lumis_core::{Error, Registry, Result};
 use lumis_render::Film;
 
+use crate::denoise::{claim_denoised_outputs, denoise_film, ConfiguredDenoiser};
 use crate::metadata::ImageMetadata;
-use crate::outputs::Outputs;
+use crate::outputs::{same_file, Outputs};
 use crate::partial::Partial;
 use crate::render::output_paths;
 
@@ -19,7 +20,8 @@ pub struct MergeArgs {
     /// in any order.
     #[arg(required = true)]
     pub parts: Vec<PathBuf>,
-    /// Output path: writes PATH.exr and PATH.png, as `lumis render` does.
+    /// Output path: writes PATH.exr and PATH.png, as `lumis render` does,
+    /// and PATH.denoised.exr and .png when the scene has a `[denoiser]`.
     #[arg(long, short)]
     pub output: PathBuf,
 }
@@ -28,6 +30,8 @@ pub struct MergeArgs {
 pub struct MergeReport {
     pub exr: PathBuf,
     pub png: PathBuf,
+    /// The denoised image's EXR, when the parts' scene has a `[denoiser]`.
+    pub denoised: Option<PathBuf>,
     pub metadata: ImageMetadata,
 }
 
@@ -36,6 +40,19 @@ pub struct MergeReport {
 fn differs(first: &Partial, part: &Partial) -> Option<String> {
     let (a, b) = (&first.metadata, &part.metadata);
     let (sa, sb) = (a.slice?, b.slice?);
+    // Before the scene hash, which counts the denoiser too: this says what
+    // differs.
+    if a.denoiser != b.denoiser {
+        let named = |d: &Option<String>| match d {
+            Some(toml) => format!("the [denoiser] {toml}"),
+            None => "no [denoiser]".to_string(),
+        };
+        return Some(format!(
+            "{}, not {}",
+            named(&b.denoiser),
+            named(&a.denoiser)
+        ));
+    }
     if a.scene_hash != b.scene_hash || a.scene_file_hash != b.scene_file_hash {
         return Some(format!(
             "a different scene (scene hash {:016x}, not {:016x}: the scene, a file it names or a --set differs)",
@@ -105,8 +122,10 @@ fn check_coverage(parts: &[(PathBuf, Partial)]) -> Result<()> {
 
 /// Reads the parts, checks them, adds their sums in sample-index order and
 /// writes the image a plain `lumis render` writes: `PATH.exr` (with the
-/// output layers and the metadata in its header) and `PATH.png`.
-pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
+/// output layers and the metadata in its header) and `PATH.png`, then, for
+/// a scene with a `[denoiser]` (made through `registry`), its denoised
+/// image `PATH.denoised.exr` and `.png`.
+pub fn merge(args: &MergeArgs, registry: &Registry) -> Result<MergeReport> {
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
         parts.push((path.clone(), Partial::read(path)?));
@@ -124,10 +143,6 @@ pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
     parts.sort_by_key(|(_, part)| part.film.start);
     check_coverage(&parts)?;
     let (exr, png) = output_paths(&args.output, "merged");
-    let same_file = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
     if let Some((part, _)) = parts.iter().find(|(p, _)| same_file(p, &exr)) {
         return Err(Error::msg(format!(
             "the output {} is the part '{}': give another -o",
@@ -136,8 +151,19 @@ pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
         )));
     }
     let outputs = Outputs::claim(&exr, Some(&png))?;
-    let film = append_all(&parts)?;
+    // Made and claimed before the merge, as `lumis render` does before it
+    // renders: an unknown denoiser stops it before it writes anything.
     let base = &parts[0].1.metadata;
+    let denoiser = base
+        .denoiser
+        .as_ref()
+        .map(|toml| ConfiguredDenoiser::of_header(toml, &parts[0].0, registry))
+        .transpose()?;
+    let denoised_outputs = denoiser
+        .as_ref()
+        .map(|_| claim_denoised_outputs(&exr))
+        .transpose()?;
+    let film = append_all(&parts)?;
     let metadata = ImageMetadata {
         command: "render".into(),
         spp: film.samples,
@@ -147,7 +173,15 @@ pub fn merge(args: &MergeArgs) -> Result<MergeReport> {
         ..base.clone()
     };
     outputs.write(&film.image(), &film.aov_images(), &metadata)?;
-    Ok(MergeReport { exr, png, metadata })
+    if let (Some(denoiser), Some(denoised)) = (&denoiser, &denoised_outputs) {
+        denoise_film(denoiser, &film, denoised, &metadata, &exr)?;
+    }
+    Ok(MergeReport {
+        exr,
+        png,
+        denoised: denoised_outputs.map(|o| o.exr.clone()),
+        metadata,
+    })
 }
 
 /// The film of the whole render: the parts' sums added in sample-index

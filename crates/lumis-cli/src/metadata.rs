@@ -30,6 +30,11 @@ pub struct ImageMetadata {
     /// For a part of a render split over processes (a partial image), the
     /// sample indices it holds of how many; `None` for a whole image.
     pub slice: Option<SampleSlice>,
+    /// The scene's `[denoiser]` as one line of TOML
+    /// (`{ quality = "fast", type = "oidn" }`), from which a merge of the
+    /// parts or `lumis denoise` makes the same denoiser; `None` where the
+    /// scene has none.
+    pub denoiser: Option<String>,
 }
 
 const PREFIX: &str = "lumis.";
@@ -70,6 +75,7 @@ impl ImageMetadata {
                 ("total_spp", slice.total.to_string()),
             ]
         }))
+        .chain(self.denoiser.iter().map(|toml| ("denoiser", toml.clone())))
         .map(|(k, v)| (format!("{PREFIX}{k}"), v))
         .collect()
     }
@@ -134,6 +140,7 @@ impl ImageMetadata {
                 .map_err(|_| invalid("seconds", "a number"))?,
             version: field("version")?.to_string(),
             slice,
+            denoiser: get("denoiser").map(str::to_string),
         }))
     }
 }
@@ -161,6 +168,7 @@ mod tests {
             seconds: 1.5,
             version: lumis_version(),
             slice: None,
+            denoiser: None,
         };
         let image = lumis_image::Image::new(1, 1);
         lumis_image::write_exr_with_metadata(&path, &image, &meta.attributes()).unwrap();
@@ -171,6 +179,7 @@ mod tests {
                 end: 48,
                 total: 512,
             }),
+            denoiser: Some("{ quality = \"fast\", type = \"oidn\" }".into()),
             ..meta
         };
         lumis_image::write_exr_with_metadata(&path, &image, &part.attributes()).unwrap();

@@ -22,6 +22,15 @@ fn image_error(e: lumis_image::ImageError) -> Error {
     Error::msg(e.to_string())
 }
 
+/// Whether `a` and `b` name one existing file (through links and `..`):
+/// a command must not write over what it reads.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 impl Outputs {
     /// Checks the outputs' directory exists, locks the outputs (the lock is
     /// on the EXR: `PATH.exr.lock`) and removes the temporary files that

@@ -156,6 +156,8 @@ pub fn render_reference(
                 seconds: 0.0,
                 version: lumis_version(),
                 slice: None,
+                // A reference is never denoised.
+                denoiser: None,
             },
             None,
         ),

@@ -14,6 +14,7 @@ use lumis_render::{
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
+use crate::denoise::{claim_denoised_outputs, denoise_film, ConfiguredDenoiser};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
 use crate::partial::Partial;
@@ -428,11 +429,15 @@ pub fn render_scene_file(
     // A part writes its partial EXR only, and is not denoised (the merged
     // image is the render).
     let outputs = Outputs::claim(&exr, slice.is_none().then_some(png.as_path()))?;
-    let denoised_outputs = loaded
+    let denoiser = loaded
         .denoiser
+        .take()
+        .map(ConfiguredDenoiser::of_scene)
+        .transpose()?;
+    let denoised_outputs = denoiser
         .as_ref()
         .filter(|_| slice.is_none())
-        .map(|_| crate::denoise::claim_denoised_outputs(&exr))
+        .map(|_| claim_denoised_outputs(&exr))
         .transpose()?;
     crate::warn_if_threads_capped(args.threads);
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
@@ -491,6 +496,7 @@ pub fn render_scene_file(
         seconds: state.seconds,
         version: lumis_version(),
         slice,
+        denoiser: denoiser.as_ref().map(|d| d.toml.clone()),
     };
     let save = |state: &Checkpoint| -> Result<()> {
         state.write(&checkpoint_file)?;
@@ -598,22 +604,10 @@ pub fn render_scene_file(
         interrupted = false;
     }
     // Only a finished render is denoised, after its raw image is on disk.
-    let denoised = match (&loaded.denoiser, &denoised_outputs) {
+    let denoised = match (&denoiser, &denoised_outputs) {
         (Some(denoiser), Some(denoised)) if !interrupted => {
-            // The film's albedo and normal (which a scene with a denoiser
-            // always makes) guide it.
-            let aovs = state.film.aov_images();
-            let guide = |wanted: Aov| aovs.iter().find(|(aov, _)| *aov == wanted).map(|(_, i)| i);
             let start = Instant::now();
-            let image = crate::denoise::write_denoised(
-                denoiser.as_ref(),
-                &state.film.image(),
-                guide(Aov::Albedo),
-                guide(Aov::Normal),
-                denoised,
-                &metadata(&state),
-                &exr,
-            )?;
+            let image = denoise_film(denoiser, &state.film, denoised, &metadata(&state), &exr)?;
             Some(DenoisedReport {
                 image,
                 exr: denoised.exr.clone(),

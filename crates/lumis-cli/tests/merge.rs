@@ -297,3 +297,124 @@ fn render_refuses_slices_it_cannot_render() {
     assert!(refusal(&["--parts", "2", "--part", "0/2"]).contains("--part"));
     assert!(!Path::new(&out).exists());
 }
+
+/// A `[denoiser]` of the glossy plates, and another.
+const BALANCED: [&str; 4] = [
+    "--set",
+    "denoiser.type=\"oidn\"",
+    "--set",
+    "denoiser.quality=\"balanced\"",
+];
+const FAST: [&str; 4] = [
+    "--set",
+    "denoiser.type=\"oidn\"",
+    "--set",
+    "denoiser.quality=\"fast\"",
+];
+
+/// With a `[denoiser]`, the merge denoises the merged film as `lumis
+/// render --parts N` denoises its own: the same image, bit for bit, which
+/// records the same denoiser; parts of other denoisers are refused.
+#[test]
+fn merge_denoises_as_the_render_in_parts_does() {
+    let tmp = scratch("merge-denoised");
+    let file = |name: &str| path_in(tmp.path(), name);
+    let (part_0, part_1) = (file("part-0.exr"), file("part-1.exr"));
+    render(
+        "sobol",
+        &part_0,
+        &[&["--part", "0/2"][..], &BALANCED].concat(),
+    );
+    render(
+        "sobol",
+        &part_1,
+        &[&["--part", "1/2"][..], &BALANCED].concat(),
+    );
+    // A part is not denoised: the merged image is the render.
+    assert!(!tmp.path().join("part-0.denoised.exr").exists());
+    let merged_exr = file("merged.exr");
+    merged(&[&part_1, &part_0], &merged_exr);
+    let in_one_process = file("parts.exr");
+    render(
+        "sobol",
+        &in_one_process,
+        &[&["--parts", "2"][..], &BALANCED].concat(),
+    );
+    assert_eq!(
+        all_channels(Path::new(&merged_exr)),
+        all_channels(Path::new(&in_one_process)),
+        "the merged raw image is not the render in parts"
+    );
+    let (merged_denoised, render_denoised) = (
+        tmp.path().join("merged.denoised.exr"),
+        tmp.path().join("parts.denoised.exr"),
+    );
+    assert!(tmp.path().join("merged.denoised.png").is_file());
+    assert_eq!(
+        exr_pixels(&merged_denoised),
+        exr_pixels(&render_denoised),
+        "the merge's denoised image is not the render's"
+    );
+    let recorded = "{ quality = \"balanced\", type = \"oidn\" }";
+    for (path, key) in [
+        (Path::new(&part_0), "denoiser"),
+        (Path::new(&merged_exr), "denoiser"),
+        (merged_denoised.as_path(), "denoiser"),
+        (merged_denoised.as_path(), "denoised_by"),
+        (render_denoised.as_path(), "denoised_by"),
+    ] {
+        assert_eq!(header(path, key), recorded, "{} {key}", path.display());
+    }
+    assert_eq!(header(&merged_denoised, "spp"), SPP);
+
+    let fast = file("fast-1.exr");
+    render("sobol", &fast, &[&["--part", "1/2"][..], &FAST].concat());
+    let err = merge_error(&[&part_0, &fast], &file("refused.exr"));
+    assert!(
+        err.contains("fast-1.exr")
+            && err.contains(
+                "the [denoiser] { quality = \"fast\", type = \"oidn\" }, \
+                 not the [denoiser] { quality = \"balanced\", type = \"oidn\" }"
+            ),
+        "{err}"
+    );
+    // A part whose denoiser this lumis does not have: refused before the
+    // merge writes anything.
+    let whole_part = file("whole-part.exr");
+    render(
+        "sobol",
+        &whole_part,
+        &[&["--part", "0/1"][..], &BALANCED].concat(),
+    );
+    let foreign = file("foreign.exr");
+    let mut attributes = lumis_image::read_exr_metadata(Path::new(&whole_part)).unwrap();
+    for (name, value) in &mut attributes {
+        if name == "lumis.denoiser" {
+            *value = "{ type = \"nlm\" }".into();
+        }
+    }
+    let (_, channels) = lumis_image::read_exr_uint_channels(Path::new(&whole_part)).unwrap();
+    let uints: Vec<lumis_image::ExrUintChannel> = channels
+        .iter()
+        .map(|(name, values)| lumis_image::ExrUintChannel { name, values })
+        .collect();
+    let colour = lumis_image::read_exr(Path::new(&whole_part)).unwrap();
+    lumis_image::stage_exr_with_channels(Path::new(&foreign), &colour, &[], &uints, &attributes)
+        .unwrap()
+        .commit()
+        .unwrap();
+    let err = merge_error(&[&foreign], &file("refused.exr"));
+    assert!(
+        err.contains("foreign.exr' header lumis.denoiser = { type = \"nlm\" }: unknown denoiser type \"nlm\"")
+            && err.contains("available: oidn"),
+        "{err}"
+    );
+    assert!(!tmp.path().join("refused.exr").exists());
+    let plain = file("plain-1.exr");
+    render("sobol", &plain, &["--part", "1/2"]);
+    let err = merge_error(&[&part_0, &plain], &file("refused.exr"));
+    assert!(
+        err.contains("plain-1.exr") && err.contains("no [denoiser], not the [denoiser] { quality"),
+        "{err}"
+    );
+}

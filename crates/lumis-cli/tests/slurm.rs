@@ -3,7 +3,8 @@
 //! over a job array equals, bit for bit, one process rendering with passes
 //! at the parts' boundaries; a part whose task is cancelled keeps the merge
 //! from running (`afterok`), `lumis merge` refuses the gap by name, and
-//! `lumis slurm status --resubmit` renders exactly that part again.
+//! `lumis slurm status --resubmit` renders exactly that part again. The
+//! merge job denoises the image as one process does.
 //!
 //! Where Slurm cannot run (slurm-wlm or munge not installed, a daemon that
 //! does not start), the test says why on stderr and returns (`cargo test
@@ -22,6 +23,8 @@ use lumis_cli::SlurmManifest;
 const PARTS: u32 = 4;
 const SPP: &str = "16";
 const RESOLUTION: &str = "film.resolution=[32, 32]";
+/// The merge job denoises the merged image as `lumis render` would.
+const DENOISER: &str = "denoiser.type=\"oidn\"";
 /// How long a job may take on a loaded machine before the test gives up
 /// and shows the cluster's logs.
 const PATIENCE: Duration = Duration::from_secs(300);
@@ -132,7 +135,8 @@ fn submit(cluster: &Cluster, run: &Path) -> SlurmManifest {
     let out = run.display().to_string();
     let tasks = PARTS.to_string();
     let args = [
-        "slurm", &scene, "--tasks", &tasks, "--spp", SPP, "--set", RESOLUTION, "--out", &out,
+        "slurm", &scene, "--tasks", &tasks, "--spp", SPP, "--set", RESOLUTION, "--set", DENOISER,
+        "--out", &out,
     ];
     let output = cluster.lumis(&args);
     assert!(output.status.success(), "{output:?}");
@@ -156,7 +160,8 @@ fn single_process_render(dir: &Path) -> PathBuf {
     let parts = PARTS.to_string();
     let scene = scene("bench/cornell-box.toml");
     let args = [
-        "render", &scene, "--spp", SPP, "--parts", &parts, "--set", RESOLUTION, "-q", "-o", &out,
+        "render", &scene, "--spp", SPP, "--parts", &parts, "--set", RESOLUTION, "--set", DENOISER,
+        "-q", "-o", &out,
     ];
     let output = lumis(&args);
     assert!(output.status.success(), "{output:?}");
@@ -233,11 +238,18 @@ fn a_job_array_renders_the_image_of_one_process_and_resubmits_a_lost_part() {
     let run = work.path().join("whole");
     submit(&cluster, &run);
     let image = run.join("cornell-box.exr");
-    cluster.wait(&run, "the merged image", || image.is_file());
+    let denoised = run.join("cornell-box.denoised.exr");
+    // Written after the image.
+    cluster.wait(&run, "the denoised image", || denoised.is_file());
     assert_eq!(
         exr_pixels(&image),
         exr_pixels(&single),
         "the parts merged on Slurm differ from one process's render"
+    );
+    assert_eq!(
+        exr_pixels(&denoised),
+        exr_pixels(single.with_extension("denoised.exr")),
+        "the merge job's denoised image differs from one process's"
     );
 
     // A run whose task 2 is cancelled before it starts: the node is

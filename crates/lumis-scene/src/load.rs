@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use lumis_core::doc;
 use lumis_core::files::{read_text_bounded, FileKind, MIB};
-use lumis_core::{Denoiser, Error, Integrator, LightSampler, Location, Registry, Result, Sampler};
+use lumis_core::{
+    Denoiser, Error, Integrator, LightSampler, Location, PluginEntity, Registry, Result, Sampler,
+};
 use lumis_render::{Aov, PerspectiveCamera};
 
 use crate::assembly::assemble;
@@ -24,7 +26,7 @@ pub struct LoadedScene {
     pub sampler: Box<dyn Sampler>,
     pub integrator: Box<dyn Integrator>,
     /// `[denoiser]`, run on the finished film; the raw render is kept too.
-    pub denoiser: Option<Box<dyn Denoiser>>,
+    pub denoiser: Option<SceneDenoiser>,
     pub seed: u64,
     /// `film.output`, resolved against the scene file's directory.
     pub output: Option<PathBuf>,
@@ -35,6 +37,15 @@ pub struct LoadedScene {
     pub clamp: Option<f32>,
     /// `sampler.adaptive`, its `max_spp` the sampler's spp.
     pub adaptive: Option<lumis_render::AdaptiveSampling>,
+}
+
+/// A scene's `[denoiser]`: the plugin, and the entity it was made from
+/// (its `type` and parameters, overrides applied), which a render records
+/// in its images so that a merge of its parts, or `lumis denoise`, makes
+/// the same one.
+pub struct SceneDenoiser {
+    pub denoiser: Box<dyn Denoiser>,
+    pub entity: PluginEntity,
 }
 
 /// A scene is text a person writes: far below this bound, which refuses
@@ -153,7 +164,10 @@ pub fn load_str(
         camera: description.camera,
         sampler: plugins.sampler,
         integrator: plugins.integrator,
-        denoiser: plugins.denoiser,
+        denoiser: plugins
+            .denoiser
+            .zip(description.denoiser)
+            .map(|(denoiser, entity)| SceneDenoiser { denoiser, entity }),
         seed: description.seed,
         output: description.film.output,
         aovs,

@@ -8,16 +8,18 @@
 //! under a temporary name renamed into place, so the image of a task that
 //! fails or is killed is never taken for a finished part.
 //!
-//! Each script first removes its output's lock (`PATH.exr.lock`): the lock
-//! names a process by its id, which means something only on the node that
-//! wrote it, so the lock a killed task left would stop the task that
-//! replaces it on another node. Slurm runs one task per part at a time
+//! Each script first removes its outputs' locks (`PATH.exr.lock`, and the
+//! merge's `PATH.denoised.exr.lock` too): a lock names a process by its
+//! id, which means something only on the node that wrote it, so the lock
+//! a killed task left would stop the task that replaces it on another
+//! node. Slurm runs one task per part at a time
 //! (`lumis slurm status` resubmits only parts whose task ended).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use super::manifest::Manifest;
+use crate::denoise::denoised_paths;
 
 /// The job array's script, in the run directory.
 pub const RENDER_SCRIPT: &str = "render.sbatch";
@@ -66,9 +68,11 @@ pub fn render_script(manifest: &Manifest, dir: &Path) -> String {
 }
 
 /// The merge job: `lumis merge` over every part, which refuses a missing
-/// or foreign part by name.
+/// or foreign part by name, and writes the denoised image too when the
+/// scene has a `[denoiser]` (so both outputs' locks are removed first).
 pub fn merge_script(manifest: &Manifest, dir: &Path) -> String {
     let parts: Vec<String> = (0..manifest.parts).map(Manifest::part_name).collect();
+    let (denoised, _) = denoised_paths(Path::new(&manifest.image));
     format!(
         "#!/bin/sh\n\
          # Written by `lumis slurm`: merges the {count} parts into {image}.\n\
@@ -76,11 +80,12 @@ pub fn merge_script(manifest: &Manifest, dir: &Path) -> String {
          #SBATCH --output={LOG_DIR}/merge-%j.out\n\
          set -eu\n\
          cd {dir}\n\
-         rm -f {lock}\n\
+         rm -f {lock} {denoised_lock}\n\
          {lumis} merge {parts} -o {image}\n",
         count = manifest.parts,
         image = quote(&manifest.image),
         lock = quote(&format!("{}.lock", manifest.image)),
+        denoised_lock = quote(&format!("{}.lock", denoised.display())),
         name = job_name("merge", &manifest.scene),
         dir = quote(&dir.to_string_lossy()),
         lumis = quote(&manifest.lumis.to_string_lossy()),
@@ -184,6 +189,10 @@ mod tests {
             script.contains(
                 "'/shared/bin/lumis' merge part-0.exr part-1.exr part-2.exr part-3.exr -o 'box.exr'\n"
             ),
+            "{script}"
+        );
+        assert!(
+            script.contains("rm -f 'box.exr.lock' 'box.denoised.exr.lock'\n"),
             "{script}"
         );
     }
