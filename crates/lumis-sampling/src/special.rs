@@ -356,12 +356,7 @@ pub fn sin_cos_turns<F: Real>(t: F) -> (F, F) {
 /// the sign of `y`.
 #[inline]
 pub fn atan2<F: Real>(y: F, x: F) -> F {
-    const P: [f32; 4] = [
-        -0.333_329_5,
-        0.199_777_11,
-        -0.138_776_85,
-        0.080_537_446,
-    ];
+    const P: [f32; 4] = [-0.333_329_5, 0.199_777_11, -0.138_776_85, 0.080_537_446];
     const TAN_PI_8: f32 = 0.414_213_57;
     let s = F::splat;
     let (ax, ay) = (x.abs(), y.abs());
