@@ -7,6 +7,7 @@
 
 pub mod distribution;
 pub mod distribution2d;
+pub mod guide_table;
 pub mod halfdiff;
 pub mod mis;
 pub mod pdv;
@@ -25,6 +26,7 @@ pub mod warp;
 
 pub use distribution::Distribution1D;
 pub use distribution2d::Distribution2D;
+pub use guide_table::GuideTable;
 pub use mis::{balance_heuristic, power_heuristic};
 pub use permutation::permutation_element;
 pub use radical_inverse::{

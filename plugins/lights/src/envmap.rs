@@ -127,8 +127,8 @@ impl EnvMapLight {
     /// The scaled radiance arriving along `-w` (world).
     #[inline]
     fn radiance(&self, w: Vec3) -> Rgb {
-        let d = self.to_world.inverse() * w;
-        self.map.lookup(Equirect::uv_of(d.normalize())) * self.scale
+        let (uv, _) = Equirect::uv_of(self.to_world.inverse() * w);
+        self.map.lookup(uv) * self.scale
     }
 
     /// A point beyond the scene's bounding sphere along `wi`, for the
@@ -186,8 +186,11 @@ impl Light for EnvMapLight {
     }
 
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        let (wi, pdf) = match &self.distribution {
-            None => (warp::square_to_uniform_sphere(u), warp::UNIFORM_SPHERE_PDF),
+        let (wi, pdf, l) = match &self.distribution {
+            None => {
+                let wi = warp::square_to_uniform_sphere(u);
+                (wi, warp::UNIFORM_SPHERE_PDF, self.radiance(wi))
+            }
             Some(distribution) => {
                 // A black map has nothing to draw.
                 if distribution.integral() == 0.0 {
@@ -198,14 +201,17 @@ impl Light for EnvMapLight {
                 if !(sin_theta > 0.0 && pdf_uv > 0.0) {
                     return None;
                 }
+                // The radiance at the drawn point itself: the same as
+                // looking up `wi`, without mapping it back.
                 (
                     (self.to_world * d).normalize(),
                     pdf_uv / (2.0 * PI * PI * sin_theta),
+                    self.map.lookup(uv) * self.scale,
                 )
             }
         };
         Some(LightSample {
-            l: self.radiance(wi),
+            l,
             wi,
             pdf,
             p: self.far_point(ctx, wi),
@@ -219,12 +225,11 @@ impl Light for EnvMapLight {
         if distribution.integral() == 0.0 {
             return 0.0;
         }
-        let d = (self.to_world.inverse() * wi).normalize();
-        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+        let (uv, sin_theta) = Equirect::uv_of((self.to_world.inverse() * wi).normalize());
         if sin_theta.is_nan() || sin_theta <= 0.0 {
             return 0.0;
         }
-        distribution.pdf(Equirect::uv_of(d)) / (2.0 * PI * PI * sin_theta)
+        distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
     }
 
     fn l(&self, _p: Vec3, _n: Vec3, _uv: Vec2, w: Vec3) -> Rgb {

@@ -1,7 +1,8 @@
 //! The `envmap` light: `sample_li` draws directions with the density
 //! `pdf_li` reports (chi-square) on smooth, spiky, sparse, single-texel and
 //! large maps; that density is positive wherever the bilinear radiance is;
-//! the map is oriented as Mitsuba's `envmap`; and bad files are refused
+//! the map is oriented as Mitsuba's `envmap`, its coordinates are those
+//! of the double-precision formulas; and bad files are refused
 //! with errors naming the key and the file.
 
 use std::path::Path;
@@ -234,6 +235,56 @@ fn the_map_is_oriented_as_mitsubas() {
     // `up` turns the top row toward +z.
     let turned = self::light(m, Quat::from_rotation_arc(Vec3::Y, Vec3::Z));
     assert!((turned.l(Vec3::ZERO, Vec3::ZERO, Vec2::ZERO, -Vec3::Z).r - 20.0).abs() < 1e-4);
+}
+
+/// `uv_of` (two single-precision `atan2`s) and `direction_of` (sines in
+/// turns) against the double-precision formulas: over a grid of `uv`
+/// that takes in the poles (`v = 0, 1`), the seam (`u = 0, 1`) and the
+/// texel edges of common map sizes, directions within 3e-7 and
+/// coordinates within 1e-6 (`u` modulo 1, and any `u` at the poles);
+/// `sin theta` within 3e-7.
+#[test]
+fn map_coordinates_match_double_precision_at_the_poles_and_the_seam() {
+    let pi = std::f64::consts::PI;
+    let n = 2048;
+    let mut values: Vec<f32> = (0..=n).map(|k| k as f32 / n as f32).collect();
+    values.extend([1e-7, 1e-5, 0.5 - 1e-7, 0.5 + 1e-7, 1.0 - 1e-7, 1.0 - 1e-5]);
+    for &v in &values {
+        for &u in values.iter().step_by(7).chain(&values[n..]) {
+            let (theta, phi) = (pi * v as f64, 2.0 * pi * u as f64);
+            let exact = [
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                -theta.sin() * phi.cos(),
+            ];
+            let (d, sin_theta) = Equirect::direction_of(Vec2::new(u, v));
+            for (got, exact) in d.to_array().iter().zip(exact) {
+                assert!(
+                    (*got as f64 - exact).abs() < 3e-7,
+                    "direction_of({u}, {v}) = {d}, exact {exact:?}"
+                );
+            }
+            assert!((sin_theta as f64 - theta.sin()).abs() < 3e-7);
+            // Back from the exact direction rounded to f32.
+            let exact = Vec3::new(exact[0] as f32, exact[1] as f32, exact[2] as f32);
+            let (uv, sin_theta) = Equirect::uv_of(exact);
+            assert!(
+                (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y),
+                "{uv}"
+            );
+            assert!(
+                (uv.y - v).abs() < 1e-6,
+                "uv_of({exact}) = {uv}, exact v {v}"
+            );
+            assert!((sin_theta as f64 - theta.sin()).abs() < 3e-7);
+            let du = (uv.x - u).abs();
+            let at_pole = theta.sin() < 1e-6;
+            assert!(
+                at_pole || du.min(1.0 - du) < 1e-6,
+                "uv_of({exact}) = {uv}, exact u {u}"
+            );
+        }
+    }
 }
 
 /// pbrt-v4's `Phi`: `pi r^2` times the integral of radiance over the

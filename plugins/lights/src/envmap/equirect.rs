@@ -7,6 +7,19 @@
 use std::f32::consts::PI;
 
 use lumis_core::{Rgb, Vec2, Vec3};
+use lumis_sampling::special::{atan2, sin_cos_turns};
+
+/// `floor(x)` as an integer, without the library call `f32::floor` makes
+/// on baseline x86-64 (no `roundss`); NaN gives 0.
+#[inline]
+fn floor(x: f32) -> i64 {
+    let t = x as i64;
+    if t as f32 > x {
+        t - 1
+    } else {
+        t
+    }
+}
 
 /// The texels of a map, bilinearly interpolated between texel centres:
 /// wrapped in `u`, clamped in `v`.
@@ -42,20 +55,24 @@ impl Equirect {
         self.texels[y * self.width + x]
     }
 
-    /// The map's coordinates of the direction `d` (unit, map frame).
+    /// The map's coordinates of the direction `d` (map frame; any
+    /// length), and its `sin theta` if `d` is unit. Both angles come from
+    /// `atan2`, which keeps `theta` accurate at the poles where `acos`
+    /// of `d.y` would not.
     #[inline]
-    pub fn uv_of(d: Vec3) -> Vec2 {
-        let u = d.x.atan2(-d.z) * (0.5 / PI);
+    pub fn uv_of(d: Vec3) -> (Vec2, f32) {
+        let sin_theta = (d.x * d.x + d.z * d.z).sqrt();
+        let u = atan2(d.x, -d.z) * (0.5 / PI);
         let u = if u < 0.0 { u + 1.0 } else { u };
-        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
-        Vec2::new(u.min(1.0), v)
+        let v = atan2(sin_theta, d.y) * (1.0 / PI);
+        (Vec2::new(u.min(1.0), v), sin_theta)
     }
 
     /// The direction (map frame) at `uv`, and its `sin theta`.
     #[inline]
     pub fn direction_of(uv: Vec2) -> (Vec3, f32) {
-        let (sin_theta, cos_theta) = (uv.y * PI).sin_cos();
-        let (sin_phi, cos_phi) = (uv.x * 2.0 * PI).sin_cos();
+        let (sin_theta, cos_theta) = sin_cos_turns(0.5 * uv.y);
+        let (sin_phi, cos_phi) = sin_cos_turns(uv.x);
         let d = Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi);
         (d, sin_theta)
     }
@@ -65,13 +82,15 @@ impl Equirect {
     pub fn lookup(&self, uv: Vec2) -> Rgb {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (floor(x), floor(y));
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
         let w = self.width as i64;
-        let wrap = |i: i64| i.rem_euclid(w) as usize;
+        // Inside the map but for the seam's neighbour: the division of
+        // `rem_euclid` only off the common path.
+        let wrap = |i: i64| if (0..w).contains(&i) { i } else { i.rem_euclid(w) } as usize;
         let clamp = |j: i64| j.clamp(0, self.height as i64 - 1) as usize;
-        let (xa, xb) = (wrap(x0 as i64), wrap(x0 as i64 + 1));
-        let (ya, yb) = (clamp(y0 as i64), clamp(y0 as i64 + 1));
+        let (xa, xb) = (wrap(x0), wrap(x0 + 1));
+        let (ya, yb) = (clamp(y0), clamp(y0 + 1));
         let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
         let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
