@@ -328,11 +328,14 @@ impl Bsdf for Plastic {
         } else {
             BsdfFlags::DIFFUSE_REFLECTION
         };
+        // `pdf` and `f` as `Self::eval` gives them (`reflection` rejects
+        // `wi` below the surface first), sharing `fo` and the half vector.
+        let half = base.coat.as_ref().and_then(|_| half_vector(wo, wi));
         BsdfSample::reflection(
             wi,
             flags,
-            |wi| self.eval_pdf(&base, wo, wi),
-            |wi| self.eval_f(&base, wo, wi),
+            |wi| self.pdf_above(&base, fo, half, wo, wi),
+            |wi| self.f_above(&base, fo, half, wo, wi),
         )
     }
 

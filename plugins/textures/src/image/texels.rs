@@ -17,10 +17,23 @@ pub enum Wrap {
 
 impl Wrap {
     /// The texel index that `i` refers to in a row (or column) of `n`.
-    #[inline]
+    #[inline(always)]
     pub fn index(self, i: i64, n: usize) -> usize {
+        // Every mode leaves an index inside the row where it is: most
+        // lookups, and no division for them.
+        if (0..n as i64).contains(&i) {
+            i as usize
+        } else {
+            self.index_outside(i, n)
+        }
+    }
+
+    /// [`Self::index`] of an `i` outside `0..n`.
+    fn index_outside(self, i: i64, n: usize) -> usize {
         let n = n as i64;
         (match self {
+            // A power-of-two width (most textures) needs no division.
+            Wrap::Repeat if n.count_ones() == 1 => i & (n - 1),
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::Mirror => {
                 let m = i.rem_euclid(2 * n);
@@ -89,8 +102,12 @@ impl Texels {
     /// The texel at integer coordinates `(x, y)`, wrapped in u and in v.
     #[inline]
     pub fn texel(&self, x: i64, y: i64, wrap: [Wrap; 2]) -> Rgb {
-        let x = wrap[0].index(x, self.width);
-        let y = wrap[1].index(y, self.height);
+        self.at(wrap[0].index(x, self.width), wrap[1].index(y, self.height))
+    }
+
+    /// The texel at column `x` and row `y`, both inside the image.
+    #[inline]
+    fn at(&self, x: usize, y: usize) -> Rgb {
         let i = y * self.width + x;
         match &self.values {
             TexelValues::Linear(values) => values[i],
@@ -136,9 +153,11 @@ impl Texels {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
-        (1.0 - fy) * ((1.0 - fx) * self.texel(x0, y0, wrap) + fx * self.texel(x0 + 1, y0, wrap))
-            + fy * ((1.0 - fx) * self.texel(x0, y0 + 1, wrap)
-                + fx * self.texel(x0 + 1, y0 + 1, wrap))
+        // Two columns and two rows, each wrapped once for the four texels.
+        let [x0, x1] = [x0, x0 + 1].map(|x| wrap[0].index(x, self.width));
+        let [y0, y1] = [y0, y0 + 1].map(|y| wrap[1].index(y, self.height));
+        (1.0 - fy) * ((1.0 - fx) * self.at(x0, y0) + fx * self.at(x1, y0))
+            + fy * ((1.0 - fx) * self.at(x0, y1) + fx * self.at(x1, y1))
     }
 }
 
@@ -168,6 +187,26 @@ mod tests {
         assert_eq!(indices(Wrap::Repeat), [2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0]);
         assert_eq!(indices(Wrap::Mirror), [2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0]);
         assert_eq!(indices(Wrap::Clamp), [0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2]);
+    }
+
+    #[test]
+    fn every_wrap_agrees_with_its_definition_on_any_width() {
+        // Power-of-two widths take a shortcut for repeat; every width takes
+        // one for indices inside the row.
+        for n in [1, 2, 3, 4, 5, 8, 64, 100] {
+            let m = n as i64;
+            for i in -3 * m - 2..3 * m + 2 {
+                assert_eq!(Wrap::Repeat.index(i, n), i.rem_euclid(m) as usize);
+                let mirrored = i.rem_euclid(2 * m);
+                let mirrored = if mirrored >= m {
+                    2 * m - 1 - mirrored
+                } else {
+                    mirrored
+                };
+                assert_eq!(Wrap::Mirror.index(i, n), mirrored as usize);
+                assert_eq!(Wrap::Clamp.index(i, n), i.clamp(0, m - 1) as usize);
+            }
+        }
     }
 
     #[test]
