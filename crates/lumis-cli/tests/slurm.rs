@@ -38,7 +38,9 @@ struct Cluster {
 impl Cluster {
     /// Starts the cluster, or `None` with the reason it cannot run here.
     fn start() -> Result<Self, String> {
-        let dir = scratch("slurm-cluster");
+        stop_orphaned_clusters();
+        let dir = scratch(CLUSTER_DIR);
+        std::fs::write(dir.path().join(OWNER_FILE), std::process::id().to_string()).unwrap();
         let output = Command::new("bash")
             .arg(script())
             .args(["start".as_ref(), dir.path().as_os_str()])
@@ -122,6 +124,40 @@ impl Drop for Cluster {
             .arg(script())
             .args(["stop".as_ref(), self.dir.path().as_os_str()])
             .status();
+    }
+}
+
+/// The cluster's scratch directory name, and the file in it that holds the
+/// process id of the test that started it.
+const CLUSTER_DIR: &str = "slurm-cluster";
+const OWNER_FILE: &str = "owner.pid";
+
+/// Stops the clusters of earlier test runs that were killed before their
+/// `Drop` could (their owner is gone), and removes their directories: a
+/// killed test would otherwise leave munged, slurmctld and slurmd running.
+/// A cluster whose test still runs (another clone's, say) is left alone.
+fn stop_orphaned_clusters() {
+    let prefix = format!("lumis-cli-{CLUSTER_DIR}-");
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else {
+        return;
+    };
+    for dir in entries.flatten().map(|e| e.path()) {
+        let ours = dir
+            .file_name()
+            .is_some_and(|n| n.to_string_lossy().starts_with(&prefix));
+        let owner = std::fs::read_to_string(dir.join(OWNER_FILE)).unwrap_or_default();
+        let owner_alive = Path::new("/proc").join(owner.trim()).exists();
+        if ours && !owner.trim().is_empty() && !owner_alive {
+            eprintln!(
+                "stopping the cluster a killed test left in {}",
+                dir.display()
+            );
+            let _ = Command::new("bash")
+                .arg(script())
+                .args(["stop".as_ref(), dir.as_os_str()])
+                .status();
+            let _ = std::fs::remove_dir_all(&dir);
+        }
     }
 }
 
