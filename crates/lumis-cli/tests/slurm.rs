@@ -146,8 +146,7 @@ fn stop_orphaned_clusters() {
             .file_name()
             .is_some_and(|n| n.to_string_lossy().starts_with(&prefix));
         let owner = std::fs::read_to_string(dir.join(OWNER_FILE)).unwrap_or_default();
-        let owner_alive = Path::new("/proc").join(owner.trim()).exists();
-        if ours && !owner.trim().is_empty() && !owner_alive {
+        if ours && !owner.trim().is_empty() && !running(owner.trim()) {
             eprintln!(
                 "stopping the cluster a killed test left in {}",
                 dir.display()
@@ -159,6 +158,15 @@ fn stop_orphaned_clusters() {
             let _ = std::fs::remove_dir_all(&dir);
         }
     }
+}
+
+/// Whether process `pid` runs: it exists and is not a zombie (a killed
+/// process whose parent has not reaped it yet).
+fn running(pid: &str) -> bool {
+    std::fs::read_to_string(Path::new("/proc").join(pid).join("stat"))
+        .ok()
+        .and_then(|stat| Some(stat.get(stat.rfind(')')? + 2..)?.starts_with('Z')))
+        .is_some_and(|zombie| !zombie)
 }
 
 fn script() -> PathBuf {
