@@ -1,30 +1,11 @@
 //! The `lumis` binary as a user runs it.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Command;
 
-fn lumis(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lumis"))
-        .args(args)
-        .output()
-        .expect("lumis runs")
-}
-
-fn scene(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-/// A fresh directory for one test's files, removed when the test ends.
-fn scratch(name: &str) -> tempfile::TempDir {
-    tempfile::Builder::new()
-        .prefix(&format!("lumis-cli-{name}-"))
-        .tempdir()
-        .unwrap()
-}
+use common::*;
 
 #[test]
 fn help_documents_every_flag() {
@@ -358,12 +339,7 @@ fn samplers_analyze_writes_pictures_points_and_a_convergence_table() {
         "--dump",
         dump.to_str().unwrap(),
     ]);
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let stdout = stdout_of_success(&run);
     for file in [
         "sobol-points.png",
         "sobol-points-d2-d3.png",
@@ -402,12 +378,7 @@ fn lecture_writes_its_figures_and_tables() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let stdout = stdout_of_success(&run);
     for file in [
         "stratified-variance-gaussian.png",
         "stratified-variance-disk.png",
@@ -500,12 +471,7 @@ fn diff_prints_known_numbers_per_region_and_refuses_other_sizes() {
         "--error-image",
         picture.to_str().unwrap(),
     ]);
-    let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let stdout = stdout_of_success(&run);
     let image_row = stdout.lines().find(|l| l.starts_with("image")).unwrap();
     let numbers: Vec<f64> = image_row
         .split_whitespace()

@@ -13,6 +13,18 @@ pub fn lumis(args: &[&str]) -> Output {
         .expect("lumis runs")
 }
 
+/// The standard output of a `lumis` run that must have succeeded; fails
+/// showing both outputs if it did not.
+pub fn stdout_of_success(run: &Output) -> String {
+    let stdout = String::from_utf8_lossy(&run.stdout).into_owned();
+    assert!(
+        run.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    stdout
+}
+
 /// Starts `lumis` without waiting, its output captured.
 pub fn spawn(args: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_lumis"))
