@@ -275,7 +275,7 @@ fn check_lanes(
     let mut lanes = s.lanes(n);
     let order: Vec<usize> = (0..n).collect();
     for (i, _) in forward.iter().enumerate() {
-        let lane = lanes.lane(i);
+        let mut lane = lanes.lane(i);
         lane.start_pixel_sample(pixel, i as u32, seed);
         lane.get_pixel_2d();
     }

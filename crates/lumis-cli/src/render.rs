@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
-use lumis_render::profile::{Profile, ProfileReport, ProfiledSampler, ProfiledScene};
+use lumis_render::profile::{profiled_sampler, profiled_scene, Profile, ProfileReport};
 use lumis_render::{
     progress_units, render_pass, Aov, Film, PassContext, RenderPool, RenderProgress,
 };
@@ -461,10 +461,10 @@ pub fn render_scene_file(
     if args.stats {
         loaded.scene = loaded.scene.into_profiled();
     }
-    let profiled_scene = ProfiledScene(&loaded.scene);
+    let profiled_scene = profiled_scene(&loaded.scene);
     let profiled_sampler = args
         .stats
-        .then(|| ProfiledSampler(loaded.sampler.clone_sampler()));
+        .then(|| profiled_sampler(loaded.sampler.clone_sampler()));
     let (scene, sampler): (&dyn Scene, &dyn Sampler) = match &profiled_sampler {
         Some(sampler) => (&profiled_scene, sampler),
         None => (&loaded.scene, loaded.sampler.as_ref()),

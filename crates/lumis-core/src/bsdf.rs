@@ -1,6 +1,7 @@
 //! The BSDF plugin interface (pbrt-v4 `BxDF`), in the local shading frame.
 
 use glam::{Vec2, Vec3};
+use lumis_derive::plugin_interface;
 
 use crate::spectrum::Rgb;
 use crate::texture::TextureQuery;
@@ -116,6 +117,7 @@ impl BsdfSample {
 /// Directions point away from the surface. `f` excludes the cosine factor;
 /// `pdf` is a density w.r.t. solid angle and must describe exactly the
 /// distribution `sample_f` draws from (the chi-square tests check this).
+#[plugin_interface]
 pub trait Bsdf: Send + Sync {
     fn flags(&self) -> BsdfFlags;
 
@@ -150,6 +152,7 @@ pub trait Bsdf: Send + Sync {
     /// `sample_f`; an override computes the lanes together (SIMD) and must
     /// return what `sample_f` returns up to rounding (the check kit
     /// compares). All slices have the length of `out`.
+    #[on_fault(out.fill(None))]
     fn sample_f_batch(
         &self,
         ctx: &[BsdfContext],
@@ -166,6 +169,7 @@ pub trait Bsdf: Send + Sync {
     /// [`Bsdf::eval`] for each lane of a batch: `out[i]` is
     /// `eval(&ctx[i], wo[i], wi[i])`. Same contract as
     /// [`Bsdf::sample_f_batch`].
+    #[on_fault(out.fill((Rgb::BLACK, 0.0)))]
     fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
         for (i, out) in out.iter_mut().enumerate() {
             *out = self.eval(&ctx[i], wo[i], wi[i]);

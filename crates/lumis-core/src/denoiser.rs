@@ -5,6 +5,7 @@
 //! raw render next to it.
 
 use crate::error::{Error, Result};
+use lumis_derive::plugin_interface;
 
 /// A finished film as a denoiser reads it: the colour and, when the film
 /// produced them, the first non-specular hit's albedo and shading normal
@@ -69,9 +70,11 @@ impl DenoiseInput<'_> {
 }
 
 /// A post-process that turns a noisy film into a smoother image.
+#[plugin_interface]
 pub trait Denoiser: Send + Sync {
     /// The denoised colour, `width * height` pixels; an error (never a
     /// panic) when the input is invalid or the denoiser fails.
+    #[on_fault(Err(fault.into_error()))]
     fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>>;
 }
 

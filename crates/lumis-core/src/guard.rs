@@ -20,22 +20,9 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
-use glam::{UVec2, Vec2, Vec3};
-
-use crate::bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample};
-use crate::denoiser::{DenoiseInput, Denoiser};
 use crate::error::{Error, Result};
-use crate::integrator::Integrator;
-use crate::interaction::LightSampleContext;
-use crate::light::{Light, LightKind, LightSample};
-use crate::light_sampler::{LightSampler, SampledLight};
-use crate::ray::Ray;
 use crate::registry::Registry;
-use crate::sampler::{Sampler, SamplerLanes};
-use crate::scene::Scene;
-use crate::spectrum::Rgb;
-use crate::stats::RenderStats;
-use crate::texture::{Texture, TextureQuery};
+use crate::wrap::{CallHook, Fault, Wrapped};
 
 /// The faults of guarded plugins; shared by a registry and every guard it
 /// made.
@@ -155,267 +142,56 @@ impl PluginGuard {
     }
 }
 
-/// A guarded plugin: its guard and how messages name it. Once it has
-/// panicked it is not called again: its state may be broken, and each
-/// further panic would cost as much as the work it interrupts.
-pub struct Guarded<P> {
-    inner: P,
+/// The hook of a guarded plugin: its guard and how messages name it. Once
+/// the plugin has panicked it is not called again: its state may be
+/// broken, and each further panic would cost as much as the work it
+/// interrupts.
+pub struct Guard {
     guard: PluginGuard,
     label: Arc<str>,
     tripped: AtomicBool,
 }
 
-impl<P> Guarded<P> {
+impl Guard {
     /// `label` names the plugin in messages, with its parameters.
-    pub fn new(inner: P, guard: PluginGuard, label: Arc<str>) -> Self {
+    pub fn new(guard: PluginGuard, label: Arc<str>) -> Self {
         Self {
-            inner,
             guard,
             label,
             tripped: AtomicBool::new(false),
         }
     }
+}
 
-    fn value<T>(&self, method: &str, neutral: T, f: impl FnOnce(&P) -> T) -> T {
+impl CallHook for Guard {
+    #[inline]
+    fn call<T>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
         if self.tripped.load(Ordering::Relaxed) {
-            return neutral;
+            return Err(Fault::Tripped);
         }
-        let inner = &self.inner;
-        self.guard
-            .call(&self.label, method, || f(inner))
-            .unwrap_or_else(|_| {
-                self.tripped.store(true, Ordering::Relaxed);
-                neutral
-            })
-    }
-
-    fn value_mut<T>(&mut self, method: &str, neutral: T, f: impl FnOnce(&mut P) -> T) -> T {
-        if *self.tripped.get_mut() {
-            return neutral;
-        }
-        let inner = &mut self.inner;
-        match self.guard.call(&self.label, method, || f(inner)) {
-            Ok(value) => value,
-            Err(_) => {
-                *self.tripped.get_mut() = true;
-                neutral
-            }
-        }
-    }
-}
-
-impl Bsdf for Guarded<Arc<dyn Bsdf>> {
-    fn flags(&self) -> BsdfFlags {
-        self.value("Bsdf::flags", BsdfFlags::NONE, |b| b.flags())
-    }
-    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        self.value("Bsdf::f", Rgb::BLACK, |b| b.f(ctx, wo, wi))
-    }
-    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        self.value("Bsdf::sample_f", None, |b| b.sample_f(ctx, wo, u1, u2))
-    }
-    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        self.value("Bsdf::pdf", 0.0, |b| b.pdf(ctx, wo, wi))
-    }
-    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        self.value("Bsdf::eval", (Rgb::BLACK, 0.0), |b| b.eval(ctx, wo, wi))
-    }
-    fn sample_f_batch(
-        &self,
-        ctx: &[BsdfContext],
-        wo: &[Vec3],
-        u1: &[f32],
-        u2: &[Vec2],
-        out: &mut [Option<BsdfSample>],
-    ) {
-        let out_of_call = &mut *out;
-        let done = self.value("Bsdf::sample_f_batch", false, |b| {
-            b.sample_f_batch(ctx, wo, u1, u2, out_of_call);
-            true
-        });
-        if !done {
-            out.fill(None);
-        }
-    }
-    fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
-        let out_of_call = &mut *out;
-        let done = self.value("Bsdf::eval_batch", false, |b| {
-            b.eval_batch(ctx, wo, wi, out_of_call);
-            true
-        });
-        if !done {
-            out.fill((Rgb::BLACK, 0.0));
-        }
-    }
-}
-
-impl Texture for Guarded<Arc<dyn Texture>> {
-    fn eval(&self, query: &TextureQuery) -> Rgb {
-        self.value("Texture::eval", Rgb::BLACK, |t| t.eval(query))
-    }
-    fn eval_float(&self, query: &TextureQuery) -> f32 {
-        self.value("Texture::eval_float", 0.0, |t| t.eval_float(query))
-    }
-    fn uses_footprint(&self) -> bool {
-        self.value("Texture::uses_footprint", false, |t| t.uses_footprint())
-    }
-}
-
-impl Light for Guarded<Box<dyn Light>> {
-    fn kind(&self) -> LightKind {
-        self.inner.kind()
-    }
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        self.value("Light::sample_li", None, |l| l.sample_li(ctx, u))
-    }
-    fn sample_li_batch(
-        &self,
-        ctx: &[LightSampleContext],
-        u: &[Vec2],
-        out: &mut [Option<LightSample>],
-    ) {
-        let out_of_call = &mut *out;
-        let done = self.value("Light::sample_li_batch", false, |l| {
-            l.sample_li_batch(ctx, u, out_of_call);
-            true
-        });
-        if !done {
-            out.fill(None);
-        }
-    }
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
-        self.value("Light::pdf_li", 0.0, |l| l.pdf_li(ctx, wi))
-    }
-    fn l(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
-        self.value("Light::l", Rgb::BLACK, |l| l.l(p, n, uv, w))
-    }
-    fn power(&self) -> Rgb {
-        self.value("Light::power", Rgb::BLACK, |l| l.power())
-    }
-    fn preprocess(&mut self, scene_center: Vec3, scene_radius: f32) {
-        self.value_mut("Light::preprocess", (), |l| {
-            l.preprocess(scene_center, scene_radius)
+        self.guard.call(&self.label, method, call).map_err(|error| {
+            self.tripped.store(true, Ordering::Relaxed);
+            Fault::Panicked(error)
         })
     }
-}
 
-impl LightSampler for Guarded<Box<dyn LightSampler>> {
-    fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
-        self.value("LightSampler::sample", None, |s| s.sample(ctx, u))
-    }
-    fn pmf(&self, ctx: &LightSampleContext, index: u32) -> f32 {
-        self.value("LightSampler::pmf", 0.0, |s| s.pmf(ctx, index))
+    fn child(&self) -> Self {
+        Self::new(self.guard.clone(), self.label.clone())
     }
 }
 
-impl Sampler for Guarded<Box<dyn Sampler>> {
-    fn samples_per_pixel(&self) -> u32 {
-        self.value("Sampler::samples_per_pixel", 1, |s| s.samples_per_pixel())
-    }
-    fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
-        self.value_mut("Sampler::start_pixel_sample", (), |s| {
-            s.start_pixel_sample(pixel, index, seed)
-        })
-    }
-    fn get_1d(&mut self) -> f32 {
-        self.value_mut("Sampler::get_1d", 0.5, |s| s.get_1d())
-    }
-    fn get_2d(&mut self) -> Vec2 {
-        self.value_mut("Sampler::get_2d", Vec2::splat(0.5), |s| s.get_2d())
-    }
-    fn get_1d_2d(&mut self) -> (f32, Vec2) {
-        self.value_mut("Sampler::get_1d_2d", (0.5, Vec2::splat(0.5)), |s| {
-            s.get_1d_2d()
-        })
-    }
-    fn get_pixel_2d(&mut self) -> Vec2 {
-        self.value_mut("Sampler::get_pixel_2d", Vec2::splat(0.5), |s| {
-            s.get_pixel_2d()
-        })
-    }
-    fn clone_sampler(&self) -> Box<dyn Sampler> {
-        // A clone that panicked is replaced by this sampler's own clone
-        // under the same guard; the fault is recorded either way.
-        let clone = self.guard.call(&self.label, "Sampler::clone_sampler", || {
-            self.inner.clone_sampler()
-        });
-        match clone {
-            Ok(inner) => Box::new(Guarded::new(inner, self.guard.clone(), self.label.clone())),
-            Err(_) => Box::new(FaultedSampler(self.samples_per_pixel())),
-        }
-    }
-}
-
-/// What a sampler whose clone panicked draws: the centre of every
-/// dimension, until the host stops at the recorded fault.
-struct FaultedSampler(u32);
-
-impl Sampler for FaultedSampler {
-    fn samples_per_pixel(&self) -> u32 {
-        self.0
-    }
-    fn start_pixel_sample(&mut self, _: UVec2, _: u32, _: u64) {}
-    fn get_1d(&mut self) -> f32 {
-        0.5
-    }
-    fn get_2d(&mut self) -> Vec2 {
-        Vec2::splat(0.5)
-    }
-    fn get_pixel_2d(&mut self) -> Vec2 {
-        Vec2::splat(0.5)
-    }
-    fn clone_sampler(&self) -> Box<dyn Sampler> {
-        Box::new(FaultedSampler(self.0))
-    }
-}
-
-/// A panicking denoiser is an error: the host still has the raw render.
-impl Denoiser for Guarded<Box<dyn Denoiser>> {
-    fn denoise(&self, input: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
-        self.guard.call(&self.label, "Denoiser::denoise", || {
-            self.inner.denoise(input)
-        })?
-    }
-}
-
-impl Integrator for Guarded<Box<dyn Integrator>> {
-    fn li(
-        &self,
-        ray: &Ray,
-        scene: &dyn Scene,
-        sampler: &mut dyn Sampler,
-        stats: &mut RenderStats,
-    ) -> Rgb {
-        self.value("Integrator::li", Rgb::BLACK, |i| {
-            i.li(ray, scene, sampler, stats)
-        })
-    }
-    fn batch_size(&self) -> usize {
-        self.value("Integrator::batch_size", 1, |i| i.batch_size())
-            .max(1)
-    }
-    fn li_batch(
-        &self,
-        rays: &[Ray],
-        scene: &dyn Scene,
-        samplers: &mut dyn SamplerLanes,
-        stats: &mut RenderStats,
-        out: &mut [Rgb],
-    ) {
-        let out_of_call = &mut *out;
-        let done = self.value("Integrator::li_batch", false, |i| {
-            i.li_batch(rays, scene, samplers, stats, out_of_call);
-            true
-        });
-        if !done {
-            out.fill(Rgb::BLACK);
-        }
-    }
-}
+/// A loaded plugin object, every call of it guarded: `Guarded<Arc<dyn
+/// Bsdf>>` is a `Bsdf` (see [`crate::wrap`]).
+pub type Guarded<C> = Wrapped<C, Guard>;
 
 #[cfg(test)]
 mod tests {
+    use glam::{Vec2, Vec3};
+
     use super::*;
+    use crate::bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample};
+    use crate::denoiser::{DenoiseInput, Denoiser};
+    use crate::spectrum::Rgb;
 
     struct Faulty;
 
@@ -440,7 +216,10 @@ mod tests {
         let faults = Arc::new(FaultSink::default());
         let guard = PluginGuard::new("libfaulty.so", faults.clone());
         let bsdf: Arc<dyn Bsdf> = Arc::new(Faulty);
-        let guarded = Guarded::new(bsdf, guard, Arc::from("bsdf 'faulty' (sigma = 0.65)"));
+        let guarded = Guarded::new(
+            bsdf,
+            Guard::new(guard, Arc::from("bsdf 'faulty' (sigma = 0.65)")),
+        );
         let ctx = BsdfContext::default();
         assert_eq!(guarded.f(&ctx, Vec3::Z, Vec3::Z), Rgb::splat(0.25));
         assert!(faults.check().is_ok());
@@ -466,7 +245,10 @@ mod tests {
         let faults = Arc::new(FaultSink::default());
         let guard = PluginGuard::new("libdenoise.so", faults.clone());
         let denoiser: Box<dyn Denoiser> = Box::new(Panicking);
-        let guarded = Guarded::new(denoiser, guard, Arc::from("denoiser (type = \"x\")"));
+        let guarded = Guarded::new(
+            denoiser,
+            Guard::new(guard, Arc::from("denoiser (type = \"x\")")),
+        );
         let input = DenoiseInput {
             width: 1,
             height: 1,

@@ -32,6 +32,7 @@ pub mod scene;
 pub mod spectrum;
 pub mod stats;
 pub mod texture;
+pub mod wrap;
 
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
 pub use denoiser::{DenoiseInput, Denoiser};
@@ -49,12 +50,15 @@ pub use params::{
 };
 pub use ray::Ray;
 pub use registry::{PluginInterface, PluginKind, PluginSpec, Registry};
-pub use sampler::{ConcreteLanes, PixelPattern, Sampler, SamplerLanes};
+pub use sampler::{ConcreteLanes, Lane, PixelPattern, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;
 pub use texture::{BsdfScope, Texture, TextureQuery, Textures, UvTransform};
 
+/// `#[plugin_interface]`: a plugin trait and its wrappers, declared once
+/// (see [`wrap`]).
+pub use lumis_derive::plugin_interface;
 /// `#[derive(PluginParams)]` and `#[derive(ParamChoice)]`: a plugin's
 /// parameters declared once, as a struct (see [`PluginParams`](trait@PluginParams)).
 pub use lumis_derive::{ParamChoice, PluginParams};

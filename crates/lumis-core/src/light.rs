@@ -1,6 +1,7 @@
 //! The light plugin interface.
 
 use glam::{Vec2, Vec3};
+use lumis_derive::plugin_interface;
 
 use crate::interaction::LightSampleContext;
 use crate::light_bounds::LightBounds;
@@ -81,7 +82,9 @@ impl<'a> LightInput<'a> {
 }
 
 /// A light source. Each shape brings its own sampling and density.
+#[plugin_interface]
 pub trait Light: Send + Sync {
+    #[on_fault(LightKind::Area)]
     fn kind(&self) -> LightKind;
 
     /// Samples a direction toward the light from `ctx`.
@@ -90,6 +93,7 @@ pub trait Light: Send + Sync {
     /// [`Light::sample_li`] for each lane of a batch: `out[i]` is
     /// `sample_li(&ctx[i], u[i])`. The default loops; an override (SIMD)
     /// must return what `sample_li` returns up to rounding.
+    #[on_fault(out.fill(None))]
     fn sample_li_batch(
         &self,
         ctx: &[LightSampleContext],

@@ -21,8 +21,18 @@ pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// lumis-cores with the same version whose traits differ have different
 /// fingerprints (`build/fingerprint.rs`).
 pub const INTERFACE_FINGERPRINT: &str = env!("LUMIS_INTERFACE_FINGERPRINT");
-/// The symbol [`lumis_plugin!`](crate::lumis_plugin) exports.
-pub const ENTRY_POINT: &str = "lumis_plugin_declaration";
+/// What the symbol [`lumis_plugin!`](crate::lumis_plugin) exports begins
+/// with; the crate's name follows ([`entry_point`]).
+pub const ENTRY_POINT_PREFIX: &str = "lumis_plugin_declaration_";
+
+/// The symbol a plugin library whose crate is `crate_name` exports
+/// (`lumis_plugin_declaration_my_bsdf`). Named after the crate, as CPython
+/// names an extension's `PyInit_<module>`, so that several plugin crates
+/// link into one binary (a test of them together) without a clash; the
+/// host finds it from the library's file name, `lib<crate>.so`.
+pub fn entry_point(crate_name: &str) -> String {
+    format!("{ENTRY_POINT_PREFIX}{crate_name}")
+}
 
 const TEXT: usize = 128;
 
@@ -109,7 +119,8 @@ impl PluginDeclaration {
 /// lumis_core::lumis_plugin!(register);
 /// ```
 ///
-/// The entry point only returns a pointer to a static, so no panic can
+/// The entry point, `lumis_plugin_declaration_<crate name>`
+/// ([`entry_point`]), only returns a pointer to a static, so no panic can
 /// cross it. `register` runs under the plugin's own `catch_unwind`, and so
 /// do the factories it adds and the plugins they make (`crate::guard`): a
 /// panic in the plugin is an error the host reports, not an abort.
@@ -117,7 +128,7 @@ impl PluginDeclaration {
 macro_rules! lumis_plugin {
     ($register:path) => {
         #[allow(unsafe_code)]
-        #[no_mangle]
+        #[export_name = concat!("lumis_plugin_declaration_", env!("CARGO_CRATE_NAME"))]
         pub extern "C" fn lumis_plugin_declaration() -> *const $crate::plugin::PluginDeclaration {
             fn register_guarded(registry: &mut $crate::Registry) -> $crate::Result<()> {
                 $crate::guard::register_guarded(registry, $register)

@@ -12,7 +12,7 @@ use crate::bsdf::Bsdf;
 use crate::denoiser::Denoiser;
 use crate::entity::PluginEntity;
 use crate::error::{Error, Result};
-use crate::guard::{FaultSink, Guarded, PluginGuard};
+use crate::guard::{FaultSink, Guard, Guarded, PluginGuard};
 use crate::integrator::Integrator;
 use crate::light::{Light, LightInput, LightShape};
 use crate::light_sampler::LightSampler;
@@ -106,7 +106,7 @@ macro_rules! registered {
             None => Arc::new($factory),
             Some(guard) => Arc::new(move |$params: &Params $(, $input: $ty)?| {
                 guarded(&guard, $params, || $factory($params $(, $input)?), |made, guard, label| {
-                    $boxed(Guarded::new(made, guard, label))
+                    $boxed(Guarded::new(made, Guard::new(guard, label)))
                 })
             }),
         }

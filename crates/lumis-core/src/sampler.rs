@@ -1,19 +1,24 @@
 //! The sample-generator plugin interface.
 
 use glam::{UVec2, Vec2};
+use lumis_derive::plugin_interface;
 
 /// Hands out the random numbers of one pixel sample, dimension by dimension.
 ///
 /// Deterministic: the same pixel, sample index and seed give the same numbers
 /// on any thread, so renders do not depend on the thread count.
+#[plugin_interface(lane_view = Lane)]
 pub trait Sampler: Send + Sync {
+    #[on_fault(1)]
     fn samples_per_pixel(&self) -> u32;
 
     /// Starts sample `index` of `pixel`; dimensions restart at zero.
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64);
 
+    #[on_fault(0.5)]
     fn get_1d(&mut self) -> f32;
 
+    #[on_fault(Vec2::splat(0.5))]
     fn get_2d(&mut self) -> Vec2;
 
     /// `get_1d()` then `get_2d()`, the same three numbers: what a light
@@ -21,6 +26,7 @@ pub trait Sampler: Send + Sync {
     /// which direction) each draw. One call instead of two, so a sampler
     /// can share the work of the three dimensions (a Sobol' sampler walks
     /// the sample index's bits once for all three).
+    #[on_fault((0.5, Vec2::splat(0.5)))]
     fn get_1d_2d(&mut self) -> (f32, Vec2) {
         let u = self.get_1d();
         (u, self.get_2d())
@@ -28,15 +34,18 @@ pub trait Sampler: Send + Sync {
 
     /// The film position within the pixel (the first two dimensions of a
     /// sample, so samplers can stratify them best).
+    #[on_fault(Vec2::splat(0.5))]
     fn get_pixel_2d(&mut self) -> Vec2;
 
     /// An independent copy for another thread.
+    #[on_fault(Box::new(FaultedSampler))]
     fn clone_sampler(&self) -> Box<dyn Sampler>;
 
     /// What the film positions ([`Sampler::get_pixel_2d`]) of a pixel's
     /// `samples_per_pixel()` samples guarantee, for any pixel and seed:
     /// what `lumis check-plugin` verifies exactly. The default promises
     /// nothing beyond uniformity.
+    #[on_fault(PixelPattern::Random)]
     fn pixel_pattern(&self) -> PixelPattern {
         PixelPattern::Random
     }
@@ -46,6 +55,7 @@ pub trait Sampler: Send + Sync {
     /// estimates are unbiased. `false` declares a deterministic point set
     /// (strata centres, an unscrambled sequence): `lumis check-plugin`
     /// does not hold it to uniformity, and says so.
+    #[on_fault(true)]
     fn randomized(&self) -> bool {
         true
     }
@@ -54,8 +64,13 @@ pub trait Sampler: Send + Sync {
     /// default boxes `n` clones and asks them one virtual call at a time;
     /// a `Clone` sampler returns [`ConcreteLanes`] instead, whose batched requests
     /// call it directly.
+    #[on_fault(Box::new(ConcreteLanes::<dyn Sampler>(
+        (0..n).map(|_| Box::new(FaultedSampler) as Box<dyn Sampler>).collect(),
+    )))]
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
-        Box::new(BoxedLanes((0..n).map(|_| self.clone_sampler()).collect()))
+        Box::new(ConcreteLanes::<dyn Sampler>(
+            (0..n).map(|_| self.clone_sampler()).collect(),
+        ))
     }
 }
 
@@ -77,9 +92,12 @@ pub enum PixelPattern {
 }
 
 /// The samplers of a batch of paths, one per lane, each drawing its own
-/// pixel sample's numbers in its own order; a wavefront integrator asks
-/// them together.
-pub trait SamplerLanes: Send {
+/// pixel sample's numbers in its own order, asked by lane: a wavefront
+/// integrator asks them together. Lane `i` answers exactly what its own
+/// sampler would answer asked alone; [`lane`](SamplerLanes::lane) is one
+/// lane as a [`Sampler`].
+#[plugin_interface]
+pub trait SamplerLanes: Send + Sync {
     /// How many lanes.
     fn len(&self) -> usize;
 
@@ -87,53 +105,129 @@ pub trait SamplerLanes: Send {
         self.len() == 0
     }
 
-    /// Lane `i`'s sampler, for a request of one lane.
-    fn lane(&mut self, i: usize) -> &mut dyn Sampler;
+    /// [`Sampler::samples_per_pixel`], the same for every lane.
+    #[on_fault(1)]
+    fn samples_per_pixel(&self) -> u32;
+
+    /// [`Sampler::start_pixel_sample`] of lane `lane`.
+    fn start_pixel_sample(&mut self, lane: usize, pixel: UVec2, index: u32, seed: u64);
+
+    /// [`Sampler::get_1d`] of lane `lane`.
+    #[on_fault(0.5)]
+    fn get_1d(&mut self, lane: usize) -> f32;
+
+    /// [`Sampler::get_2d`] of lane `lane`.
+    #[on_fault(Vec2::splat(0.5))]
+    fn get_2d(&mut self, lane: usize) -> Vec2;
+
+    /// [`Sampler::get_1d_2d`] of lane `lane`.
+    #[on_fault((0.5, Vec2::splat(0.5)))]
+    fn get_1d_2d(&mut self, lane: usize) -> (f32, Vec2);
+
+    /// [`Sampler::get_pixel_2d`] of lane `lane`.
+    #[on_fault(Vec2::splat(0.5))]
+    fn get_pixel_2d(&mut self, lane: usize) -> Vec2;
+
+    /// An independent copy of lane `lane`'s sampler.
+    #[on_fault(Box::new(FaultedSampler))]
+    fn clone_lane(&self, lane: usize) -> Box<dyn Sampler>;
 
     /// `out[k]` = [`Sampler::get_1d_2d`] of lane `lanes[k]`, in order: the
     /// request each vertex of a wave makes for its BSDF sample and for its
     /// light sample. Each lane gets exactly the numbers it would get asked
     /// alone.
+    #[on_fault(out.fill((0.5, Vec2::splat(0.5))))]
     fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
         for (&i, out) in lanes.iter().zip(out) {
-            *out = self.lane(i).get_1d_2d();
+            *out = self.get_1d_2d(i);
         }
     }
 }
 
-/// The default [`Sampler::lanes`]: boxed clones.
-struct BoxedLanes(Vec<Box<dyn Sampler>>);
-
-impl SamplerLanes for BoxedLanes {
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-    fn lane(&mut self, i: usize) -> &mut dyn Sampler {
-        self.0[i].as_mut()
+impl dyn SamplerLanes + '_ {
+    /// Lane `index` as a [`Sampler`] of its own.
+    pub fn lane(&mut self, index: usize) -> Lane<'_> {
+        Lane { lanes: self, index }
     }
 }
 
-/// Lanes of a concrete sampler type: the batched requests call `S`'s
-/// methods without a virtual call per lane, so they inline into one loop.
-pub struct ConcreteLanes<S>(pub Vec<S>);
+/// One lane of a batch of samplers, as a [`Sampler`]: its requests are the
+/// batch's requests for the lane, and its declarations those of the lane's
+/// own sampler (the implementation is generated with [`Sampler`]'s).
+pub struct Lane<'a> {
+    lanes: &'a mut dyn SamplerLanes,
+    index: usize,
+}
+
+/// Lanes of one sampler type `S`, each boxed: for a concrete `S`, the
+/// batched requests call `S`'s methods without a virtual call per lane, so
+/// they inline into one loop; `S = dyn Sampler` is what any sampler's
+/// clones make ([`Sampler::lanes`]'s default).
+pub struct ConcreteLanes<S: ?Sized>(Vec<Box<S>>);
 
 impl<S: Sampler + Clone + 'static> ConcreteLanes<S> {
     /// `n` copies of `sampler`, boxed for [`Sampler::lanes`].
     pub fn boxed(sampler: &S, n: usize) -> Box<dyn SamplerLanes> {
-        Box::new(Self(vec![sampler.clone(); n]))
+        Box::new(Self((0..n).map(|_| Box::new(sampler.clone())).collect()))
     }
 }
 
-impl<S: Sampler + 'static> SamplerLanes for ConcreteLanes<S> {
+impl<S: Sampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
     fn len(&self) -> usize {
         self.0.len()
     }
-    fn lane(&mut self, i: usize) -> &mut dyn Sampler {
-        &mut self.0[i]
+    fn samples_per_pixel(&self) -> u32 {
+        self.0.first().map_or(1, |s| s.samples_per_pixel())
+    }
+    fn start_pixel_sample(&mut self, lane: usize, pixel: UVec2, index: u32, seed: u64) {
+        self.0[lane].start_pixel_sample(pixel, index, seed)
+    }
+    #[inline]
+    fn get_1d(&mut self, lane: usize) -> f32 {
+        self.0[lane].get_1d()
+    }
+    #[inline]
+    fn get_2d(&mut self, lane: usize) -> Vec2 {
+        self.0[lane].get_2d()
+    }
+    #[inline]
+    fn get_1d_2d(&mut self, lane: usize) -> (f32, Vec2) {
+        self.0[lane].get_1d_2d()
+    }
+    #[inline]
+    fn get_pixel_2d(&mut self, lane: usize) -> Vec2 {
+        self.0[lane].get_pixel_2d()
+    }
+    fn clone_lane(&self, lane: usize) -> Box<dyn Sampler> {
+        self.0[lane].clone_sampler()
     }
     fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
         for (&i, out) in lanes.iter().zip(out) {
             *out = self.0[i].get_1d_2d();
         }
+    }
+}
+
+/// What a wrapped sampler whose clone faulted draws: the centre of every
+/// dimension, one sample per pixel, until the host stops at the recorded
+/// fault.
+struct FaultedSampler;
+
+impl Sampler for FaultedSampler {
+    fn samples_per_pixel(&self) -> u32 {
+        1
+    }
+    fn start_pixel_sample(&mut self, _: UVec2, _: u32, _: u64) {}
+    fn get_1d(&mut self) -> f32 {
+        0.5
+    }
+    fn get_2d(&mut self) -> Vec2 {
+        Vec2::splat(0.5)
+    }
+    fn get_pixel_2d(&mut self) -> Vec2 {
+        Vec2::splat(0.5)
+    }
+    fn clone_sampler(&self) -> Box<dyn Sampler> {
+        Box::new(FaultedSampler)
     }
 }

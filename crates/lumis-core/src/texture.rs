@@ -5,6 +5,7 @@
 //! [`Textured`](crate::params::Textured) holds either a constant or a
 //! texture, and the BSDF evaluates it with the hit's [`TextureQuery`].
 
+use lumis_derive::plugin_interface;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -63,6 +64,7 @@ impl TextureQuery {
 /// Must be cheap to evaluate, deterministic, and finite everywhere; a
 /// texture used as a reflectance should stay in [0, 1] (a constant is
 /// checked by the BSDF that reads it, a texture's values cannot be).
+#[plugin_interface]
 pub trait Texture: Send + Sync {
     /// The value at `query`, linear RGB.
     fn eval(&self, query: &TextureQuery) -> Rgb;

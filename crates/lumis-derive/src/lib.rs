@@ -25,6 +25,7 @@
 
 mod attrs;
 mod param_choice;
+mod plugin_interface;
 mod plugin_params;
 mod value;
 
@@ -68,6 +69,28 @@ pub fn derive_plugin_params(input: TokenStream) -> TokenStream {
 pub fn derive_param_choice(input: TokenStream) -> TokenStream {
     let input = parse_macro_input!(input as DeriveInput);
     param_choice::expand(&input)
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// Declares a plugin interface: the trait, and its wrappers generated from
+/// it (`lumis_core::wrap::Wrapped<C, H>` implements it by forwarding every
+/// method through a `CallHook`: the panic guard of a loaded plugin, the
+/// profiler). A method added to the trait is forwarded by every wrapper
+/// without further code.
+///
+/// - `#[on_fault(expr)]` on a method: its answer when the hook did not let
+///   the call complete (the arguments, and the fault as `fault`, are in
+///   scope); without it, `Neutral::neutral()` of the return type.
+/// - `#[wrappers_answer(expr)]`: wrappers answer without asking the
+///   wrapped object (`Scene::as_any`, whose answer would bypass them).
+/// - `#[plugin_interface(lane_view = Lane)]`: also implements the trait for
+///   one lane of a batch of samplers.
+#[proc_macro_attribute]
+pub fn plugin_interface(args: TokenStream, item: TokenStream) -> TokenStream {
+    let args = parse_macro_input!(args as plugin_interface::Args);
+    let item = parse_macro_input!(item as syn::ItemTrait);
+    plugin_interface::expand(args, item)
         .unwrap_or_else(syn::Error::into_compile_error)
         .into()
 }

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use libloading::{Library, Symbol};
 use lumis_core::plugin::{
-    PluginDeclaration, CORE_VERSION, ENTRY_POINT, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION,
+    entry_point, PluginDeclaration, CORE_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION,
     RUSTC_VERSION,
 };
 use lumis_core::{Error, Registry, Result};
@@ -53,6 +53,20 @@ fn describe_error(e: &dyn std::error::Error) -> String {
         source = s.source();
     }
     text
+}
+
+/// The crate a library at `path` was built from, by cargo's naming of a
+/// `cdylib` (`libmy_bsdf.so` is `my_bsdf`).
+fn crate_name(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let name = name
+        .strip_prefix(std::env::consts::DLL_PREFIX)
+        .unwrap_or(&name);
+    // `libm.so.6`: the name ends at its first dot.
+    name.split('.').next().unwrap_or(name).replace('-', "_")
 }
 
 /// Loads the plugin library at `path` (relative to the current directory)
@@ -99,10 +113,12 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
     // SAFETY: the symbol, if present, was exported by `lumis_plugin!` with
     // exactly this signature; a library that exports the name with another
     // signature is not a lumis plugin and breaks the contract it claims.
-    let entry: Symbol<Entry> = unsafe { library.get(ENTRY_POINT.as_bytes()) }.map_err(|_| {
+    let symbol = entry_point(&crate_name(&path));
+    let entry: Symbol<Entry> = unsafe { library.get(symbol.as_bytes()) }.map_err(|_| {
         Error::msg(format!(
-            "'{shown}' has no {ENTRY_POINT} entry point: it is not a lumis plugin \
-             (a plugin crate calls lumis_core::lumis_plugin!(register))"
+            "'{shown}' has no {symbol} entry point: it is not a lumis plugin \
+             (a plugin crate calls lumis_core::lumis_plugin!(register)), or it was renamed \
+             (a plugin library keeps the file name cargo gives it, lib<crate>.so)"
         ))
     })?;
     let declaration = catch_unwind(|| entry()).map_err(|p| {
@@ -234,7 +250,7 @@ mod tests {
         let err = load_library(libm, &mut Registry::new()).unwrap_err();
         assert!(
             err.message
-                .contains("no lumis_plugin_declaration entry point"),
+                .contains("no lumis_plugin_declaration_m entry point"),
             "{err}"
         );
     }

@@ -171,15 +171,18 @@ fn render_tile(
     let width = tile.max.x - tile.min.x;
     let count = film.sums.len();
     let first_hits = film.first_hits.is_some();
+    // At least one lane, even from a plugin's lanes that faulted (whose
+    // answers are then neutral until the host stops at the fault).
+    let n = lanes.len().max(1);
     let mut batch = Batch {
-        rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); lanes.len()],
-        pixel_of_lane: vec![0; lanes.len()],
-        index_of_lane: vec![0; lanes.len()],
-        radiance: vec![Rgb::BLACK; lanes.len()],
+        rays: vec![Ray::new(Vec3::ZERO, Vec3::Z); n],
+        pixel_of_lane: vec![0; n],
+        index_of_lane: vec![0; n],
+        radiance: vec![Rgb::BLACK; n],
         filled: 0,
     };
-    let run = lanes.len().min(count);
-    let samples_per_batch = (lanes.len() / run) as u32;
+    let run = n.min(count);
+    let samples_per_batch = (n / run) as u32;
     for first in (0..count).step_by(run) {
         let pixels = first..(first + run).min(count);
         for base in samples.clone().step_by(samples_per_batch as usize) {
@@ -193,7 +196,7 @@ fn render_tile(
                     }
                     let pixel =
                         UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
-                    let lane = lanes.lane(batch.filled);
+                    let mut lane = lanes.lane(batch.filled);
                     lane.start_pixel_sample(pixel, index, seed);
                     // Box filter of radius 1/2: uniform over the pixel, weight 1.
                     batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {

@@ -4,11 +4,13 @@
 //! and a sampling thread reads every slot once a millisecond. A stage's
 //! share of the samples is its share of the workers' time.
 //!
-//! Stages are entered by thin wrappers around the plugins and the scene
+//! Stages are entered by wrappers around the plugins and the scene
 //! ([`ProfiledBsdf`], [`ProfiledLight`], [`ProfiledLightSampler`],
 //! [`ProfiledSampler`], [`ProfiledScene`]), which a profiled render puts in
-//! place of the originals: the integrators stay as they are. A wrapper
-//! costs two relaxed stores and one more virtual call, so a profiled
+//! place of the originals: the integrators stay as they are. The wrappers
+//! are the plugin traits' own ([`lumis_core::wrap`]) with a hook that
+//! enters the stage, so they forward every method, declarations included.
+//! A wrapper costs two relaxed stores and one more virtual call, so a profiled
 //! render is a few percent slower than a plain one, and the profiled
 //! scene takes the integrators' loop over `dyn Scene`.
 
@@ -18,11 +20,8 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use lumis_core::bsdf::BsdfContext;
-use lumis_core::{
-    Bsdf, BsdfFlags, BsdfSample, Light, LightKind, LightSample, LightSampleContext, LightSampler,
-    Ray, Rgb, SampledLight, Sampler, Scene, SurfaceInteraction, UVec2, Vec2, Vec3,
-};
+use lumis_core::wrap::{CallHook, Fault, Wrapped};
+use lumis_core::{Bsdf, Light, LightSampler, Sampler, Scene};
 
 /// A stage of the render, as the profile reports it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -231,139 +230,78 @@ impl ProfileReport {
     }
 }
 
-/// A BSDF whose calls count as [`Stage::Bsdf`].
-pub struct ProfiledBsdf(pub Arc<dyn Bsdf>);
+/// The profiler's hook: every call of the wrapped object counts as its
+/// stage. Never faults.
+#[derive(Debug, Clone, Copy)]
+pub struct InStage(pub Stage);
 
-impl Bsdf for ProfiledBsdf {
-    fn flags(&self) -> BsdfFlags {
-        self.0.flags()
+impl CallHook for InStage {
+    #[inline]
+    fn call<T>(&self, _: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
+        Ok(in_stage(self.0, call))
     }
-    fn f(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> Rgb {
-        in_stage(Stage::Bsdf, || self.0.f(ctx, wo, wi))
-    }
-    fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        in_stage(Stage::Bsdf, || self.0.sample_f(ctx, wo, u1, u2))
-    }
-    fn pdf(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> f32 {
-        in_stage(Stage::Bsdf, || self.0.pdf(ctx, wo, wi))
-    }
-    fn eval(&self, ctx: &BsdfContext, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        in_stage(Stage::Bsdf, || self.0.eval(ctx, wo, wi))
-    }
-    fn sample_f_batch(
-        &self,
-        ctx: &[BsdfContext],
-        wo: &[Vec3],
-        u1: &[f32],
-        u2: &[Vec2],
-        out: &mut [Option<BsdfSample>],
-    ) {
-        in_stage(Stage::Bsdf, || self.0.sample_f_batch(ctx, wo, u1, u2, out))
-    }
-    fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
-        in_stage(Stage::Bsdf, || self.0.eval_batch(ctx, wo, wi, out))
+    fn child(&self) -> Self {
+        *self
     }
 }
 
-/// A light whose calls count as [`Stage::LightSampling`].
-pub struct ProfiledLight(pub Box<dyn Light>);
+/// The scene's hook: closest-hit queries count as [`Stage::Traversal`],
+/// occlusion queries as [`Stage::ShadowRays`], and the rest (the lights)
+/// as the stage of whoever asks.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneStages;
 
-impl Light for ProfiledLight {
-    fn kind(&self) -> LightKind {
-        self.0.kind()
-    }
-    fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
-        in_stage(Stage::LightSampling, || self.0.sample_li(ctx, u))
-    }
-    fn sample_li_batch(
-        &self,
-        ctx: &[LightSampleContext],
-        u: &[Vec2],
-        out: &mut [Option<LightSample>],
-    ) {
-        in_stage(Stage::LightSampling, || self.0.sample_li_batch(ctx, u, out))
-    }
-    fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {
-        in_stage(Stage::LightSampling, || self.0.pdf_li(ctx, wi))
-    }
-    fn l(&self, p: Vec3, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
-        in_stage(Stage::LightSampling, || self.0.l(p, n, uv, w))
-    }
-    fn power(&self) -> Rgb {
-        self.0.power()
-    }
-    fn preprocess(&mut self, scene_center: Vec3, scene_radius: f32) {
-        self.0.preprocess(scene_center, scene_radius)
-    }
-}
-
-/// A light sampler whose calls count as [`Stage::LightSampling`].
-pub struct ProfiledLightSampler(pub Box<dyn LightSampler>);
-
-impl LightSampler for ProfiledLightSampler {
-    fn sample(&self, ctx: &LightSampleContext, u: f32) -> Option<SampledLight> {
-        in_stage(Stage::LightSampling, || self.0.sample(ctx, u))
-    }
-    fn pmf(&self, ctx: &LightSampleContext, index: u32) -> f32 {
-        in_stage(Stage::LightSampling, || self.0.pmf(ctx, index))
-    }
-}
-
-/// A sampler whose requests count as [`Stage::Sampler`].
-pub struct ProfiledSampler(pub Box<dyn Sampler>);
-
-impl Sampler for ProfiledSampler {
-    fn samples_per_pixel(&self) -> u32 {
-        self.0.samples_per_pixel()
-    }
-    fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
-        in_stage(Stage::Sampler, || {
-            self.0.start_pixel_sample(pixel, index, seed)
+impl CallHook for SceneStages {
+    #[inline]
+    fn call<T>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
+        Ok(if method.starts_with("Scene::intersect") {
+            in_stage(Stage::Traversal, call)
+        } else if method.starts_with("Scene::occluded") {
+            in_stage(Stage::ShadowRays, call)
+        } else {
+            call()
         })
     }
-    fn get_1d(&mut self) -> f32 {
-        in_stage(Stage::Sampler, || self.0.get_1d())
-    }
-    fn get_2d(&mut self) -> Vec2 {
-        in_stage(Stage::Sampler, || self.0.get_2d())
-    }
-    fn get_1d_2d(&mut self) -> (f32, Vec2) {
-        in_stage(Stage::Sampler, || self.0.get_1d_2d())
-    }
-    fn get_pixel_2d(&mut self) -> Vec2 {
-        in_stage(Stage::Sampler, || self.0.get_pixel_2d())
-    }
-    fn clone_sampler(&self) -> Box<dyn Sampler> {
-        Box::new(ProfiledSampler(self.0.clone_sampler()))
+    fn child(&self) -> Self {
+        *self
     }
 }
 
+/// A BSDF whose calls count as [`Stage::Bsdf`].
+pub type ProfiledBsdf = Wrapped<Arc<dyn Bsdf>, InStage>;
+/// A light whose calls count as [`Stage::LightSampling`].
+pub type ProfiledLight = Wrapped<Box<dyn Light>, InStage>;
+/// A light sampler whose calls count as [`Stage::LightSampling`].
+pub type ProfiledLightSampler = Wrapped<Box<dyn LightSampler>, InStage>;
+/// A sampler whose requests count as [`Stage::Sampler`].
+pub type ProfiledSampler = Wrapped<Box<dyn Sampler>, InStage>;
 /// A scene whose queries count as [`Stage::Traversal`] and
 /// [`Stage::ShadowRays`].
-pub struct ProfiledScene<'a>(pub &'a dyn Scene);
+pub type ProfiledScene<'a> = Wrapped<&'a dyn Scene, SceneStages>;
 
-impl Scene for ProfiledScene<'_> {
-    fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction<'_>> {
-        in_stage(Stage::Traversal, || self.0.intersect(ray))
-    }
-    fn occluded(&self, ray: &Ray) -> bool {
-        in_stage(Stage::ShadowRays, || self.0.occluded(ray))
-    }
-    fn intersect_batch<'s>(&'s self, rays: &[Ray], out: &mut [Option<SurfaceInteraction<'s>>]) {
-        in_stage(Stage::Traversal, || self.0.intersect_batch(rays, out))
-    }
-    fn occluded_batch(&self, rays: &[Ray], out: &mut [bool]) {
-        in_stage(Stage::ShadowRays, || self.0.occluded_batch(rays, out))
-    }
-    fn lights(&self) -> &[Box<dyn Light>] {
-        self.0.lights()
-    }
-    fn infinite_lights(&self) -> &[u32] {
-        self.0.infinite_lights()
-    }
-    fn light_sampler(&self) -> &dyn LightSampler {
-        self.0.light_sampler()
-    }
+/// `bsdf`, its calls counted as [`Stage::Bsdf`].
+pub fn profiled_bsdf(bsdf: Arc<dyn Bsdf>) -> ProfiledBsdf {
+    Wrapped::new(bsdf, InStage(Stage::Bsdf))
+}
+
+/// `light`, its calls counted as [`Stage::LightSampling`].
+pub fn profiled_light(light: Box<dyn Light>) -> ProfiledLight {
+    Wrapped::new(light, InStage(Stage::LightSampling))
+}
+
+/// `sampler`, its calls counted as [`Stage::LightSampling`].
+pub fn profiled_light_sampler(sampler: Box<dyn LightSampler>) -> ProfiledLightSampler {
+    Wrapped::new(sampler, InStage(Stage::LightSampling))
+}
+
+/// `sampler`, its requests counted as [`Stage::Sampler`].
+pub fn profiled_sampler(sampler: Box<dyn Sampler>) -> ProfiledSampler {
+    Wrapped::new(sampler, InStage(Stage::Sampler))
+}
+
+/// `scene`, its queries counted by kind.
+pub fn profiled_scene(scene: &dyn Scene) -> ProfiledScene<'_> {
+    Wrapped::new(scene, SceneStages)
 }
 
 #[cfg(test)]

@@ -227,15 +227,15 @@ impl RenderScene {
     /// render attributes their time (`lumis render --stats`). Their values
     /// are unchanged; only their calls cost a little more.
     pub fn into_profiled(mut self) -> Self {
-        use lumis_render::profile::{ProfiledBsdf, ProfiledLight, ProfiledLightSampler};
+        use lumis_render::profile::{profiled_bsdf, profiled_light, profiled_light_sampler};
         for b in &mut self.bsdfs {
-            b.bsdf = Arc::new(ProfiledBsdf(Arc::clone(&b.bsdf)));
+            b.bsdf = Arc::new(profiled_bsdf(Arc::clone(&b.bsdf)));
         }
         self.lights = std::mem::take(&mut self.lights)
             .into_iter()
-            .map(|light| Box::new(ProfiledLight(light)) as Box<dyn Light>)
+            .map(|light| Box::new(profiled_light(light)) as Box<dyn Light>)
             .collect();
-        self.light_sampler = Box::new(ProfiledLightSampler(self.light_sampler));
+        self.light_sampler = Box::new(profiled_light_sampler(self.light_sampler));
         self
     }
 
@@ -686,7 +686,8 @@ impl Scene for RenderScene {
 
 #[cfg(test)]
 mod tests {
-    use lumis_core::{BsdfContext, BsdfSample, LightSampleContext, Rgb, SampledLight};
+    use lumis_core::light_sampler::NoLights;
+    use lumis_core::{BsdfContext, BsdfSample, Rgb};
     use lumis_embree::{Device, SceneBuilder, SceneOptions, SpherePoint};
 
     use super::*;
@@ -704,17 +705,6 @@ mod tests {
             None
         }
         fn pdf(&self, _: &BsdfContext, _: Vec3, _: Vec3) -> f32 {
-            0.0
-        }
-    }
-
-    struct NoLights;
-
-    impl LightSampler for NoLights {
-        fn sample(&self, _: &LightSampleContext, _: f32) -> Option<SampledLight> {
-            None
-        }
-        fn pmf(&self, _: &LightSampleContext, _: u32) -> f32 {
             0.0
         }
     }

@@ -208,14 +208,18 @@ pub trait Param: FromParam {
     }
 }
 
+/// Compares a number with its declared range in the number's own
+/// precision (`$wide`): a range written `(0.02, 1.0)` holds the f32 `0.02`,
+/// which widened to f64 is not the f64 `0.02`. Integers compare in f64,
+/// exactly for every value a scene can write.
 macro_rules! number_param {
-    ($($ty:ty => $param:ident),*) => {$(
+    ($($ty:ty => $param:ident as $wide:ty),*) => {$(
         impl Param for $ty {
             const TYPE: ParamType = ParamType::$param;
 
             fn check_range(&self, (min, max): (f64, f64)) -> std::result::Result<(), String> {
-                let v = *self as f64;
-                if v >= min && v <= max {
+                let v = *self as $wide;
+                if v >= min as $wide && v <= max as $wide {
                     Ok(())
                 } else {
                     Err(format!("must be in [{min}, {max}], got {self}"))
@@ -225,7 +229,13 @@ macro_rules! number_param {
     )*};
 }
 
-number_param!(f32 => Float, f64 => Float, i64 => Int, u32 => Int, usize => Int);
+number_param!(
+    f32 => Float as f32,
+    f64 => Float as f64,
+    i64 => Int as f64,
+    u32 => Int as f64,
+    usize => Int as f64
+);
 
 macro_rules! plain_param {
     ($($ty:ty => $param:ident),*) => {$(

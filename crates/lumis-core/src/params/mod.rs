@@ -241,12 +241,10 @@ impl<'a> Params<'a> {
     /// A number within the range the spec declares (`ParamSpec::in_range`).
     pub fn get_in_range(&self, name: &str) -> Result<f32> {
         let v: f32 = self.get(name)?;
-        let (min, max) = self.spec[self.spec_index(name)]
+        let range = self.spec[self.spec_index(name)]
             .range
             .unwrap_or_else(|| panic!("plugin bug: '{name}' of {} declares no range", self.owner));
-        if !(v as f64 >= min && v as f64 <= max) {
-            return Err(self.error(name, format!("must be in [{min}, {max}], got {v}")));
-        }
+        v.check_range(range).map_err(|e| self.error(name, e))?;
         Ok(v)
     }
 
@@ -446,6 +444,28 @@ mod tests {
             p.get::<std::path::PathBuf>("file").unwrap(),
             std::path::Path::new("/abs/a.binary")
         );
+    }
+
+    /// A declared end that is not exact in f32 is accepted as the f32 a
+    /// scene writes for it; the next f32 beyond either end is not.
+    #[test]
+    fn a_range_holds_its_own_ends() {
+        const RANGED: &[ParamSpec] =
+            &[ParamSpec::required("roughness", ParamType::Float, "r").in_range(0.02, 1.0)];
+        let read = |v: f32| {
+            let t = params(&format!("roughness = {v:?}\n"));
+            let p = Params::new("x", &t, Location::Builtin, RANGED, &[]).unwrap();
+            (
+                p.value::<f32>("roughness").is_ok(),
+                p.get_in_range("roughness").is_ok(),
+            )
+        };
+        assert_eq!(read(0.02), (true, true));
+        assert_eq!(read(1.0), (true, true));
+        let below = f32::from_bits(0.02f32.to_bits() - 1);
+        let above = f32::from_bits(1.0f32.to_bits() + 1);
+        assert_eq!(read(below), (false, false));
+        assert_eq!(read(above), (false, false));
     }
 
     #[test]

@@ -261,7 +261,7 @@ impl WavefrontIntegrator {
                 continue;
             }
             let plan = if hit.bsdf_flags.is_non_specular() {
-                estimator.plan(samplers.lane(lane))
+                estimator.plan(&mut samplers.lane(lane))
             } else {
                 VertexPlan::UNWEIGHTED
             };
@@ -303,8 +303,14 @@ impl WavefrontIntegrator {
                 continue;
             };
             let path = &mut wave.paths[v.lane];
-            let sampler = samplers.lane(v.lane);
-            if path.continue_path(&v.vertex(hit), bs, &v.plan, self.path.rr_depth, sampler) {
+            let mut sampler = samplers.lane(v.lane);
+            if path.continue_path(
+                &v.vertex(hit),
+                bs,
+                &v.plan,
+                self.path.rr_depth,
+                &mut sampler,
+            ) {
                 wave.live.push(v.lane);
             }
         }
