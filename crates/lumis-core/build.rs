@@ -1,11 +1,8 @@
 //! Records what a dynamically loaded plugin must share with its host (Rust
 //! has no stable ABI): the compiler version, and the fingerprint of the
-//! plugin interface (`build/fingerprint.rs`).
+//! plugin interface (the `lumis-fingerprint` crate).
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-#[path = "build/fingerprint.rs"]
-mod fingerprint;
 
 /// The crates whose types appear in the plugin traits, pinned to one
 /// version in the workspace manifest.
@@ -38,10 +35,9 @@ fn main() {
         .iter()
         .map(|name| pinned_requirement(&workspace, name))
         .collect();
-    let hash = fingerprint::fingerprint(&sources, &boundary);
+    let hash = lumis_fingerprint::fingerprint(&sources, &boundary);
     println!("cargo:rustc-env=LUMIS_INTERFACE_FINGERPRINT={hash:016x}");
     println!("cargo:rerun-if-changed=src");
-    println!("cargo:rerun-if-changed=build");
     println!("cargo:rerun-if-changed={}", manifest.display());
 }
 
