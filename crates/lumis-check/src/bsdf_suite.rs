@@ -32,9 +32,7 @@ use crate::corrected_significance;
 use crate::lobe_zoom::chi_square_zoomed;
 use crate::outcome::{add_faults, summary, unmade, verdict, write_notes, Outcome};
 use crate::sweep::declared;
-pub use crate::sweep::{
-    parameter_sweep, parameter_sweep_with, variant, Variant, INTERIOR_VALUES, STAND_IN_BSDFS,
-};
+pub use crate::sweep::{parameter_sweep, parameter_sweep_with, variant, Variant, STAND_IN_BSDFS};
 
 /// How thoroughly to check.
 #[derive(Debug, Clone, PartialEq)]
@@ -479,6 +477,7 @@ pub fn check_bsdf_variants(
                     let (mut sample, pdf) = bsdf_pair(bsdf.as_ref(), wo);
                     let case_cfg = ChiSquareConfig {
                         seed: chi_cfg.seed.wrapping_add(2 * case as u64 + h as u64),
+                        samples: variant.samples(chi_cfg.samples),
                         ..chi_cfg
                     };
                     chi_square_zoomed(
@@ -490,7 +489,7 @@ pub fn check_bsdf_variants(
                 .min_by(|a, b| a.0.p_value.total_cmp(&b.0.p_value))
                 .expect("at least one hemisphere");
             let (albedo, albedo_se, problems) =
-                check_values(bsdf.as_ref(), wo, cfg.samples, i as u64);
+                check_values(bsdf.as_ref(), wo, variant.samples(cfg.samples), i as u64);
             let not_testable = if report.passed || report.defect.is_some() {
                 None
             } else {

@@ -224,7 +224,11 @@ pub fn check_light_sampler_with(
             match sampler {
                 Ok(sampler) => {
                     let seed = cfg.seed.wrapping_add(i as u64);
-                    check_case(sampler.as_ref(), &lights, &ctx, cfg, seed, &mut result);
+                    let cfg = LightSamplerCheckConfig {
+                        samples: variant.samples(cfg.samples),
+                        ..cfg.clone()
+                    };
+                    check_case(sampler.as_ref(), &lights, &ctx, &cfg, seed, &mut result);
                 }
                 Err(e) => match unmade(registry, &owner(name, variant), e) {
                     Ok(refusal) => result.refused = Some(refusal),

@@ -363,9 +363,12 @@ pub fn check_light_variants(
                     .push(format!("power() = {:?}", result.power));
             }
             if light.kind() == LightKind::DeltaPosition {
-                result
-                    .problems
-                    .extend(check_delta(light.as_ref(), &ctx, cfg.samples, case as u64));
+                result.problems.extend(check_delta(
+                    light.as_ref(),
+                    &ctx,
+                    variant.samples(cfg.samples),
+                    case as u64,
+                ));
                 result.not_testable = Some(
                     "delta light: no density to test (sample_li deterministic, pdf_li = 0 checked)"
                         .into(),
@@ -374,6 +377,7 @@ pub fn check_light_variants(
                 let (sample, pdf) = light_pair(light.as_ref(), ctx);
                 let case_cfg = ChiSquareConfig {
                     seed: chi_cfg.seed.wrapping_add(case as u64),
+                    samples: variant.samples(chi_cfg.samples),
                     ..chi_cfg
                 };
                 let report = chi_square(sample, pdf, &case_cfg);
@@ -384,7 +388,7 @@ pub fn check_light_variants(
                 result.problems.extend(check_values(
                     light.as_ref(),
                     &ctx,
-                    cfg.samples,
+                    variant.samples(cfg.samples),
                     case as u64,
                 ));
             }

@@ -14,6 +14,30 @@ pub struct Variant {
     /// E.g. `base` or `exponent = 1000000`.
     pub label: String,
     pub table: Table,
+    /// For a value inside a range: which of its [`STRATA`] it lies in.
+    pub stratum: Option<usize>,
+}
+
+impl Variant {
+    /// The share of a full case's samples this variant is checked with. A
+    /// range's ends and every other setting take them all; the values
+    /// inside a range take [`INTERIOR_BUDGET`] / [`STRATA`] each, so the
+    /// strata of a range cost together what [`INTERIOR_BUDGET`] full
+    /// variants cost, and each is still met by every case of a suite (every
+    /// incident direction, every reference point): a defect at one value
+    /// is a NaN, a negative value, an inconsistent pdf or energy created,
+    /// each found with few samples.
+    pub fn share(&self) -> f64 {
+        match self.stratum {
+            Some(_) => INTERIOR_BUDGET as f64 / STRATA as f64,
+            None => 1.0,
+        }
+    }
+
+    /// `samples` scaled by [`Variant::share`], at least one.
+    pub fn samples(&self, samples: usize) -> usize {
+        ((samples as f64 * self.share()).ceil() as usize).max(1)
+    }
 }
 
 /// A value to use for a required parameter with no default.
@@ -75,20 +99,27 @@ pub fn variant(label: impl Into<String>, toml: &str) -> Result<Variant> {
     Ok(Variant {
         label: label.into(),
         table: doc::parse(toml, "<sweep>")?,
+        stratum: None,
     })
 }
 
-/// Seeded values between the ends of each ranged parameter: a defect at an
-/// interior value (a panic for 0.6 < sigma < 0.7) that the ends and the
-/// default miss. Seeded by the plugin's and the parameter's names, so a
-/// check is repeatable.
-pub const INTERIOR_VALUES: usize = 2;
+/// A ranged parameter is checked at a seeded value in each of this many
+/// equal parts of its range (log-spaced where the range spans decades):
+/// a defect confined to a tenth of the range (a panic for 0.6 < sigma <
+/// 0.7) is met, which the ends and the default miss. Seeded by the
+/// plugin's and the parameter's names, so a check is repeatable.
+pub const STRATA: usize = 10;
+
+/// What the [`STRATA`] of one range cost together, in full variants: each
+/// stratum is checked with its share of a case's samples
+/// ([`Variant::share`]).
+pub const INTERIOR_BUDGET: usize = 2;
 
 /// The parameter settings to check: the defaults (with stand-ins for
 /// required parameters), then one parameter at a time at each end of its
-/// range and at [`INTERIOR_VALUES`] seeded values inside it, at each
-/// declared choice, at each boolean value, and each colour at its maximum
-/// (where a BSDF that creates energy shows it most).
+/// range and at a seeded value in each of its [`STRATA`], at each declared
+/// choice, at each boolean value, and each colour at its maximum (where a
+/// BSDF that creates energy shows it most).
 pub fn parameter_sweep(spec: &PluginSpec) -> Result<Vec<Variant>> {
     parameter_sweep_with(spec, &[])
 }
@@ -124,13 +155,14 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
             ));
         }
     }
-    let mut settings: Vec<(String, Vec<(String, String)>)> = vec![("base".into(), base.clone())];
+    let mut settings: Vec<(String, Setting, Option<usize>)> =
+        vec![("base".into(), base.clone(), None)];
     for p in spec
         .params
         .iter()
         .filter(|p| !fixed.iter().any(|(k, _)| k == p.name))
     {
-        let mut values: Vec<String> = Vec::new();
+        let mut values: Vec<(String, Option<usize>)> = Vec::new();
         match p.ty {
             ParamType::Float | ParamType::TexturedFloat | ParamType::Int => {
                 if let Some((a, b)) = p.range {
@@ -141,10 +173,16 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
                             format!("{v:?}")
                         }
                     };
-                    values.extend([fmt(a), fmt(b)]);
+                    values.extend([(fmt(a), None), (fmt(b), None)]);
                     let mut rng = Pcg32::new(name_seed(spec.name, p.name), 0x5eed);
-                    for _ in 0..INTERIOR_VALUES {
-                        values.push(fmt(interior(a, b, rng.next_f32() as f64)));
+                    for k in 0..STRATA {
+                        let t = (k as f64 + rng.next_f32() as f64) / STRATA as f64;
+                        let v = fmt(interior(a, b, t));
+                        // An integer range narrower than the strata
+                        // repeats values: each is checked once.
+                        if !values.iter().any(|(seen, _)| *seen == v) {
+                            values.push((v, Some(k)));
+                        }
                     }
                 }
             }
@@ -175,33 +213,42 @@ pub fn parameter_sweep_with(spec: &PluginSpec, fixed: &[(String, String)]) -> Re
                 } else {
                     ""
                 };
-                settings.push((format!("{} = {max}{zeroed}", p.name), s));
+                settings.push((format!("{} = {max}{zeroed}", p.name), s, None));
             }
-            ParamType::Bool => values.extend(["true".to_string(), "false".to_string()]),
-            ParamType::String => values.extend(p.choices.iter().map(|c| format!("\"{c}\""))),
+            ParamType::Bool => values.extend(["true", "false"].map(|b| (b.to_string(), None))),
+            ParamType::String => {
+                values.extend(p.choices.iter().map(|c| (format!("\"{c}\""), None)))
+            }
             ParamType::Bsdf => values.extend(
                 STAND_IN_BSDFS
                     .iter()
-                    .map(|(name, ..)| format!("\"{name}\"")),
+                    .map(|(name, ..)| (format!("\"{name}\""), None)),
             ),
             _ => {}
         }
-        for v in values {
+        for (v, stratum) in values {
             let mut s: Vec<(String, String)> =
                 base.iter().filter(|(k, _)| k != p.name).cloned().collect();
             s.push((p.name.to_string(), v.clone()));
-            settings.push((format!("{} = {v}", p.name), s));
+            settings.push((format!("{} = {v}", p.name), s, stratum));
         }
     }
     settings
         .into_iter()
-        .map(|(label, kv)| {
+        .map(|(label, kv, stratum)| {
             let text: String = kv.iter().map(|(k, v)| format!("{k} = {v}\n")).collect();
             let table = doc::parse(&text, "<sweep>")?;
-            Ok(Variant { label, table })
+            Ok(Variant {
+                label,
+                table,
+                stratum,
+            })
         })
         .collect()
 }
+
+/// A parameter setting as `(key, TOML value)` pairs.
+type Setting = Vec<(String, String)>;
 
 /// The BSDFs that a BSDF parameter (an adapter's inner BSDF, e.g.
 /// `twosided`'s) is swept over: name, built-in plugin, parameters.
@@ -262,6 +309,20 @@ mod tests {
         assert!(err.contains("no parameter 'roughnes'"), "{err}");
     }
 
+    /// The strata of a range take together the samples of
+    /// [`INTERIOR_BUDGET`] full variants.
+    #[test]
+    fn strata_share_the_samples() {
+        let sweep = parameter_sweep(&SPEC).unwrap();
+        let strata: usize = sweep
+            .iter()
+            .filter(|v| v.stratum.is_some())
+            .map(|v| v.samples(1_000_000))
+            .sum();
+        assert_eq!(strata, INTERIOR_BUDGET * 1_000_000);
+        assert_eq!(sweep[0].samples(1000), 1000);
+    }
+
     #[test]
     fn sweep_covers_range_ends_choices_and_booleans() {
         let labels: Vec<String> = parameter_sweep(&SPEC)
@@ -285,20 +346,31 @@ mod tests {
         }
     }
 
-    /// Seeded interior values lie inside the range, log-uniform over a
-    /// range of decades, the same on every run; each colour is swept at its
-    /// maximum with the other colours that have defaults at zero.
+    /// Seeded interior values lie inside the range, one in each of its
+    /// tenths (log-spaced over a range of decades), the same on every run;
+    /// each colour is swept at its maximum with the other colours that
+    /// have defaults at zero.
     #[test]
     fn sweep_adds_interior_values_and_colours_at_their_maximum() {
         let sweep = parameter_sweep(&SPEC).unwrap();
-        let inside: Vec<f64> = sweep
+        let inside: Vec<(f64, usize)> = sweep
             .iter()
-            .filter_map(|v| v.label.strip_prefix("roughness = "))
-            .map(|v| v.parse().unwrap())
-            .filter(|&v| v != 1e-4 && v != 1.0)
+            .filter_map(|v| Some((v.label.strip_prefix("roughness = ")?, v.stratum?)))
+            .map(|(v, k)| (v.parse().unwrap(), k))
             .collect();
-        assert_eq!(inside.len(), INTERIOR_VALUES, "{inside:?}");
-        assert!(inside.iter().all(|&v| 1e-4 < v && v < 1.0), "{inside:?}");
+        assert_eq!(inside.len(), STRATA, "{inside:?}");
+        for (k, &(v, stratum)) in inside.iter().enumerate() {
+            assert_eq!(stratum, k);
+            // The tenth of the log range, from 1e-4 to 1: [1e-4 10^(0.4k), ...).
+            let (lo, hi) = (
+                1e-4 * 10f64.powf(0.4 * k as f64),
+                1e-4 * 10f64.powf(0.4 * (k + 1) as f64),
+            );
+            assert!(
+                lo <= v && v < hi * (1.0 + 1e-12),
+                "{k}: {v} not in [{lo}, {hi})"
+            );
+        }
         let again: Vec<String> = parameter_sweep(&SPEC)
             .unwrap()
             .into_iter()

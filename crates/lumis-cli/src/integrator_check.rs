@@ -175,6 +175,12 @@ pub fn check_integrator_with(
             Location::Builtin,
         );
         let made = registry.create::<dyn Integrator>(&entity, ());
+        // A value inside a range is rendered with its share of the samples.
+        let cfg = &IntegratorCheckConfig {
+            spp: variant.samples(cfg.spp as usize) as u32,
+            compare_spp: variant.samples(cfg.compare_spp as usize) as u32,
+            ..cfg.clone()
+        };
         for (t, test) in IntegratorTest::ALL.into_iter().enumerate() {
             let mut result = IntegratorCaseResult {
                 integrator: name.to_string(),

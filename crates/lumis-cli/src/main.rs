@@ -190,6 +190,10 @@ fn main() -> ExitCode {
             for line in report.profile.iter().flat_map(|p| p.lines()) {
                 println!("{line}");
             }
+            for warning in report.defect_warnings() {
+                eprintln!("{warning}");
+            }
+            report.strict_check(&args)?;
             Ok(Outcome::Done)
         }),
         Command::Merge(args) => plain(|| {
@@ -453,6 +457,13 @@ fn check_plugin(
     set: &[String],
 ) -> Result<bool> {
     let fixed = lumis_cli::fixed_parameters(set)?;
+    // Before any check runs: a failure picture has somewhere to go.
+    std::fs::create_dir_all(out).map_err(|e| {
+        Error::msg(format!(
+            "--out {}: cannot create the directory for failure pictures: {e}",
+            out.display()
+        ))
+    })?;
     let mut registry = registry_with_search_path()?;
     if let Some(library) = &library {
         // The library's plugins are the ones it added (its path as the

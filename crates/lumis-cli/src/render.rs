@@ -3,8 +3,10 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
+use lumis_core::audit::Defects;
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{profiled_sampler, profiled_scene, Profile, ProfileReport};
@@ -54,6 +56,11 @@ pub struct RenderArgs {
     /// slower).
     #[arg(long)]
     pub stats: bool,
+    /// Fail (exit 1, after the image is written) where a loaded plugin
+    /// answered with NaN or infinite values, negative ones, or BSDF samples
+    /// that create energy; without it, each is a warning.
+    #[arg(long)]
+    pub strict: bool,
     /// Save the render's state (NAME.checkpoint beside the EXR, and the
     /// image so far) every SECONDS, or after every pass without a value.
     /// Without this flag a render checkpoints every 60 s.
@@ -112,9 +119,33 @@ pub struct RenderReport {
     pub stats: RenderStats,
     /// Time by stage, with `--stats`.
     pub profile: Option<ProfileReport>,
+    /// The loaded plugins whose answers held defects, each named with its
+    /// library ([`lumis_core::audit`]).
+    pub defects: Vec<(Arc<str>, Defects)>,
 }
 
 impl RenderReport {
+    /// One warning line per loaded plugin whose answers held defects.
+    pub fn defect_warnings(&self) -> Vec<String> {
+        self.defects
+            .iter()
+            .map(|(plugin, defects)| {
+                format!("warning: {plugin}: {}", defects.describe().join("; "))
+            })
+            .collect()
+    }
+
+    /// With `--strict`, the error that defects are.
+    pub fn strict_check(&self, args: &RenderArgs) -> Result<()> {
+        if args.strict && !self.defects.is_empty() {
+            return Err(Error::msg(format!(
+                "--strict: {} loaded plugin(s) answered with defects (warned above); the image was written to {}",
+                self.defects.len(),
+                self.exr.display()
+            )));
+        }
+        Ok(())
+    }
     /// The one-line summary printed at the end of a render.
     pub fn summary(&self) -> String {
         let secs = self.seconds.max(1e-9);
@@ -627,6 +658,7 @@ pub fn render_scene_file(
         seconds,
         stats,
         profile,
+        defects: registry.faults().defects(),
     })
 }
 

@@ -20,17 +20,29 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
+use crate::audit::{Answer, Defects, Tally};
 use crate::error::{Error, Result};
 use crate::registry::Registry;
 use crate::wrap::{CallHook, Fault, Wrapped};
 
 /// The faults of guarded plugins; shared by a registry and every guard it
 /// made.
-#[derive(Debug, Default)]
+#[derive(Default)]
 pub struct FaultSink {
     faulted: AtomicBool,
     /// The first fault of each plugin (by label), in the order they came.
     faults: Mutex<Vec<(Arc<str>, Error)>>,
+    /// What each plugin's answers held that no correct plugin gives, by
+    /// the plugin's name with its library ([`crate::audit`]).
+    tallies: Mutex<Vec<(Arc<str>, Arc<Tally>)>>,
+}
+
+impl std::fmt::Debug for FaultSink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FaultSink")
+            .field("faulted", &self.has_fault())
+            .finish_non_exhaustive()
+    }
 }
 
 impl FaultSink {
@@ -58,6 +70,29 @@ impl FaultSink {
             .first()
             .map(|(_, e)| e.clone())
             .unwrap_or_else(|| Error::msg("a plugin panicked")))
+    }
+
+    /// The tally of the plugin named `name`, shared by every object made
+    /// under that name.
+    fn tally(&self, name: &str) -> Arc<Tally> {
+        let mut tallies = self.tallies.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, tally)) = tallies.iter().find(|(n, _)| **n == *name) {
+            return tally.clone();
+        }
+        let tally = Arc::new(Tally::default());
+        tallies.push((Arc::from(name), tally.clone()));
+        tally
+    }
+
+    /// The loaded plugins whose answers held defects so far (NaN or
+    /// infinite, negative, energy created), each named with its library.
+    pub fn defects(&self) -> Vec<(Arc<str>, Defects)> {
+        let tallies = self.tallies.lock().unwrap_or_else(|e| e.into_inner());
+        tallies
+            .iter()
+            .map(|(name, tally)| (name.clone(), tally.defects()))
+            .filter(|(_, defects)| defects.any())
+            .collect()
     }
 
     /// The faults of the plugins whose label starts with `owner` (the
@@ -146,37 +181,63 @@ impl PluginGuard {
 /// the plugin has panicked it is not called again: its state may be
 /// broken, and each further panic would cost as much as the work it
 /// interrupts.
+///
+/// Every answer that comes back is audited ([`crate::audit`]): the counts
+/// go to the plugin's tally in the registry's [`FaultSink`].
 pub struct Guard {
     guard: PluginGuard,
     label: Arc<str>,
     tripped: AtomicBool,
+    tally: Arc<Tally>,
 }
 
 impl Guard {
     /// `label` names the plugin in messages, with its parameters.
     pub fn new(guard: PluginGuard, label: Arc<str>) -> Self {
+        let tally = guard
+            .faults
+            .tally(&format!("{label} from '{}'", guard.library));
         Self {
             guard,
             label,
             tripped: AtomicBool::new(false),
+            tally,
         }
     }
 }
 
 impl CallHook for Guard {
     #[inline]
-    fn call<T>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
+    fn call<T: Answer>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
         if self.tripped.load(Ordering::Relaxed) {
             return Err(Fault::Tripped);
         }
-        self.guard.call(&self.label, method, call).map_err(|error| {
-            self.tripped.store(true, Ordering::Relaxed);
-            Fault::Panicked(error)
-        })
+        match self.guard.call(&self.label, method, call) {
+            Ok(answer) => {
+                answer.audit(&self.tally);
+                Ok(answer)
+            }
+            Err(error) => {
+                self.tripped.store(true, Ordering::Relaxed);
+                Err(Fault::Panicked(error))
+            }
+        }
+    }
+
+    #[inline]
+    fn seen<T: Answer>(&self, out: &[T]) {
+        for answer in out {
+            answer.audit(&self.tally);
+        }
     }
 
     fn child(&self) -> Self {
-        Self::new(self.guard.clone(), self.label.clone())
+        Self {
+            guard: self.guard.clone(),
+            label: self.label.clone(),
+            tripped: AtomicBool::new(false),
+            tally: self.tally.clone(),
+        }
     }
 }
 

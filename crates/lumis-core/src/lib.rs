@@ -9,6 +9,7 @@
 // The derives name `::lumis_core`, which this lets them do here too.
 extern crate self as lumis_core;
 
+pub mod audit;
 pub mod bsdf;
 pub mod denoiser;
 pub mod doc;

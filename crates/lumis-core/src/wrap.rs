@@ -14,6 +14,7 @@ use std::ops::{Deref, DerefMut};
 
 use glam::{Vec2, Vec3};
 
+use crate::audit::Answer;
 use crate::bsdf::BsdfFlags;
 use crate::error::Error;
 use crate::spectrum::Rgb;
@@ -22,7 +23,12 @@ use crate::spectrum::Rgb;
 pub trait CallHook: Send + Sync + Sized + 'static {
     /// Runs `call`, one call of the method `method` (`"Bsdf::f"`), or
     /// answers with the fault that kept it from completing.
-    fn call<T>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault>;
+    fn call<T: Answer>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault>;
+
+    /// What a batched method wrote into its `out` lanes, after the call
+    /// completed: each lane is an answer too.
+    #[inline]
+    fn seen<T: Answer>(&self, _out: &[T]) {}
 
     /// The hook for a plugin object the wrapped one made (a sampler's
     /// clone, its lanes): wrapped the same way, with state of its own.

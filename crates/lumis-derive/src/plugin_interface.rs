@@ -17,7 +17,9 @@
 //! A method whose call faulted answers with its `#[on_fault(expr)]` (the
 //! arguments, and the fault as `fault`, are in scope), else with
 //! `Neutral::neutral()` of its return type. A returned `Box<dyn X>` (a
-//! sampler's clone) is wrapped in turn with the hook's `child()`.
+//! sampler's clone) is wrapped in turn with the hook's `child()`. The lanes
+//! a batched method writes into its `out` argument are shown to the hook
+//! (`seen`) after the call.
 //!
 //! `#[wrappers_answer(expr)]` on a method makes every wrapper answer it
 //! without asking the wrapped object: for a method whose answer would let
@@ -213,6 +215,13 @@ fn wrapped_impl(item: &ItemTrait, methods: &[Method]) -> TokenStream {
         } else {
             quote!(value)
         };
+        // A batched method's answers are its `out` lanes.
+        let seen = method
+            .args
+            .iter()
+            .zip(&method.mutable_refs)
+            .find(|(name, &mutable)| mutable && *name == "out")
+            .map(|(out, _)| quote!(::lumis_core::wrap::CallHook::seen(hook, &*#out);));
         let fault = match &method.on_fault {
             Some(answer) => quote!(#answer),
             None => quote!(::lumis_core::wrap::Neutral::neutral()),
@@ -222,7 +231,10 @@ fn wrapped_impl(item: &ItemTrait, methods: &[Method]) -> TokenStream {
             #sig {
                 #parts
                 match ::lumis_core::wrap::CallHook::call(hook, #label, || inner.#ident(#(#args),*)) {
-                    ::core::result::Result::Ok(value) => #value,
+                    ::core::result::Result::Ok(value) => {
+                        #seen
+                        #value
+                    }
                     ::core::result::Result::Err(fault) => {
                         let _ = &fault;
                         #fault

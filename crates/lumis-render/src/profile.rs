@@ -20,6 +20,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use lumis_core::audit::Answer;
 use lumis_core::wrap::{CallHook, Fault, Wrapped};
 use lumis_core::{Bsdf, Light, LightSampler, Sampler, Scene};
 
@@ -237,7 +238,7 @@ pub struct InStage(pub Stage);
 
 impl CallHook for InStage {
     #[inline]
-    fn call<T>(&self, _: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
+    fn call<T: Answer>(&self, _: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
         Ok(in_stage(self.0, call))
     }
     fn child(&self) -> Self {
@@ -253,7 +254,7 @@ pub struct SceneStages;
 
 impl CallHook for SceneStages {
     #[inline]
-    fn call<T>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
+    fn call<T: Answer>(&self, method: &'static str, call: impl FnOnce() -> T) -> Result<T, Fault> {
         Ok(if method.starts_with("Scene::intersect") {
             in_stage(Stage::Traversal, call)
         } else if method.starts_with("Scene::occluded") {
