@@ -159,9 +159,10 @@ fn check_sampler(sampler: &mut dyn Sampler, how: &str) {
     let mut out = [(0.0, Vec2::ZERO); 2];
     lanes.get_1d_2d_batch(&[0, 2], &mut out);
     assert_eq!(out, [LANES_1D_2D; 2], "{how}: the sampler's own lanes");
-    let mut lane = lanes.lane(1);
-    assert_eq!(lane.get_1d_2d(), U1_2D, "{how}: one lane");
-    assert_eq!(lane.pixel_pattern(), PATTERN, "{how}: one lane");
+    lanes.with_lane(1, |lane| {
+        assert_eq!(lane.get_1d_2d(), U1_2D, "{how}: one lane");
+        assert_eq!(lane.pixel_pattern(), PATTERN, "{how}: one lane");
+    });
 }
 
 fn check_integrator(integrator: &dyn Integrator, lanes_of: &dyn Sampler, how: &str) {

@@ -275,9 +275,10 @@ fn check_lanes(
     let mut lanes = s.lanes(n);
     let order: Vec<usize> = (0..n).collect();
     for (i, _) in forward.iter().enumerate() {
-        let mut lane = lanes.lane(i);
-        lane.start_pixel_sample(pixel, i as u32, seed);
-        lane.get_pixel_2d();
+        lanes.with_lane(i, |lane| {
+            lane.start_pixel_sample(pixel, i as u32, seed);
+            lane.get_pixel_2d();
+        });
     }
     let mut out = vec![(0.0, Vec2::ZERO); n];
     for round in 0..rounds {

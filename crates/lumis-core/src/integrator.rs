@@ -42,7 +42,7 @@ pub trait Integrator: Send + Sync {
         out: &mut [Rgb],
     ) {
         for (i, (ray, out)) in rays.iter().zip(out).enumerate() {
-            *out = self.li(ray, scene, &mut samplers.lane(i), stats);
+            *out = samplers.with_lane(i, |sampler| self.li(ray, scene, sampler, stats));
         }
     }
 }

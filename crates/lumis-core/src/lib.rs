@@ -51,7 +51,7 @@ pub use params::{
 };
 pub use ray::Ray;
 pub use registry::{PluginInterface, PluginKind, PluginSpec, Registry};
-pub use sampler::{ConcreteLanes, Lane, PixelPattern, Sampler, SamplerLanes};
+pub use sampler::{ConcreteLanes, PixelPattern, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
 pub use stats::RenderStats;

@@ -132,6 +132,16 @@ pub trait SamplerLanes: Send + Sync {
     #[on_fault(Box::new(FaultedSampler))]
     fn clone_lane(&self, lane: usize) -> Box<dyn Sampler>;
 
+    /// Lane `lane`'s own sampler, where the lanes can lend it: asked
+    /// directly, a request costs one virtual call instead of two (see
+    /// [`with_lane`](SamplerLanes::with_lane)). A wrapper lends nothing:
+    /// its requests must pass through it.
+    #[wrappers_answer(None)]
+    fn own_lane(&mut self, lane: usize) -> Option<&mut dyn Sampler> {
+        let _ = lane;
+        None
+    }
+
     /// `out[k]` = [`Sampler::get_1d_2d`] of lane `lanes[k]`, in order: the
     /// request each vertex of a wave makes for its BSDF sample and for its
     /// light sample. Each lane gets exactly the numbers it would get asked
@@ -145,16 +155,22 @@ pub trait SamplerLanes: Send + Sync {
 }
 
 impl dyn SamplerLanes + '_ {
-    /// Lane `index` as a [`Sampler`] of its own.
-    pub fn lane(&mut self, index: usize) -> Lane<'_> {
-        Lane { lanes: self, index }
+    /// Runs `f` with lane `index` as a [`Sampler`] of its own: the lane's
+    /// own sampler where the lanes lend it, else a view whose requests are
+    /// the batch's requests for the lane.
+    #[inline]
+    pub fn with_lane<R>(&mut self, index: usize, f: impl FnOnce(&mut dyn Sampler) -> R) -> R {
+        if let Some(sampler) = self.own_lane(index) {
+            return f(sampler);
+        }
+        f(&mut Lane { lanes: self, index })
     }
 }
 
 /// One lane of a batch of samplers, as a [`Sampler`]: its requests are the
 /// batch's requests for the lane, and its declarations those of the lane's
 /// own sampler (the implementation is generated with [`Sampler`]'s).
-pub struct Lane<'a> {
+struct Lane<'a> {
     lanes: &'a mut dyn SamplerLanes,
     index: usize,
 }
@@ -172,7 +188,28 @@ impl<S: Sampler + Clone + 'static> ConcreteLanes<S> {
     }
 }
 
-impl<S: Sampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
+/// A sampler as `&mut dyn Sampler`: what a concrete sampler coerces to,
+/// and what `dyn Sampler` already is, so that [`ConcreteLanes`] lends
+/// either.
+pub trait AsDynSampler: Sampler {
+    fn as_dyn(&mut self) -> &mut dyn Sampler;
+}
+
+impl<S: Sampler> AsDynSampler for S {
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn Sampler {
+        self
+    }
+}
+
+impl AsDynSampler for dyn Sampler {
+    #[inline]
+    fn as_dyn(&mut self) -> &mut dyn Sampler {
+        self
+    }
+}
+
+impl<S: AsDynSampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
     fn len(&self) -> usize {
         self.0.len()
     }
@@ -200,6 +237,10 @@ impl<S: Sampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
     }
     fn clone_lane(&self, lane: usize) -> Box<dyn Sampler> {
         self.0[lane].clone_sampler()
+    }
+    #[inline]
+    fn own_lane(&mut self, lane: usize) -> Option<&mut dyn Sampler> {
+        Some(self.0[lane].as_dyn())
     }
     fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
         for (&i, out) in lanes.iter().zip(out) {

@@ -196,11 +196,12 @@ fn render_tile(
                     }
                     let pixel =
                         UVec2::new(tile.min.x + i as u32 % width, tile.min.y + i as u32 / width);
-                    let mut lane = lanes.lane(batch.filled);
-                    lane.start_pixel_sample(pixel, index, seed);
-                    // Box filter of radius 1/2: uniform over the pixel, weight 1.
-                    batch.rays[batch.filled] = profile::in_stage(Stage::CameraAndFilm, || {
-                        camera.generate_ray(pixel, lane.get_pixel_2d())
+                    batch.rays[batch.filled] = lanes.with_lane(batch.filled, |lane| {
+                        lane.start_pixel_sample(pixel, index, seed);
+                        // Box filter of radius 1/2: uniform over the pixel, weight 1.
+                        profile::in_stage(Stage::CameraAndFilm, || {
+                            camera.generate_ray(pixel, lane.get_pixel_2d())
+                        })
                     });
                     if first_hits {
                         let mut rng = first_hit_rng(pixel, index, seed);

@@ -107,9 +107,10 @@ fn batched_requests_match_lone_samplers() {
         let mut lone: Vec<Box<dyn Sampler>> = (0..N).map(|_| sampler.clone_sampler()).collect();
         for (i, lone) in lone.iter_mut().enumerate() {
             let (pixel, index) = (UVec2::new(i as u32 % 3, 40 + i as u32), 7 * i as u32);
-            lanes.lane(i).start_pixel_sample(pixel, index, 42);
+            lanes.with_lane(i, |lane| lane.start_pixel_sample(pixel, index, 42));
             lone.start_pixel_sample(pixel, index, 42);
-            assert_eq!(lanes.lane(i).get_pixel_2d(), lone.get_pixel_2d(), "{name}");
+            let film = lanes.with_lane(i, |lane| lane.get_pixel_2d());
+            assert_eq!(film, lone.get_pixel_2d(), "{name}");
         }
         let subsets: [&[usize]; 3] = [&[0, 1, 2, 3, 4, 5], &[1, 4], &[5, 0, 3]];
         for request in 0..30 {
@@ -128,7 +129,7 @@ fn batched_requests_match_lone_samplers() {
             // Russian roulette make.
             let i = request % N;
             assert_eq!(
-                lanes.lane(i).get_1d().to_bits(),
+                lanes.with_lane(i, |lane| lane.get_1d()).to_bits(),
                 lone[i].get_1d().to_bits(),
                 "{name}: lane {i}"
             );

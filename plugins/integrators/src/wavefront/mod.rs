@@ -261,7 +261,7 @@ impl WavefrontIntegrator {
                 continue;
             }
             let plan = if hit.bsdf_flags.is_non_specular() {
-                estimator.plan(&mut samplers.lane(lane))
+                samplers.with_lane(lane, |sampler| estimator.plan(sampler))
             } else {
                 VertexPlan::UNWEIGHTED
             };
@@ -303,14 +303,11 @@ impl WavefrontIntegrator {
                 continue;
             };
             let path = &mut wave.paths[v.lane];
-            let mut sampler = samplers.lane(v.lane);
-            if path.continue_path(
-                &v.vertex(hit),
-                bs,
-                &v.plan,
-                self.path.rr_depth,
-                &mut sampler,
-            ) {
+            let (vertex, rr_depth) = (v.vertex(hit), self.path.rr_depth);
+            let going_on = samplers.with_lane(v.lane, |sampler| {
+                path.continue_path(&vertex, bs, &v.plan, rr_depth, sampler)
+            });
+            if going_on {
                 wave.live.push(v.lane);
             }
         }
