@@ -64,13 +64,9 @@ pub trait Sampler: Send + Sync {
     /// default boxes `n` clones and asks them one virtual call at a time;
     /// a `Clone` sampler returns [`ConcreteLanes`] instead, whose batched requests
     /// call it directly.
-    #[on_fault(Box::new(ConcreteLanes::<dyn Sampler>(
-        (0..n).map(|_| Box::new(FaultedSampler) as Box<dyn Sampler>).collect(),
-    )))]
+    #[on_fault(ConcreteLanes::made_by(n, || Box::new(FaultedSampler)))]
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {
-        Box::new(ConcreteLanes::<dyn Sampler>(
-            (0..n).map(|_| self.clone_sampler()).collect(),
-        ))
+        ConcreteLanes::made_by(n, || self.clone_sampler())
     }
 }
 
@@ -94,8 +90,8 @@ pub enum PixelPattern {
 /// The samplers of a batch of paths, one per lane, each drawing its own
 /// pixel sample's numbers in its own order, asked by lane: a wavefront
 /// integrator asks them together. Lane `i` answers exactly what its own
-/// sampler would answer asked alone; [`lane`](SamplerLanes::lane) is one
-/// lane as a [`Sampler`].
+/// sampler would answer asked alone; [`with_lane`](SamplerLanes::with_lane)
+/// lends one lane as a [`Sampler`].
 #[plugin_interface]
 pub trait SamplerLanes: Send + Sync {
     /// How many lanes.
@@ -185,6 +181,13 @@ impl<S: Sampler + Clone + 'static> ConcreteLanes<S> {
     /// `n` copies of `sampler`, boxed for [`Sampler::lanes`].
     pub fn boxed(sampler: &S, n: usize) -> Box<dyn SamplerLanes> {
         Box::new(Self((0..n).map(|_| Box::new(sampler.clone())).collect()))
+    }
+}
+
+impl ConcreteLanes<dyn Sampler> {
+    /// `n` lanes, each a sampler `make` makes.
+    fn made_by(n: usize, mut make: impl FnMut() -> Box<dyn Sampler>) -> Box<dyn SamplerLanes> {
+        Box::new(Self((0..n).map(|_| make()).collect()))
     }
 }
 

@@ -1,7 +1,7 @@
 //! One forwarding rule for everything that wraps a plugin object.
 //!
-//! A wrapper (the panic guard around a loaded plugin, the profiler's
-//! stages, the render's defect counters) must forward every method of its
+//! A wrapper (the panic guard around a loaded plugin, which also audits
+//! its answers, and the profiler's stages) must forward every method of its
 //! trait, the declarations with a default included: a wrapper that names
 //! only some of them lets the trait's defaults answer for the rest, and a
 //! loaded plugin then behaves unlike the same plugin linked in. So no
@@ -45,14 +45,6 @@ pub struct Wrapped<C, H> {
 impl<C, H> Wrapped<C, H> {
     pub fn new(inner: C, hook: H) -> Self {
         Self { inner, hook }
-    }
-
-    pub fn hook(&self) -> &H {
-        &self.hook
-    }
-
-    pub fn into_inner(self) -> C {
-        self.inner
     }
 }
 
