@@ -16,7 +16,7 @@ use lumis_core::{
     TextureQuery, UVec2, Vec2, Vec3,
 };
 use lumis_render::profile::{InStage, Stage};
-use lumis_tests::cargo_build;
+use lumis_tests::build_plugin;
 
 /// `contract` of `P`'s kind, with `entries` as its table.
 fn make<P: PluginInterface + ?Sized>(
@@ -41,14 +41,7 @@ fn make<P: PluginInterface + ?Sized>(
 fn linked_and_loaded() -> [(&'static str, Registry); 2] {
     let mut linked = Registry::new();
     contract_plugin::register(&mut linked).unwrap();
-    let library = cargo_build(
-        "contract-plugin",
-        &format!(
-            "/{}contract_plugin.{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_EXTENSION
-        ),
-    );
+    let library = build_plugin("contract-plugin", "contract_plugin");
     let mut loaded = Registry::new();
     lumis_loader::load_library(&library, &mut loaded).unwrap();
     [("linked", linked), ("loaded", loaded)]

@@ -9,62 +9,19 @@ use std::process::Command;
 use lumis_check::bsdf_suite::{check_bsdf_with, BsdfCheckConfig};
 use lumis_check::outcome::Outcome;
 use lumis_core::Registry;
-use lumis_tests::{build_lumis, cargo_build};
+use lumis_tests::{build_lumis, build_plugin, plugin_quad_scene};
 
 fn scene(library: &str, defect: &str, roughness: f32) -> String {
-    format!(
-        r#"[plugins]
-load = ["{library}"]
-[film]
-resolution = [16, 16]
-[camera]
-type = "perspective"
-origin = [0.0, 0.0, 3.0]
-target = [0.0, 0.0, 0.0]
-fov = 40.0
-[sampler]
-type = "independent"
-spp = 16
-[integrator]
-type = "path"
-max_depth = 3
-[[bsdf]]
-name = "suspect"
-type = "defective"
-defect = "{defect}"
-roughness = {roughness:?}
-[[shape]]
-type = "quad"
-corner = [-1.0, -1.0, 0.0]
-edge_u = [2.0, 0.0, 0.0]
-edge_v = [0.0, 2.0, 0.0]
-bsdf = "suspect"
-[[bsdf]]
-name = "white"
-type = "diffuse"
-reflectance = 0.5
-[[shape]]
-type = "quad"
-corner = [1.2, -0.5, 1.5]
-edge_u = [0.0, 1.0, 0.0]
-edge_v = [1.0, 0.0, 0.0]
-bsdf = "white"
-emission = {{ radiance = [4.0, 4.0, 4.0] }}
-"#
-    )
+    let bsdf = format!(
+        "[[bsdf]]\nname = \"subject\"\ntype = \"defective\"\ndefect = \"{defect}\"\nroughness = {roughness:?}"
+    );
+    plugin_quad_scene(library, &bsdf, 16, 16)
 }
 
 /// `lumis render` of the defective BSDF: (exit code, stderr, whether the
 /// image was written).
 fn render(defect: &str, roughness: f32, strict: bool) -> (Option<i32>, String, bool) {
-    let library = cargo_build(
-        "defective-plugin",
-        &format!(
-            "/{}defective_plugin.{}",
-            std::env::consts::DLL_PREFIX,
-            std::env::consts::DLL_EXTENSION
-        ),
-    );
+    let library = build_plugin("defective-plugin", "defective_plugin");
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, scene(library.to_str().unwrap(), defect, roughness)).unwrap();

@@ -8,22 +8,13 @@ use std::process::Command;
 use lumis_check::bsdf_suite::{check_bsdf, format_results, BsdfCheckConfig};
 use lumis_check::outcome::Outcome;
 use lumis_tests::{
-    assert_same_mean, bonferroni_z, build_lumis, cargo_build, render_toml_with, scenes_dir,
+    assert_same_mean, bonferroni_z, build_lumis, build_plugin, plugin_quad_scene, render_toml_with,
+    scenes_dir,
 };
 
 /// `cargo build -p example-bsdf`, returning the path of the cdylib it wrote.
 fn build_example_plugin() -> PathBuf {
     build_plugin("example-bsdf", "example_bsdf")
-}
-
-/// `cargo build -p PACKAGE`, returning the path of the cdylib `LIB` it wrote.
-fn build_plugin(package: &str, lib: &str) -> PathBuf {
-    let name = format!(
-        "{}{lib}.{}",
-        std::env::consts::DLL_PREFIX,
-        std::env::consts::DLL_EXTENSION
-    );
-    cargo_build(package, &format!("/{name}"))
 }
 
 fn scene(plugins: &str, seed: u32) -> String {
@@ -329,42 +320,7 @@ fn a_panicking_plugin_is_an_error_not_an_abort() {
 }
 
 fn scene_with_plugin(library: &str, panic_in: &str) -> String {
-    format!(
-        r#"[plugins]
-load = ["{library}"]
-[film]
-resolution = [8, 8]
-[camera]
-type = "perspective"
-origin = [0.0, 0.0, 3.0]
-target = [0.0, 0.0, 0.0]
-fov = 40.0
-[sampler]
-type = "independent"
-spp = 4
-[integrator]
-type = "path"
-[[bsdf]]
-name = "faulty"
-type = "panicking"
-panic_in = "{panic_in}"
-[[shape]]
-type = "quad"
-corner = [-1.0, -1.0, 0.0]
-edge_u = [2.0, 0.0, 0.0]
-edge_v = [0.0, 2.0, 0.0]
-bsdf = "faulty"
-[[bsdf]]
-name = "white"
-type = "diffuse"
-reflectance = 0.5
-[[shape]]
-type = "quad"
-corner = [1.2, -0.5, 1.5]
-edge_u = [0.0, 1.0, 0.0]
-edge_v = [1.0, 0.0, 0.0]
-bsdf = "white"
-emission = {{ radiance = [4.0, 4.0, 4.0] }}
-"#
-    )
+    let bsdf =
+        format!("[[bsdf]]\nname = \"subject\"\ntype = \"panicking\"\npanic_in = \"{panic_in}\"");
+    plugin_quad_scene(library, &bsdf, 8, 4)
 }

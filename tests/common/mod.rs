@@ -94,6 +94,59 @@ pub fn cargo_build(package: &str, suffix: &str) -> PathBuf {
         .unwrap_or_else(|| panic!("cargo reported no {suffix}:\n{stdout}"))
 }
 
+/// `cargo build -p PACKAGE`, returning the path of the plugin library
+/// (cdylib) `LIB` it wrote.
+pub fn build_plugin(package: &str, lib: &str) -> PathBuf {
+    let name = format!(
+        "{}{lib}.{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_EXTENSION
+    );
+    cargo_build(package, &format!("/{name}"))
+}
+
+/// A scene that loads the plugin `library` and shows the BSDF `subject`,
+/// declared by `bsdf` (a `[[bsdf]]` table), on a quad lit by a small
+/// emitting quad: `size` x `size` pixels at `spp`, traced by `path`.
+pub fn plugin_quad_scene(library: &str, bsdf: &str, size: u32, spp: u32) -> String {
+    format!(
+        r#"[plugins]
+load = ["{library}"]
+[film]
+resolution = [{size}, {size}]
+[camera]
+type = "perspective"
+origin = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+fov = 40.0
+[sampler]
+type = "independent"
+spp = {spp}
+[integrator]
+type = "path"
+max_depth = 3
+{bsdf}
+[[shape]]
+type = "quad"
+corner = [-1.0, -1.0, 0.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 2.0, 0.0]
+bsdf = "subject"
+[[bsdf]]
+name = "white"
+type = "diffuse"
+reflectance = 0.5
+[[shape]]
+type = "quad"
+corner = [1.2, -0.5, 1.5]
+edge_u = [0.0, 1.0, 0.0]
+edge_v = [1.0, 0.0, 0.0]
+bsdf = "white"
+emission = {{ radiance = [4.0, 4.0, 4.0] }}
+"#
+    )
+}
+
 /// `cargo build -p lumis-cli`, returning the path of the `lumis` it wrote.
 pub fn build_lumis() -> PathBuf {
     cargo_build("lumis-cli", "/lumis")

@@ -432,27 +432,27 @@ pub fn check_bsdf_variants(
     variants: &[Variant],
     cfg: &BsdfCheckConfig,
 ) -> Result<Vec<CaseResult>> {
-    let cases = variants.len() * cfg.cos_theta_o.len();
     // A variant the plugin cannot make fails its cases; the others go on.
     let bsdfs: Vec<_> = variants
         .iter()
         .map(|v| instantiate(registry, name, v))
         .collect();
-    let tests: usize = bsdfs
+    let mut work = Vec::new();
+    for (variant, bsdf) in variants.iter().zip(&bsdfs) {
+        for (i, c) in directions_of(variant, &cfg.cos_theta_o) {
+            work.push((work.len(), variant, bsdf, i, c));
+        }
+    }
+    let tests: usize = work
         .iter()
-        .flatten()
-        .map(|b| hemispheres(b.as_ref()).len() * cfg.cos_theta_o.len())
+        .filter_map(|w| w.2.as_ref().ok())
+        .map(|b| hemispheres(b.as_ref()).len())
         .sum();
     let chi_cfg = ChiSquareConfig {
         significance: corrected_significance(cfg.alpha, tests),
         ..cfg.chi_square
     };
-    let mut work = Vec::with_capacity(cases);
-    for (variant, bsdf) in variants.iter().zip(&bsdfs) {
-        for (i, &c) in cfg.cos_theta_o.iter().enumerate() {
-            work.push((work.len(), variant, bsdf, i, c));
-        }
-    }
+    let case_variants: Vec<&Variant> = work.iter().map(|w| w.1).collect();
     let mut results: Vec<CaseResult> = work
         .into_par_iter()
         .map(|(case, variant, bsdf, i, c)| {
@@ -477,7 +477,6 @@ pub fn check_bsdf_variants(
                     let (mut sample, pdf) = bsdf_pair(bsdf.as_ref(), wo);
                     let case_cfg = ChiSquareConfig {
                         seed: chi_cfg.seed.wrapping_add(2 * case as u64 + h as u64),
-                        samples: variant.samples(chi_cfg.samples),
                         ..chi_cfg
                     };
                     chi_square_zoomed(
@@ -489,7 +488,7 @@ pub fn check_bsdf_variants(
                 .min_by(|a, b| a.0.p_value.total_cmp(&b.0.p_value))
                 .expect("at least one hemisphere");
             let (albedo, albedo_se, problems) =
-                check_values(bsdf.as_ref(), wo, variant.samples(cfg.samples), i as u64);
+                check_values(bsdf.as_ref(), wo, cfg.samples, i as u64);
             let not_testable = if report.passed || report.defect.is_some() {
                 None
             } else {
@@ -511,14 +510,33 @@ pub fn check_bsdf_variants(
         .collect();
     // A loaded plugin that panicked answered with neutral values (see
     // lumis_core::guard); every case of its variant fails with the panic.
-    for (result, variant) in results.iter_mut().zip(
-        variants
-            .iter()
-            .flat_map(|v| std::iter::repeat_n(v, cfg.cos_theta_o.len())),
-    ) {
+    for (result, variant) in results.iter_mut().zip(case_variants) {
         add_faults(registry, &owner(name, variant), &mut result.problems);
     }
     Ok(results)
+}
+
+/// The incident directions `(index, cos theta_o)` a variant is checked at:
+/// all of them; or, for a value inside a range (a stratum of the sweep), a
+/// share at full strength: each stratum one front-side direction, and
+/// every other stratum one back-side direction too, in turn, so that the
+/// ten strata of a range take 15 cases (two full values took 16), every
+/// stratum meets the side every BSDF has, and together they meet every
+/// direction.
+fn directions_of(variant: &Variant, cos_theta_o: &[f32]) -> Vec<(usize, f32)> {
+    let all = cos_theta_o.iter().copied().enumerate();
+    let Some(k) = variant.stratum else {
+        return all.collect();
+    };
+    let (front, back): (Vec<_>, Vec<_>) = all.partition(|&(_, c)| c > 0.0);
+    let mut chosen = Vec::new();
+    if !front.is_empty() {
+        chosen.push(front[k % front.len()]);
+    }
+    if (k % 2 == 1 || front.is_empty()) && !back.is_empty() {
+        chosen.push(back[(k / 2) % back.len()]);
+    }
+    chosen
 }
 
 /// Where a chi-square test looks for samples.

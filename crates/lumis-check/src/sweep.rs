@@ -24,9 +24,11 @@ impl Variant {
     /// inside a range take [`INTERIOR_BUDGET`] / [`STRATA`] each, so the
     /// strata of a range cost together what [`INTERIOR_BUDGET`] full
     /// variants cost, and each is still met by every case of a suite (every
-    /// incident direction, every reference point): a defect at one value
-    /// is a NaN, a negative value, an inconsistent pdf or energy created,
-    /// each found with few samples.
+    /// reference point, every test scene): a defect at one value is a NaN,
+    /// a negative value, an inconsistent pdf or energy created, each found
+    /// with few samples. (The BSDF suite, whose chi-square test costs as
+    /// much per bin as per sample, shares its incident directions among
+    /// the strata instead: `bsdf_suite::directions_of`.)
     pub fn share(&self) -> f64 {
         match self.stratum {
             Some(_) => INTERIOR_BUDGET as f64 / STRATA as f64,

@@ -19,6 +19,7 @@
 //! the renderer rather than in the dependency-light lumis-check.
 
 use lumis_check::outcome::{self, add_faults, summary, unmade, verdict, write_notes, Outcome as _};
+use std::collections::HashMap;
 use std::fmt::Write;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
@@ -165,6 +166,7 @@ pub fn check_integrator_with(
     let tests = variants.len() * 3 * (2 + blocks);
     let significance = corrected_significance(cfg.alpha, tests);
     let mut results = Vec::new();
+    let mut renders = Renders::new(registry);
     for (v, variant) in variants.iter().enumerate() {
         let depth = declared_depth(&spec, variant);
         let entity = PluginEntity::new(
@@ -200,7 +202,7 @@ pub fn check_integrator_with(
                 .wrapping_add((v * IntegratorTest::ALL.len() + t) as u64);
             match &made {
                 Ok(integrator) => measure(
-                    registry,
+                    &mut renders,
                     integrator.as_ref(),
                     test,
                     depth,
@@ -222,7 +224,7 @@ pub fn check_integrator_with(
 
 /// Renders one case into `result`, or says why it cannot be tested.
 fn measure(
-    registry: &Registry,
+    renders: &mut Renders,
     integrator: &dyn Integrator,
     test: IntegratorTest,
     depth: Option<u32>,
@@ -244,7 +246,7 @@ fn measure(
         return;
     }
     let run = catch_unwind(AssertUnwindSafe(|| {
-        run_case(registry, integrator, test, depth, cfg, seed)
+        run_case(renders, integrator, test, depth, cfg, seed)
     }));
     match run {
         Ok(Ok(outcome)) => outcome.fill(result),
@@ -314,13 +316,14 @@ fn two_sided_p(z: f64) -> f64 {
 }
 
 fn run_case(
-    registry: &Registry,
+    renders: &mut Renders,
     integrator: &dyn Integrator,
     test: IntegratorTest,
     depth: u32,
     cfg: &IntegratorCheckConfig,
     seed: u64,
 ) -> Result<Outcome> {
+    let registry = renders.registry;
     match test {
         IntegratorTest::Furnace => {
             let (image, nonfinite) = render_with(registry, &furnace_scene(cfg), integrator, seed)?;
@@ -338,21 +341,44 @@ fn run_case(
         IntegratorTest::AgreesWithPath => {
             let scene = lit_box(cfg, depth);
             let (image, nonfinite) = render_with(registry, &scene, integrator, seed)?;
-            let loaded = load(registry, &scene)?;
+            let reference = renders.path_reference(cfg, depth)?;
+            Ok(against_reference(&image, reference, cfg.block, nonfinite))
+        }
+    }
+}
+
+/// What the cases render with: the registry, and the built-in `path`'s
+/// images of the lit box, made once per depth and sample count and shared
+/// by every setting compared with them (their noise then correlates the
+/// tests, which leaves the Sidak correction conservative).
+struct Renders<'r> {
+    registry: &'r Registry,
+    path_references: HashMap<(u32, u32), Image>,
+}
+
+impl<'r> Renders<'r> {
+    fn new(registry: &'r Registry) -> Self {
+        Self {
+            registry,
+            path_references: HashMap::new(),
+        }
+    }
+
+    /// `path`'s image of the lit box at `depth`, at `cfg.compare_spp`.
+    fn path_reference(&mut self, cfg: &IntegratorCheckConfig, depth: u32) -> Result<&Image> {
+        let key = (depth, cfg.compare_spp);
+        if !self.path_references.contains_key(&key) {
+            let loaded = load(self.registry, &lit_box(cfg, depth))?;
             let reference = render(
                 &loaded.camera,
                 &loaded.scene,
                 loaded.integrator.as_ref(),
                 loaded.sampler.as_ref(),
-                &settings(&loaded, seed ^ 0x9e37_79b9_7f4a_7c15),
+                &settings(&loaded, cfg.seed ^ 0x9e37_79b9_7f4a_7c15),
             )?;
-            Ok(against_reference(
-                &image,
-                &reference.image,
-                cfg.block,
-                nonfinite,
-            ))
+            self.path_references.insert(key, reference.image);
         }
+        Ok(&self.path_references[&key])
     }
 }
 

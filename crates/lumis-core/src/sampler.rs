@@ -171,75 +171,100 @@ struct Lane<'a> {
     index: usize,
 }
 
-/// Lanes of one sampler type `S`, each boxed: for a concrete `S`, the
-/// batched requests call `S`'s methods without a virtual call per lane, so
-/// they inline into one loop; `S = dyn Sampler` is what any sampler's
+/// Lanes of one sampler type: for a concrete `S`, the batched requests
+/// call `S`'s methods without a virtual call per lane, so they inline into
+/// one loop; `ConcreteLanes<Box<dyn Sampler>>` is what any sampler's
 /// clones make ([`Sampler::lanes`]'s default).
-pub struct ConcreteLanes<S: ?Sized>(Vec<Box<S>>);
+pub struct ConcreteLanes<S>(Vec<S>);
 
 impl<S: Sampler + Clone + 'static> ConcreteLanes<S> {
     /// `n` copies of `sampler`, boxed for [`Sampler::lanes`].
     pub fn boxed(sampler: &S, n: usize) -> Box<dyn SamplerLanes> {
-        Box::new(Self((0..n).map(|_| Box::new(sampler.clone())).collect()))
+        Box::new(Self(vec![sampler.clone(); n]))
     }
 }
 
-impl ConcreteLanes<dyn Sampler> {
+impl ConcreteLanes<Box<dyn Sampler>> {
     /// `n` lanes, each a sampler `make` makes.
     fn made_by(n: usize, mut make: impl FnMut() -> Box<dyn Sampler>) -> Box<dyn SamplerLanes> {
         Box::new(Self((0..n).map(|_| make()).collect()))
     }
 }
 
-/// A sampler as `&mut dyn Sampler`: what a concrete sampler coerces to,
-/// and what `dyn Sampler` already is, so that [`ConcreteLanes`] lends
-/// either.
-pub trait AsDynSampler: Sampler {
+/// What one lane of [`ConcreteLanes`] holds: a sampler of a concrete type,
+/// called without a virtual call, or a boxed one.
+pub trait LaneSlot: Send + Sync + 'static {
+    type Sampler: Sampler + ?Sized;
+    fn sampler(&self) -> &Self::Sampler;
+    fn sampler_mut(&mut self) -> &mut Self::Sampler;
+    /// The sampler as `&mut dyn Sampler`, to lend it.
     fn as_dyn(&mut self) -> &mut dyn Sampler;
 }
 
-impl<S: Sampler> AsDynSampler for S {
+impl<S: Sampler + 'static> LaneSlot for S {
+    type Sampler = S;
+    #[inline]
+    fn sampler(&self) -> &S {
+        self
+    }
+    #[inline]
+    fn sampler_mut(&mut self) -> &mut S {
+        self
+    }
     #[inline]
     fn as_dyn(&mut self) -> &mut dyn Sampler {
         self
     }
 }
 
-impl AsDynSampler for dyn Sampler {
+impl LaneSlot for Box<dyn Sampler> {
+    type Sampler = dyn Sampler;
+    #[inline]
+    fn sampler(&self) -> &Self::Sampler {
+        self.as_ref()
+    }
+    #[inline]
+    fn sampler_mut(&mut self) -> &mut Self::Sampler {
+        self.as_mut()
+    }
     #[inline]
     fn as_dyn(&mut self) -> &mut dyn Sampler {
-        self
+        self.as_mut()
     }
 }
 
-impl<S: AsDynSampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
+impl<S: LaneSlot> SamplerLanes for ConcreteLanes<S> {
     fn len(&self) -> usize {
         self.0.len()
     }
     fn samples_per_pixel(&self) -> u32 {
-        self.0.first().map_or(1, |s| s.samples_per_pixel())
+        self.0
+            .first()
+            .map_or(1, |s| s.sampler().samples_per_pixel())
     }
     fn start_pixel_sample(&mut self, lane: usize, pixel: UVec2, index: u32, seed: u64) {
-        self.0[lane].start_pixel_sample(pixel, index, seed)
+        self.0[lane]
+            .sampler_mut()
+            .start_pixel_sample(pixel, index, seed)
     }
     #[inline]
     fn get_1d(&mut self, lane: usize) -> f32 {
-        self.0[lane].get_1d()
+        self.0[lane].sampler_mut().get_1d()
     }
     #[inline]
     fn get_2d(&mut self, lane: usize) -> Vec2 {
-        self.0[lane].get_2d()
+        self.0[lane].sampler_mut().get_2d()
     }
     #[inline]
     fn get_1d_2d(&mut self, lane: usize) -> (f32, Vec2) {
-        self.0[lane].get_1d_2d()
+        self.0[lane].sampler_mut().get_1d_2d()
     }
     #[inline]
     fn get_pixel_2d(&mut self, lane: usize) -> Vec2 {
-        self.0[lane].get_pixel_2d()
+        self.0[lane].sampler_mut().get_pixel_2d()
     }
     fn clone_lane(&self, lane: usize) -> Box<dyn Sampler> {
-        self.0[lane].clone_sampler()
+        self.0[lane].sampler().clone_sampler()
     }
     #[inline]
     fn own_lane(&mut self, lane: usize) -> Option<&mut dyn Sampler> {
@@ -247,7 +272,7 @@ impl<S: AsDynSampler + ?Sized> SamplerLanes for ConcreteLanes<S> {
     }
     fn get_1d_2d_batch(&mut self, lanes: &[usize], out: &mut [(f32, Vec2)]) {
         for (&i, out) in lanes.iter().zip(out) {
-            *out = self.0[i].get_1d_2d();
+            *out = self.0[i].sampler_mut().get_1d_2d();
         }
     }
 }
