@@ -90,7 +90,7 @@ pub enum PixelPattern {
 /// The samplers of a batch of paths, one per lane, each drawing its own
 /// pixel sample's numbers in its own order, asked by lane: a wavefront
 /// integrator asks them together. Lane `i` answers exactly what its own
-/// sampler would answer asked alone; [`with_lane`](SamplerLanes::with_lane)
+/// sampler would answer asked alone; `with_lane` (on `dyn SamplerLanes`)
 /// lends one lane as a [`Sampler`].
 #[plugin_interface]
 pub trait SamplerLanes: Send + Sync {
@@ -130,7 +130,7 @@ pub trait SamplerLanes: Send + Sync {
 
     /// Lane `lane`'s own sampler, where the lanes can lend it: asked
     /// directly, a request costs one virtual call instead of two (see
-    /// [`with_lane`](SamplerLanes::with_lane)). A wrapper lends nothing:
+    /// `with_lane` on `dyn SamplerLanes`). A wrapper lends nothing:
     /// its requests must pass through it.
     #[wrappers_answer(None)]
     fn own_lane(&mut self, lane: usize) -> Option<&mut dyn Sampler> {

@@ -6,7 +6,7 @@
 //! For a trait `T`, the expansion is the trait itself (with the helper
 //! attributes below removed) and
 //!
-//! ```ignore
+//! ```text
 //! impl<C, H> T for ::lumis_core::wrap::Wrapped<C, H>
 //! where C: Deref (+ DerefMut if a method takes `&mut self`) + Send + Sync,
 //!       C::Target: T, H: ::lumis_core::wrap::CallHook
