@@ -183,10 +183,12 @@ impl Tally {
     #[inline]
     fn weight(&self, w: f64) {
         let slot = &self.weights[SLOT.with(|s| *s)];
-        // Only this thread adds to its slot: loads and stores, no
-        // read-modify-write on the sums.
+        // A slot is one thread's unless more threads than slots run, so the
+        // exchange almost never retries; it keeps the sums exact when it must.
         let add = |sum: &AtomicU64, v: f64| {
-            sum.store((f64::from_bits(sum.load(Relaxed)) + v).to_bits(), Relaxed)
+            let _ = sum.fetch_update(Relaxed, Relaxed, |bits| {
+                Some((f64::from_bits(bits) + v).to_bits())
+            });
         };
         add(&slot.sum, w);
         add(&slot.sum_sq, w * w);
