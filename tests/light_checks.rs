@@ -12,7 +12,7 @@ use lumis_check::outcome::Outcome;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
     Light, LightKind, LightSample, LightSampleContext, LightSampler, LightShape, Params,
-    PluginKind, PluginSpec, Registry, Result, Rgb, SampledLight, Vec2, Vec3,
+    PluginKind, PluginSpec, Registrar, Registry, Result, Rgb, SampledLight, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 

@@ -151,8 +151,8 @@ fn library_from_another_lumis_core_is_refused_before_registering() {
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("built against lumis-core 0.0.0-elsewhere")
-            && err.contains(lumis_core::plugin::CORE_VERSION)
+        err.contains("built against lumis-api 0.0.0-elsewhere")
+            && err.contains(lumis_core::plugin::API_VERSION)
             && err.contains("rebuild"),
         "{err}"
     );

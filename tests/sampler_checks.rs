@@ -5,7 +5,9 @@
 
 use lumis_check::outcome::Outcome;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
-use lumis_core::{PixelPattern, PluginKind, PluginSpec, Registry, Result, Sampler, UVec2, Vec2};
+use lumis_core::{
+    PixelPattern, PluginKind, PluginSpec, Registrar, Registry, Result, Sampler, UVec2, Vec2,
+};
 use lumis_sampling::{hash_u64, Pcg32};
 
 /// Fewer pixels, seeds and pooled pixels than `check-plugin`'s default.

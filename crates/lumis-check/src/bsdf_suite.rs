@@ -509,7 +509,7 @@ pub fn check_bsdf_variants(
         })
         .collect();
     // A loaded plugin that panicked answered with neutral values (see
-    // lumis_core::guard); every case of its variant fails with the panic.
+    // lumis_api::guard); every case of its variant fails with the panic.
     for (result, variant) in results.iter_mut().zip(case_variants) {
         add_faults(registry, &owner(name, variant), &mut result.problems);
     }
@@ -649,7 +649,7 @@ pub fn write_histogram_png(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::BsdfSample;
+    use lumis_core::{BsdfSample, Registrar};
 
     /// A Lambertian BSDF whose batched methods can be made wrong.
     #[derive(Default)]

@@ -396,7 +396,7 @@ pub fn check_light_variants(
         })
         .collect();
     // A loaded plugin that panicked answered with neutral values (see
-    // lumis_core::guard); every case of its setting fails with the panic.
+    // lumis_api::guard); every case of its setting fails with the panic.
     for result in &mut results {
         let variant = variants
             .iter()

@@ -74,7 +74,7 @@ pub fn unmade(registry: &Registry, owner: &str, error: &Error) -> Result<String,
 
 /// Adds to `problems` every panic recorded against `owner` that it does not
 /// mention yet. A loaded plugin that panicked answered with neutral values
-/// (see `lumis_core::guard`), so the panic is what fails its case.
+/// (see `lumis_api::guard`), so the panic is what fails its case.
 pub fn add_faults(registry: &Registry, owner: &str, problems: &mut Vec<String>) {
     for fault in registry.faults().faults_of(owner) {
         if !problems.iter().any(|p| p.contains(&fault.message)) {

@@ -168,10 +168,10 @@ enum SamplersCommand {
 /// library must match to load.
 fn version_text() -> String {
     use lumis_core::plugin::{
-        CORE_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
+        API_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
     };
     format!(
-        "{}\nlumis-core {CORE_VERSION}, plugin ABI {PLUGIN_ABI_VERSION}, plugin interface \
+        "{}\nlumis-api {API_VERSION}, plugin ABI {PLUGIN_ABI_VERSION}, plugin interface \
          {INTERFACE_FINGERPRINT}\nbuilt by {RUSTC_VERSION}",
         env!("CARGO_PKG_VERSION")
     )

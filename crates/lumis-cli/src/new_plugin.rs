@@ -2,7 +2,7 @@
 //! example per plugin kind, from the templates in `templates/`.
 //!
 //! The crate depends on this lumis by path: a plugin must be built against
-//! the very `lumis-core` the host was built from (its interface fingerprint
+//! the very `lumis-api` the host was built from (its interface fingerprint
 //! and compiler version are checked at load), so by default the source tree
 //! this binary was built from, which it records at compile time.
 
@@ -112,7 +112,7 @@ pub fn built_from_tree() -> Option<PathBuf> {
 }
 
 fn is_lumis_tree(dir: &Path) -> bool {
-    ["lumis-core", "lumis-sampling", "lumis-check"]
+    ["lumis-api", "lumis-core", "lumis-sampling", "lumis-check"]
         .iter()
         .all(|c| dir.join("crates").join(c).join("Cargo.toml").is_file())
 }
@@ -167,7 +167,7 @@ pub fn new_plugin(args: &NewPluginArgs, parent: &Path) -> Result<PathBuf> {
         })?,
         Some(dir) => {
             return Err(Error::msg(format!(
-                "--lumis-path {}: not a lumis source tree (expected crates/lumis-core, crates/lumis-sampling and crates/lumis-check in it)",
+                "--lumis-path {}: not a lumis source tree (expected crates/lumis-api, crates/lumis-core, crates/lumis-sampling and crates/lumis-check in it)",
                 dir.display()
             )))
         }

@@ -11,8 +11,8 @@ use lumis_cli::{
     IntegratorCheckConfig, IntegratorTest,
 };
 use lumis_core::{
-    Integrator, PluginKind, PluginParams, PluginSpec, Ray, Registry, RenderStats, Rgb, Sampler,
-    Scene,
+    Integrator, PluginKind, PluginParams, PluginSpec, Ray, Registrar, Registry, RenderStats, Rgb,
+    Sampler, Scene,
 };
 use lumis_integrators::{EstimatorParams, PathIntegrator, PathParams};
 

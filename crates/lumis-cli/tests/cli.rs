@@ -537,7 +537,7 @@ fn version_names_the_plugin_interface_and_the_compiler() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}");
     for part in [
-        lumis_core::plugin::CORE_VERSION,
+        lumis_core::plugin::API_VERSION,
         &format!("plugin ABI {}", lumis_core::plugin::PLUGIN_ABI_VERSION),
         lumis_core::plugin::INTERFACE_FINGERPRINT,
         lumis_core::plugin::RUSTC_VERSION,

@@ -7,7 +7,9 @@ use std::path::Path;
 
 use common::*;
 use lumis_cli::{builtin_registry, denoise_image, DenoiseArgs};
-use lumis_core::{DenoiseInput, Denoiser, Error, Params, PluginKind, PluginSpec, Result};
+use lumis_core::{
+    DenoiseInput, Denoiser, Error, Params, PluginKind, PluginSpec, Registrar, Result,
+};
 
 /// The glossy plates' `[denoiser]` in these tests: not the default
 /// quality, so an image denoised without reading it differs.

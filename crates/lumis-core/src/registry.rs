@@ -5,126 +5,22 @@
 //! plugin's `register` function (a loaded library has its own copies of
 //! every static, so global state could not be shared anyway).
 
-use std::fmt;
 use std::sync::Arc;
+
+use lumis_api::guard::FaultReport;
+pub use lumis_api::registrar::{Factory, PluginKind, PluginSpec, Registrar};
 
 use crate::bsdf::Bsdf;
 use crate::denoiser::Denoiser;
 use crate::entity::PluginEntity;
 use crate::error::{Error, Result};
-use crate::guard::{FaultSink, Guard, Guarded, PluginGuard};
+use crate::faults::FaultSink;
 use crate::integrator::Integrator;
-use crate::light::{Light, LightInput, LightShape};
+use crate::light::{Light, LightInput};
 use crate::light_sampler::LightSampler;
-use crate::params::{ParamSpec, Params};
+use crate::params::Params;
 use crate::sampler::Sampler;
 use crate::texture::{BsdfScope, Texture};
-
-/// The plugin interfaces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum PluginKind {
-    Sampler,
-    Texture,
-    Bsdf,
-    Light,
-    LightSampler,
-    Integrator,
-    Denoiser,
-}
-
-impl PluginKind {
-    pub const ALL: [PluginKind; 7] = [
-        PluginKind::Sampler,
-        PluginKind::Texture,
-        PluginKind::Bsdf,
-        PluginKind::Light,
-        PluginKind::LightSampler,
-        PluginKind::Integrator,
-        PluginKind::Denoiser,
-    ];
-
-    /// The scene-file table that names plugins of this kind.
-    pub fn table_name(self) -> &'static str {
-        match self {
-            PluginKind::Sampler => "sampler",
-            PluginKind::Texture => "texture",
-            PluginKind::Bsdf => "bsdf",
-            PluginKind::Light => "light",
-            PluginKind::LightSampler => "light_sampler",
-            PluginKind::Integrator => "integrator",
-            PluginKind::Denoiser => "denoiser",
-        }
-    }
-}
-
-impl fmt::Display for PluginKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.table_name())
-    }
-}
-
-/// What a plugin declares about itself: drives validation and `lumis plugins`.
-#[derive(Debug, Clone, Copy)]
-pub struct PluginSpec {
-    pub kind: PluginKind,
-    pub name: &'static str,
-    pub doc: &'static str,
-    /// `SPECS` of the plugin's struct deriving
-    /// [`PluginParams`](crate::params::PluginParams), which its factory reads.
-    pub params: &'static [ParamSpec],
-}
-
-pub type SamplerFactory = fn(&Params) -> Result<Box<dyn Sampler>>;
-pub type TextureFactory = fn(&Params) -> Result<Arc<dyn Texture>>;
-/// A BSDF's textured parameters ([`crate::params::Textured`]) refer to the
-/// scene's textures through its `Params`.
-pub type BsdfFactory = fn(&Params) -> Result<Arc<dyn Bsdf>>;
-/// Lights get the geometry they are attached to ([`LightShape::None`] for
-/// `[[light]]` tables); a factory refuses shapes it cannot emit from.
-pub type LightFactory = fn(&Params, &LightShape) -> Result<Box<dyn Light>>;
-pub type LightSamplerFactory = fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>>;
-pub type IntegratorFactory = fn(&Params) -> Result<Box<dyn Integrator>>;
-pub type DenoiserFactory = fn(&Params) -> Result<Box<dyn Denoiser>>;
-
-// Factories as registered: the plugin's own function, or that function
-// guarded; shared, since registries are cloned per scene.
-type MakeSampler = Arc<dyn Fn(&Params) -> Result<Box<dyn Sampler>> + Send + Sync>;
-type MakeTexture = Arc<dyn Fn(&Params) -> Result<Arc<dyn Texture>> + Send + Sync>;
-type MakeBsdf = Arc<dyn Fn(&Params) -> Result<Arc<dyn Bsdf>> + Send + Sync>;
-type MakeLight = Arc<dyn Fn(&Params, &LightShape) -> Result<Box<dyn Light>> + Send + Sync>;
-type MakeLightSampler =
-    Arc<dyn Fn(&Params, &[Box<dyn Light>]) -> Result<Box<dyn LightSampler>> + Send + Sync>;
-type MakeIntegrator = Arc<dyn Fn(&Params) -> Result<Box<dyn Integrator>> + Send + Sync>;
-type MakeDenoiser = Arc<dyn Fn(&Params) -> Result<Box<dyn Denoiser>> + Send + Sync>;
-
-/// A factory as the registry keeps it: the plugin's own function for a
-/// built-in, or, while a library registers, a closure that calls it under
-/// the library's guard and guards what it makes (boxed by `$boxed`).
-macro_rules! registered {
-    ($registry:ident, $factory:ident, $boxed:path, |$params:ident $(, $input:ident: $ty:ty)?|) => {
-        match $registry.guard.clone() {
-            None => Arc::new($factory),
-            Some(guard) => Arc::new(move |$params: &Params $(, $input: $ty)?| {
-                guarded(&guard, $params, || $factory($params $(, $input)?), |made, guard, label| {
-                    $boxed(Guarded::new(made, Guard::new(guard, label)))
-                })
-            }),
-        }
-    };
-}
-
-/// Calls a loaded plugin's `factory` under `guard`, and guards what it
-/// makes. Labels the plugin with its table as written, for messages.
-fn guarded<M>(
-    guard: &PluginGuard,
-    params: &Params,
-    factory: impl FnOnce() -> Result<M>,
-    wrap: impl FnOnce(M, PluginGuard, Arc<str>) -> M,
-) -> Result<M> {
-    let label: Arc<str> = Arc::from(format!("{} {{ {} }}", params.owner(), params.written()));
-    let made = guard.call(&label, "its factory", factory)??;
-    Ok(wrap(made, guard.clone(), label))
-}
 
 /// A registered plugin and where it came from.
 #[derive(Clone)]
@@ -140,9 +36,6 @@ pub struct Registered {
 pub struct Registry {
     plugins: Vec<Registered>,
     source: Arc<str>,
-    /// Set while a library registers: its factories and their plugins are
-    /// then guarded (see [`crate::guard`]).
-    guard: Option<PluginGuard>,
     /// Where guarded plugins report a panic; shared by clones.
     faults: Arc<FaultSink>,
 }
@@ -158,22 +51,20 @@ impl Registry {
         Self {
             plugins: Vec::new(),
             source: Arc::from("built-in"),
-            guard: None,
             faults: Arc::default(),
         }
     }
 
     /// Plugins registered from now on come from the library at `path`:
-    /// they are labelled with it, and guarded, until [`Registry::end_library`].
+    /// they are labelled with it until [`Registry::end_library`]. (The
+    /// library guards them itself: `lumis_api::guard::register_guarded`.)
     pub fn begin_library(&mut self, path: &str) {
         self.source = Arc::from(path);
-        self.guard = Some(PluginGuard::new(path, self.faults.clone()));
     }
 
     /// Plugins registered from now on are built-in again.
     pub fn end_library(&mut self) {
         self.source = Arc::from("built-in");
-        self.guard = None;
     }
 
     /// Where a panic of any loaded plugin is recorded; a host checks it
@@ -181,13 +72,18 @@ impl Registry {
     pub fn faults(&self) -> &Arc<FaultSink> {
         &self.faults
     }
+}
 
-    /// Where plugins registered now are said to come from.
-    pub fn source(&self) -> &str {
-        &self.source
-    }
-
+impl Registrar for Registry {
     fn add(&mut self, spec: PluginSpec, factory: Factory) -> Result<()> {
+        if spec.kind != factory.kind() {
+            return Err(Error::msg(format!(
+                "plugin '{}' declares kind {} but registers a {} factory",
+                spec.name,
+                spec.kind,
+                factory.kind()
+            )));
+        }
         if let Some(existing) = self.find(spec.kind, spec.name) {
             return Err(Error::msg(format!(
                 "{} plugin '{}' from {} clashes with the one from {}; rename one of them",
@@ -202,67 +98,16 @@ impl Registry {
         Ok(())
     }
 
-    fn check_kind(spec: &PluginSpec, kind: PluginKind) -> Result<()> {
-        if spec.kind != kind {
-            return Err(Error::msg(format!(
-                "plugin '{}' declares kind {} but registers a {kind} factory",
-                spec.name, spec.kind
-            )));
-        }
-        Ok(())
+    fn source(&self) -> &str {
+        &self.source
     }
 
-    // In a library's registration, each `add_*` below runs in the
-    // library's own copy of this code, so the closures `registered!` makes,
-    // and their `catch_unwind`, are the library's (see `crate::guard`).
-
-    pub fn add_sampler(&mut self, spec: PluginSpec, factory: SamplerFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Sampler)?;
-        let make: MakeSampler = registered!(self, factory, Box::new, |params|);
-        self.add(spec, Factory::Sampler(make))
+    fn faults(&self) -> Arc<dyn FaultReport> {
+        self.faults.clone()
     }
+}
 
-    pub fn add_texture(&mut self, spec: PluginSpec, factory: TextureFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Texture)?;
-        let make: MakeTexture = registered!(self, factory, Arc::new, |params|);
-        self.add(spec, Factory::Texture(make))
-    }
-
-    pub fn add_bsdf(&mut self, spec: PluginSpec, factory: BsdfFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Bsdf)?;
-        let make: MakeBsdf = registered!(self, factory, Arc::new, |params|);
-        self.add(spec, Factory::Bsdf(make))
-    }
-
-    pub fn add_light(&mut self, spec: PluginSpec, factory: LightFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Light)?;
-        let make: MakeLight = registered!(self, factory, Box::new, |params, shape: &LightShape|);
-        self.add(spec, Factory::Light(make))
-    }
-
-    pub fn add_light_sampler(
-        &mut self,
-        spec: PluginSpec,
-        factory: LightSamplerFactory,
-    ) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::LightSampler)?;
-        let make: MakeLightSampler =
-            registered!(self, factory, Box::new, |params, lights: &[Box<dyn Light>]|);
-        self.add(spec, Factory::LightSampler(make))
-    }
-
-    pub fn add_integrator(&mut self, spec: PluginSpec, factory: IntegratorFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Integrator)?;
-        let make: MakeIntegrator = registered!(self, factory, Box::new, |params|);
-        self.add(spec, Factory::Integrator(make))
-    }
-
-    pub fn add_denoiser(&mut self, spec: PluginSpec, factory: DenoiserFactory) -> Result<()> {
-        Self::check_kind(&spec, PluginKind::Denoiser)?;
-        let make: MakeDenoiser = registered!(self, factory, Box::new, |params|);
-        self.add(spec, Factory::Denoiser(make))
-    }
-
+impl Registry {
     pub fn find(&self, kind: PluginKind, name: &str) -> Option<&Registered> {
         self.plugins
             .iter()
@@ -377,30 +222,13 @@ pub trait PluginInterface: sealed::Sealed {
         None
     }
     #[doc(hidden)]
-    fn call(
-        factory: &sealed::Factory,
-        params: &Params,
-        input: Self::Input<'_>,
-    ) -> Result<Self::Made>;
+    fn call(factory: &Factory, params: &Params, input: Self::Input<'_>) -> Result<Self::Made>;
 }
 
 mod sealed {
     use super::*;
 
     pub trait Sealed {}
-
-    /// A registered factory, by kind: the plugin's own function, or that
-    /// function guarded.
-    #[derive(Clone)]
-    pub enum Factory {
-        Sampler(MakeSampler),
-        Texture(MakeTexture),
-        Bsdf(MakeBsdf),
-        Light(MakeLight),
-        LightSampler(MakeLightSampler),
-        Integrator(MakeIntegrator),
-        Denoiser(MakeDenoiser),
-    }
 
     impl Sealed for dyn Sampler {}
     impl Sealed for dyn Texture {}
@@ -410,8 +238,6 @@ mod sealed {
     impl Sealed for dyn Integrator {}
     impl Sealed for dyn Denoiser {}
 }
-
-use sealed::Factory;
 
 /// Registration checks that a plugin's factory is of its declared kind, and
 /// [`Registry::create`] looks plugins up by kind: a factory of another kind
@@ -521,7 +347,7 @@ mod tests {
     use crate::doc::{self, Table, Value};
     use crate::entity::TYPE_KEY;
     use crate::error::Location;
-    use crate::params::ParamType;
+    use crate::params::{ParamSpec, ParamType};
     use crate::spectrum::Rgb;
 
     /// A BSDF of one parameter, `albedo`, returned by `f`.

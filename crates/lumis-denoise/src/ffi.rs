@@ -7,7 +7,7 @@
 use std::ffi::{c_char, c_int, c_void, CStr};
 use std::ptr::NonNull;
 
-use lumis_core::{Error, Result};
+use lumis_api::{Error, Result};
 
 #[repr(C)]
 struct DeviceImpl {

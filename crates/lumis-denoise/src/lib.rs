@@ -9,7 +9,7 @@ mod oidn;
 
 pub use oidn::{OidnDenoiser, OidnParams, Quality};
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// The version of the Open Image Denoise library this process loaded, as
 /// `(major, minor, patch)`.
@@ -19,6 +19,6 @@ pub fn oidn_version() -> Result<(u32, u32, u32)> {
 }
 
 /// Registers every denoiser of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_denoiser(oidn::SPEC, oidn::OidnDenoiser::from_params)
 }

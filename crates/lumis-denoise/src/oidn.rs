@@ -2,7 +2,7 @@
 //! Image Denoise", a U-Net trained on path-traced images with albedo and
 //! normal feature buffers).
 
-use lumis_core::{
+use lumis_api::{
     DenoiseInput, Denoiser, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result,
 };
 

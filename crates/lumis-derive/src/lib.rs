@@ -1,11 +1,11 @@
 //! Derive macros that declare a lumis plugin's parameters once, as a
 //! struct, and generate both the declaration (`PluginSpec::params`: names,
 //! types, typed defaults, ranges, choices, docs) and the code that reads
-//! it. Use them through `lumis_core`, which re-exports them next to the
+//! it. Use them through `lumis_api`, which re-exports them next to the
 //! traits they implement:
 //!
 //! ```ignore
-//! use lumis_core::{ParamChoice, PluginParams, Rgb};
+//! use lumis_api::{ParamChoice, PluginParams, Rgb};
 //!
 //! #[derive(PluginParams)]
 //! pub struct DiffuseParams {
@@ -20,8 +20,8 @@
 //! pub enum DiffuseSampling { Cosine, Uniform }
 //! ```
 //!
-//! The generated code names `::lumis_core`, so a crate using the derives
-//! depends on lumis-core under that name.
+//! The generated code names `::lumis_api`, so a crate using the derives
+//! depends on lumis-api under that name.
 
 mod attrs;
 mod param_choice;
@@ -32,7 +32,7 @@ mod value;
 use proc_macro::TokenStream;
 use syn::{parse_macro_input, DeriveInput};
 
-/// Implements `lumis_core::PluginParams` for a struct with named fields:
+/// Implements `lumis_api::PluginParams` for a struct with named fields:
 /// one parameter per field, named after it.
 ///
 /// - The field's `///` comment is the parameter's description (required).
@@ -61,7 +61,7 @@ pub fn derive_plugin_params(input: TokenStream) -> TokenStream {
         .into()
 }
 
-/// Implements `lumis_core::params::ParamChoice` (and `Param`,
+/// Implements `lumis_api::params::ParamChoice` (and `Param`,
 /// `FromParam`) for a fieldless enum: a string parameter whose choices are
 /// the variants, named in kebab case (`SolidAngle` is `"solid-angle"`) or
 /// by `#[choice("Ag")]`.
@@ -74,7 +74,7 @@ pub fn derive_param_choice(input: TokenStream) -> TokenStream {
 }
 
 /// Declares a plugin interface: the trait, and its wrappers generated from
-/// it (`lumis_core::wrap::Wrapped<C, H>` implements it by forwarding every
+/// it (`lumis_api::wrap::Wrapped<C, H>` implements it by forwarding every
 /// method through a `CallHook`: the panic guard of a loaded plugin, the
 /// profiler). A method added to the trait is forwarded by every wrapper
 /// without further code.

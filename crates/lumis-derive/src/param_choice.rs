@@ -54,7 +54,7 @@ pub fn expand(input: &DeriveInput) -> syn::Result<TokenStream> {
         ));
     }
     let name = &input.ident;
-    let core = quote!(::lumis_core::params);
+    let core = quote!(::lumis_api::params);
     Ok(quote! {
         impl #core::ParamChoice for #name {
             const VARIANTS: &'static [Self] = &[#(#name::#variants),*];
@@ -68,7 +68,7 @@ pub fn expand(input: &DeriveInput) -> syn::Result<TokenStream> {
         }
 
         impl #core::FromParam for #name {
-            fn from_node(node: &::lumis_core::doc::Node) -> ::core::result::Result<Self, ::std::string::String> {
+            fn from_node(node: &::lumis_api::doc::Node) -> ::core::result::Result<Self, ::std::string::String> {
                 #core::choice_from_node(node)
             }
         }

@@ -7,9 +7,9 @@
 //! attributes below removed) and
 //!
 //! ```text
-//! impl<C, H> T for ::lumis_core::wrap::Wrapped<C, H>
+//! impl<C, H> T for ::lumis_api::wrap::Wrapped<C, H>
 //! where C: Deref (+ DerefMut if a method takes `&mut self`) + Send + Sync,
-//!       C::Target: T, H: ::lumis_core::wrap::CallHook
+//!       C::Target: T, H: ::lumis_api::wrap::CallHook
 //! ```
 //!
 //! whose every method, provided or required, runs the wrapped object's
@@ -203,14 +203,14 @@ fn wrapped_impl(item: &ItemTrait, methods: &[Method]) -> TokenStream {
         let label = format!("{name}::{ident}");
         let args = call_args(method);
         let parts = if method.takes_mut_self {
-            quote!(let (inner, hook) = ::lumis_core::wrap::Wrapped::parts_mut(self);)
+            quote!(let (inner, hook) = ::lumis_api::wrap::Wrapped::parts_mut(self);)
         } else {
-            quote!(let (inner, hook) = ::lumis_core::wrap::Wrapped::parts(self);)
+            quote!(let (inner, hook) = ::lumis_api::wrap::Wrapped::parts(self);)
         };
         let value = if returns_boxed_object(&sig.output) {
-            quote!(::std::boxed::Box::new(::lumis_core::wrap::Wrapped::new(
+            quote!(::std::boxed::Box::new(::lumis_api::wrap::Wrapped::new(
                 value,
-                ::lumis_core::wrap::CallHook::child(hook),
+                ::lumis_api::wrap::CallHook::child(hook),
             )))
         } else {
             quote!(value)
@@ -221,16 +221,16 @@ fn wrapped_impl(item: &ItemTrait, methods: &[Method]) -> TokenStream {
             .iter()
             .zip(&method.mutable_refs)
             .find(|(name, &mutable)| mutable && *name == "out")
-            .map(|(out, _)| quote!(::lumis_core::wrap::CallHook::seen(hook, &*#out);));
+            .map(|(out, _)| quote!(::lumis_api::wrap::CallHook::seen(hook, &*#out);));
         let fault = match &method.on_fault {
             Some(answer) => quote!(#answer),
-            None => quote!(::lumis_core::wrap::Neutral::neutral()),
+            None => quote!(::lumis_api::wrap::Neutral::neutral()),
         };
         quote! {
             #[inline]
             #sig {
                 #parts
-                match ::lumis_core::wrap::CallHook::call(hook, #label, || inner.#ident(#(#args),*)) {
+                match ::lumis_api::wrap::CallHook::call(hook, #label, || inner.#ident(#(#args),*)) {
                     ::core::result::Result::Ok(value) => {
                         #seen
                         #value
@@ -244,11 +244,11 @@ fn wrapped_impl(item: &ItemTrait, methods: &[Method]) -> TokenStream {
         }
     });
     quote! {
-        impl<C, H> #name for ::lumis_core::wrap::Wrapped<C, H>
+        impl<C, H> #name for ::lumis_api::wrap::Wrapped<C, H>
         where
             C: ::core::ops::Deref #deref_mut + ::core::marker::Send + ::core::marker::Sync,
             C::Target: #name,
-            H: ::lumis_core::wrap::CallHook,
+            H: ::lumis_api::wrap::CallHook,
         {
             #(#bodies)*
         }

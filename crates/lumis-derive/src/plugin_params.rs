@@ -53,7 +53,7 @@ pub fn expand(input: &DeriveInput) -> syn::Result<TokenStream> {
     let reads = generated.iter().map(|g| &g.read);
     let key_fields = generated.iter().map(|g| &g.key_field);
     let key_values = generated.iter().map(|g| &g.key_value);
-    let core = quote!(::lumis_core::params);
+    let core = quote!(::lumis_api::params);
 
     Ok(quote! {
         #[doc = #keys_doc]
@@ -74,7 +74,7 @@ pub fn expand(input: &DeriveInput) -> syn::Result<TokenStream> {
                 #(#key_values,)*
             };
 
-            fn read(params: &#core::Params) -> ::lumis_core::Result<Self> {
+            fn read(params: &#core::Params) -> ::lumis_api::Result<Self> {
                 ::core::result::Result::Ok(Self {
                     #(#reads,)*
                 })
@@ -95,7 +95,7 @@ fn field(field: &Field) -> syn::Result<Generated> {
     let attrs = ParamAttrs::parse(&field.attrs)?;
     let span = field.span();
     // Spanned at the field, so an error in its declaration points there.
-    let core = quote_spanned!(span=> ::lumis_core::params);
+    let core = quote_spanned!(span=> ::lumis_api::params);
 
     if attrs.flatten {
         if attrs.rename.is_some() || attrs.default.is_some() || attrs.range.is_some() {

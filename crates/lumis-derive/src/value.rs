@@ -1,6 +1,6 @@
 //! Default values as written in `#[param(default = ...)]`: the literals of
 //! a scene file, or a variant of a choice, turned into a
-//! `lumis_core::params::ParamValue` constant.
+//! `lumis_api::params::ParamValue` constant.
 
 use proc_macro2::{Span, TokenStream};
 use quote::{quote, quote_spanned};
@@ -59,7 +59,7 @@ impl Value {
     /// is one (a field's own default), else of the enum its path names (a
     /// flattened group's default, `Sampling::SolidAngle`).
     pub fn tokens(&self, field_type: Option<&Type>, span: Span) -> syn::Result<TokenStream> {
-        let value = quote!(::lumis_core::params::ParamValue);
+        let value = quote!(::lumis_api::params::ParamValue);
         Ok(match self {
             Value::Bool(b) => quote!(#value::Bool(#b)),
             Value::Int(i) => quote!(#value::Int(#i)),
@@ -96,7 +96,7 @@ impl Value {
                 quote_spanned! {span=> {
                     const VARIANT: #enum_type = #variant;
                     #value::Str(
-                        <#enum_type as ::lumis_core::params::ParamChoice>::NAMES[VARIANT as usize],
+                        <#enum_type as ::lumis_api::params::ParamChoice>::NAMES[VARIANT as usize],
                     )
                 }}
             }

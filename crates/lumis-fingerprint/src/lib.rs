@@ -1,5 +1,5 @@
 //! The plugin interface's fingerprint: a hash of what a plugin library and
-//! its host must agree on, so that a plugin built against a lumis-core
+//! its host must agree on, so that a plugin built against a lumis-api
 //! whose interface changed is refused at load instead of crashing, and a
 //! plugin built against one whose interface did not change keeps loading.
 //!
@@ -9,7 +9,7 @@
 //!
 //! - every type's definition whatever its visibility (structs, enums,
 //!   unions, aliases, traits): a private field of a type that crosses the
-//!   boundary (the registry a plugin registers into) is part of its layout;
+//!   boundary (the `Params` a plugin reads) is part of its layout;
 //! - the signatures of public functions and methods, and of every method
 //!   of a trait or a trait implementation;
 //! - public constants and statics with their values (the ABI version),

@@ -4,15 +4,15 @@
 //! - the file is checked before it is mapped (`elf.rs`), and found by its
 //!   absolute path, never through the system's library search path;
 //! - the library's declaration is checked first: ABI version, rustc
-//!   version, lumis-core version and plugin interface fingerprint must
+//!   version, lumis-api version and plugin interface fingerprint must
 //!   equal the host's, or nothing else in the library is touched;
 //! - a library already loaded is not loaded again;
 //! - the registry is passed in, never shared through globals;
 //! - a `cdylib` carries its own panic runtime, whose panics the host
 //!   cannot catch: `lumis_plugin!` runs `register` under the library's own
-//!   `catch_unwind`, and the registry guards the library's factories and
-//!   plugins the same way (`lumis_core::guard`), so a panic in a plugin is
-//!   an error in the registry's fault sink;
+//!   `catch_unwind`, and guards the library's factories and plugins the
+//!   same way (`lumis_api::guard`), so a panic in a plugin is an error in
+//!   the registry's fault sink;
 //! - a library is never unloaded (thread-local destructors and vtables of
 //!   objects it created must outlive every use), so it is leaked on purpose.
 
@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 use libloading::{Library, Symbol};
 use lumis_core::plugin::{
-    entry_point, PluginDeclaration, CORE_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION,
+    entry_point, PluginDeclaration, API_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION,
     RUSTC_VERSION,
 };
 use lumis_core::{Error, Registry, Result};
@@ -117,7 +117,7 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
     let entry: Symbol<Entry> = unsafe { library.get(symbol.as_bytes()) }.map_err(|_| {
         Error::msg(format!(
             "'{shown}' has no {symbol} entry point: it is not a lumis plugin \
-             (a plugin crate calls lumis_core::lumis_plugin!(register)), or it was renamed \
+             (a plugin crate calls lumis_api::lumis_plugin!(register)), or it was renamed \
              (a plugin library keeps the file name cargo gives it, lib<crate>.so)"
         ))
     })?;
@@ -139,7 +139,7 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
     if abi != PLUGIN_ABI_VERSION {
         return Err(Error::msg(format!(
             "'{shown}' uses plugin ABI version {abi}, this lumis uses {PLUGIN_ABI_VERSION}: \
-             rebuild the plugin against this lumis-core"
+             rebuild the plugin against this lumis-api"
         )));
     }
     // SAFETY: same ABI version, so the layout of the declaration is ours.
@@ -151,19 +151,19 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
              the same toolchain (e.g. `rustup run <version> cargo build --release`)"
         )));
     }
-    let core = declaration.core_version();
-    if core != CORE_VERSION {
+    let api = declaration.api_version();
+    if api != API_VERSION {
         return Err(Error::msg(format!(
-            "'{shown}' was built against lumis-core {core}, lumis has {CORE_VERSION}: point the \
-             plugin's lumis-core dependency at this lumis and rebuild"
+            "'{shown}' was built against lumis-api {api}, lumis has {API_VERSION}: point the \
+             plugin's lumis-api dependency at this lumis and rebuild"
         )));
     }
     let interface = declaration.interface_fingerprint();
     if interface != INTERFACE_FINGERPRINT {
         return Err(Error::msg(format!(
-            "'{shown}' was built against a lumis-core {core} whose plugin interface differs from \
+            "'{shown}' was built against a lumis-api {api} whose plugin interface differs from \
              this lumis's (interface fingerprint {interface}, this lumis {INTERFACE_FINGERPRINT}): \
-             point the plugin's lumis-core dependency at this lumis and rebuild"
+             point the plugin's lumis-api dependency at this lumis and rebuild"
         )));
     }
     registry.begin_library(&shown.to_string());

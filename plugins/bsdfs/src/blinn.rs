@@ -14,7 +14,7 @@
 
 use std::f32::consts::PI;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Result, Rgb, TexturedFloat, TexturedRgb, Vec2, Vec3,
 };
@@ -111,11 +111,11 @@ impl Blinn {
     #[inline]
     fn lobe(&self, ctx: &BsdfContext) -> Lobe {
         let reflectance = match &self.reflectance {
-            lumis_core::params::Textured::Constant(r) => *r,
+            lumis_api::params::Textured::Constant(r) => *r,
             textured => textured.eval(&ctx.texture).map(|c| c.clamp(0.0, 1.0)),
         };
         let exponent = match &self.exponent {
-            lumis_core::params::Textured::Constant(n) => *n,
+            lumis_api::params::Textured::Constant(n) => *n,
             textured => textured.eval(&ctx.texture).clamp(0.0, 1e6),
         };
         Lobe {

@@ -9,7 +9,7 @@
 //! delta limit, which `conductor` also becomes below a roughness of 1e-3.
 //! One-sided, like Mitsuba's: black from behind.
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, TextureQuery, TexturedRgb, Vec2, Vec3,
 };
@@ -543,8 +543,8 @@ mod tests {
     /// A texture that is `c` times `(1 + u)`.
     struct UvRamp(Rgb);
 
-    impl lumis_core::Texture for UvRamp {
-        fn eval(&self, q: &lumis_core::TextureQuery) -> Rgb {
+    impl lumis_api::Texture for UvRamp {
+        fn eval(&self, q: &lumis_api::TextureQuery) -> Rgb {
             self.0 * (1.0 + q.uv.x)
         }
     }
@@ -556,7 +556,7 @@ mod tests {
         let mf = Microfacet::new(Distribution::Ggx, 0.3, 0.3);
         let sampling: LobeSampling = MicrofacetLobeSampling::Visible.into();
         let (eta, k) = (Rgb::new(0.2, 0.9, 1.1), Rgb::new(3.9, 2.4, 1.9));
-        let ramp = |c: Rgb| lumis_core::params::Textured::Texture(std::sync::Arc::new(UvRamp(c)));
+        let ramp = |c: Rgb| lumis_api::params::Textured::Texture(std::sync::Arc::new(UvRamp(c)));
         let fresnel = MetalFresnel::Textured {
             eta: ramp(eta),
             k: ramp(k),
@@ -601,7 +601,7 @@ mod tests {
         let plain = Conductor::new(mf, ConductorFresnel::Perfect, sampling);
         let tint = Rgb::new(0.5, 0.25, 0.125);
         let tinted = Conductor {
-            tint: Some(lumis_core::params::Textured::Texture(std::sync::Arc::new(
+            tint: Some(lumis_api::params::Textured::Texture(std::sync::Arc::new(
                 UvRamp(tint),
             ))),
             ..plain.clone()
@@ -609,7 +609,7 @@ mod tests {
         let n = 16;
         let ctx: Vec<BsdfContext> = (0..n)
             .map(|i| BsdfContext {
-                texture: lumis_core::TextureQuery::at(Vec2::new(i as f32 / n as f32, 0.5)),
+                texture: lumis_api::TextureQuery::at(Vec2::new(i as f32 / n as f32, 0.5)),
                 ..Default::default()
             })
             .collect();

@@ -12,7 +12,7 @@
 //! `eta'^2`; importance is not (Veach 1997, section 5.2). `eta'` is the
 //! relative index along the path: `eta` entering, `1/eta` leaving.
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, TransportMode, Vec2, Vec3,
 };

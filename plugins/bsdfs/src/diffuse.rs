@@ -2,7 +2,7 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Result, Rgb, TexturedRgb, Vec2, Vec3,
 };

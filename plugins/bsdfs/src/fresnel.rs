@@ -1,7 +1,7 @@
 //! Fresnel reflectance of smooth interfaces: dielectric, conductor, and the
 //! hemispherical average a diffuse layer under a coat sees.
 
-use lumis_core::{Rgb, Vec3};
+use lumis_api::{Rgb, Vec3};
 use lumis_sampling::real::Real;
 
 /// Unpolarised Fresnel reflectance of a dielectric interface (Born and

@@ -26,10 +26,10 @@ pub use twosided::{TwoSided, TwoSidedParams};
 
 use std::sync::Arc;
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers every BSDF of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_bsdf(diffuse::SPEC, |p| Ok(Arc::new(Diffuse::from_params(p)?)))?;
     registry.add_bsdf(blinn::SPEC, |p| Ok(Arc::new(Blinn::from_params(p)?)))?;
     registry.add_bsdf(conductor::SPEC, |p| {

@@ -2,7 +2,7 @@
 //! that a scene can measure what importance sampling buys (`sampling =
 //! "cosine"` or `"uniform"` on the same material).
 
-use lumis_core::{ParamChoice, Vec2, Vec3};
+use lumis_api::{ParamChoice, Vec2, Vec3};
 use lumis_sampling::warp;
 
 use crate::microfacet::NormalSampling;

@@ -1,8 +1,8 @@
 //! The parameters that choose a metal's reflectance, shared by `conductor`
 //! and `mirror`: a named metal, or its complex index of refraction.
 
-use lumis_core::params::Textured;
-use lumis_core::{ParamChoice, Params, PluginParams, Result, Rgb, TexturedRgb};
+use lumis_api::params::Textured;
+use lumis_api::{ParamChoice, Params, PluginParams, Result, Rgb, TexturedRgb};
 
 use crate::conductor::{ConductorFresnel, MetalFresnel};
 use crate::fresnel;

@@ -12,8 +12,8 @@ use std::f32::consts::PI;
 use std::ops::{Add, Div, Mul};
 use std::sync::Arc;
 
-use lumis_core::params::Textured;
-use lumis_core::{ParamChoice, PluginParams, TextureQuery, TexturedFloat, Vec2, Vec3};
+use lumis_api::params::Textured;
+use lumis_api::{ParamChoice, PluginParams, TextureQuery, TexturedFloat, Vec2, Vec3};
 use lumis_sampling::real::{Real, V3};
 use lumis_sampling::special::{erf, erf_inv, erfc, exp, ln, sin_cos_turns, FRAC_1_SQRT_PI};
 use wide::f64x4;

@@ -33,9 +33,9 @@
 
 use std::sync::Arc;
 
-use lumis_core::math::Frame;
-use lumis_core::params::NestedBsdf;
-use lumis_core::{
+use lumis_api::math::Frame;
+use lumis_api::params::NestedBsdf;
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, TexturedRgb, Vec2, Vec3,
 };
@@ -360,7 +360,7 @@ impl Bsdf for NormalMap {
 
 #[cfg(test)]
 mod tests {
-    use lumis_core::params::Textured;
+    use lumis_api::params::Textured;
     use lumis_sampling::warp;
 
     use super::*;

@@ -24,7 +24,7 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, TexturedRgb, Vec2, Vec3,
 };
@@ -397,8 +397,8 @@ mod tests {
     /// A texture of constant value `c`.
     struct Flat(Rgb);
 
-    impl lumis_core::Texture for Flat {
-        fn eval(&self, _: &lumis_core::TextureQuery) -> Rgb {
+    impl lumis_api::Texture for Flat {
+        fn eval(&self, _: &lumis_api::TextureQuery) -> Rgb {
             self.0
         }
     }
@@ -411,7 +411,7 @@ mod tests {
         let rho = Rgb::new(0.9, 0.15, 0.0);
         for (alpha, nonlinear) in [(0.0, false), (0.3, false), (0.3, true)] {
             let coat = Microfacet::new(Distribution::Ggx, alpha, alpha);
-            let texture = lumis_core::params::Textured::Texture(std::sync::Arc::new(Flat(rho)));
+            let texture = lumis_api::params::Textured::Texture(std::sync::Arc::new(Flat(rho)));
             let textured = Plastic::new(texture, Rgb::WHITE, 1.5, coat, nonlinear);
             let constant = Plastic::new(rho, Rgb::WHITE, 1.5, coat, nonlinear);
             let ctx = BsdfContext::default();

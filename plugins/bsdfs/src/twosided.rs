@@ -5,8 +5,8 @@
 //! Energy and reciprocity are the inner BSDF's on each side, and a pair of
 //! directions on opposite sides (transmission) gets nothing.
 
-use lumis_core::params::NestedBsdf;
-use lumis_core::{
+use lumis_api::params::NestedBsdf;
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, Vec2, Vec3,
 };

@@ -16,9 +16,9 @@
 use std::f32::consts::{FRAC_1_PI, PI};
 use std::sync::Arc;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Frame, ParamChoice, Params, PluginKind, PluginParams,
-    PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
+    PluginSpec, Registrar, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -60,12 +60,12 @@ pub enum Sampling {
     Uniform,
 }
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_bsdf(SPEC, |p| Ok(Arc::new(Phong::from_params(p)?)))
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 #[derive(Debug, Clone)]
 pub struct Phong {

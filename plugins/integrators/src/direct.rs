@@ -5,7 +5,7 @@
 //! `DirectLightingIntegrator`): no indirect light dilutes the difference
 //! between the strategies.
 
-use lumis_core::{
+use lumis_api::{
     Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
     Sampler, Scene,
 };

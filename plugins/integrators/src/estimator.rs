@@ -23,9 +23,9 @@
 //! (no light sample can find their direction) take weight 1 by flags, never
 //! by infinite densities.
 
-use lumis_core::bsdf::{BsdfContext, BsdfSample};
-use lumis_core::ray::RayOrigins;
-use lumis_core::{
+use lumis_api::bsdf::{BsdfContext, BsdfSample};
+use lumis_api::ray::RayOrigins;
+use lumis_api::{
     Light, LightIndex, LightKind, LightSample, LightSampleContext, LightSampler, ParamChoice,
     Params, PluginParams, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene,
     SurfaceInteraction, Vec2, Vec3,

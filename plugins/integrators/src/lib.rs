@@ -17,10 +17,10 @@ pub use path::{PathIntegrator, PathParams};
 pub use specialize::{Specialized, Trace};
 pub use wavefront::{WavefrontIntegrator, WavefrontParams};
 
-use lumis_core::{Registry, Result, Scene};
+use lumis_api::{Registrar, Result, Scene};
 
 /// Registers every integrator of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_integrator(path::SPEC, |p| {
         Ok(Box::new(PathIntegrator::from_params(p)?))
     })?;
@@ -35,7 +35,7 @@ pub fn register(registry: &mut Registry) -> Result<()> {
 /// As [`register`], with each integrator's loop also compiled for the scene
 /// type `S`, so that its queries inline into the loop: the binary passes
 /// its own scene type, which this crate cannot name.
-pub fn register_specialized<S: Scene + 'static>(registry: &mut Registry) -> Result<()> {
+pub fn register_specialized<S: Scene + 'static>(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_integrator(path::SPEC, |p| {
         Ok(Box::new(Specialized::<_, S>::new(
             PathIntegrator::from_params(p)?,

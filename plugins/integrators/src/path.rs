@@ -13,7 +13,7 @@
 //! estimation so that the two overlap; and both offset ray origins are
 //! worked out once per vertex.
 
-use lumis_core::{
+use lumis_api::{
     Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
     Sampler, Scene,
 };

@@ -3,7 +3,7 @@
 //! keeps one, the wavefront integrator one per lane, and both advance it
 //! with the same steps.
 
-use lumis_core::{BsdfFlags, BsdfSample, Ray, RenderStats, Rgb, Sampler};
+use lumis_api::{BsdfFlags, BsdfSample, Ray, RenderStats, Rgb, Sampler};
 
 use crate::estimator::{BsdfRay, Vertex, VertexPlan};
 

@@ -10,7 +10,7 @@
 
 use std::marker::PhantomData;
 
-use lumis_core::{Integrator, Ray, RenderStats, Rgb, Sampler, Scene};
+use lumis_api::{Integrator, Ray, RenderStats, Rgb, Sampler, Scene};
 
 use crate::estimator::SceneView;
 

@@ -9,7 +9,7 @@
 //! nothing in the tree can reach the point. A light of zero power is never
 //! picked.
 
-use lumis_core::{
+use lumis_api::{
     Aabb, Light, LightBounds, LightSampleContext, LightSampler, PluginKind, PluginSpec,
     SampledLight, Vec3,
 };

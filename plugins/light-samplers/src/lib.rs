@@ -8,10 +8,10 @@ pub use bvh::BvhLightSampler;
 pub use power::PowerLightSampler;
 pub use uniform::UniformLightSampler;
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers every light sampler of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_light_sampler(uniform::SPEC, |_p, lights| {
         Ok(Box::new(UniformLightSampler::new(lights.len())))
     })?;

@@ -4,7 +4,7 @@
 //! most samples on the dim ones. It ignores position: a light far from the
 //! shading point still gets its share.
 
-use lumis_core::{Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
+use lumis_api::{Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
@@ -89,7 +89,7 @@ impl LightSampler for PowerLightSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::Vec3;
+    use lumis_api::Vec3;
 
     #[test]
     fn frequencies_follow_the_weights() {

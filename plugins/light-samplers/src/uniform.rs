@@ -1,6 +1,6 @@
 //! `uniform`: every light with the same probability.
 
-use lumis_core::{LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
+use lumis_api::{LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
@@ -51,7 +51,7 @@ impl LightSampler for UniformLightSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::Vec3;
+    use lumis_api::Vec3;
 
     #[test]
     fn picks_every_light_equally() {

@@ -1,12 +1,12 @@
 //! What every area light shares: its emission parameters, and the change of
 //! measure from area to solid angle.
 
-use lumis_core::interaction::LightSampleContext;
-use lumis_core::ray::SurfacePoint;
+use lumis_api::interaction::LightSampleContext;
+use lumis_api::ray::SurfacePoint;
 use std::sync::Arc;
 
-use lumis_core::params::Textured;
-use lumis_core::{
+use lumis_api::params::Textured;
+use lumis_api::{
     Aabb, Light, LightBounds, LightKind, LightSample, ParamChoice, Params, PluginParams, Result,
     Rgb, Texture, TexturedRgb, Vec2, Vec3,
 };

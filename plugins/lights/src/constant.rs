@@ -1,9 +1,9 @@
 //! `constant`: uniform radiance arriving from every direction (the white
 //! furnace's light).
 
-use lumis_core::interaction::LightSampleContext;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::interaction::LightSampleContext;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
     Result, Rgb, Vec2, Vec3,
 };

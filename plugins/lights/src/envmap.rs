@@ -13,10 +13,10 @@ mod equirect;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
-use lumis_core::glam::Quat;
-use lumis_core::interaction::LightSampleContext;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::glam::Quat;
+use lumis_api::interaction::LightSampleContext;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Error, Light, LightKind, LightSample, LightShape, ParamChoice, Params, PluginKind,
     PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };

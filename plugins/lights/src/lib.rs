@@ -22,10 +22,10 @@ pub use spot::SpotLight;
 pub use textured::TexturedAreaLight;
 pub use triangle::{Triangle, TriangleLight};
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers every light of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_light(point::SPEC, |p, shape| {
         Ok(Box::new(PointLight::from_params(p, shape)?))
     })?;

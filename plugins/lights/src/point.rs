@@ -1,8 +1,8 @@
 //! `point`: an isotropic point light (a delta distribution in position).
 
-use lumis_core::interaction::LightSampleContext;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::interaction::LightSampleContext;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
     PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };

@@ -2,9 +2,9 @@
 //! rectangles, uniformly over the spherical rectangle it subtends (Urena et
 //! al. 2013).
 
-use lumis_core::math::gamma;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::math::gamma;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Aabb, Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2,
     Vec3,
 };
@@ -160,7 +160,7 @@ impl PlanarShape for Quad {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::{Light, LightSampleContext, Rgb};
+    use lumis_api::{Light, LightSampleContext, Rgb};
     use lumis_sampling::Pcg32;
 
     fn light() -> QuadLight {

@@ -6,9 +6,9 @@
 
 use std::f32::consts::PI;
 
-use lumis_core::math::gamma;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::math::gamma;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Aabb, Error, Light, LightBounds, LightKind, LightSample, LightSampleContext, LightShape,
     Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
@@ -407,7 +407,7 @@ impl Light for SphereLight {
 /// The SIMD lanes of `sample_li_batch` (eight, as the conductor's).
 type Lanes = F32x8;
 
-/// `lumis_core::Frame` restated over lanes (a test holds it to its bits):
+/// `lumis_api::Frame` restated over lanes (a test holds it to its bits):
 /// the orthonormal basis around a unit `z` of Duff et al. 2017,
 /// "Building an Orthonormal Basis, Revisited".
 struct FrameLanes<F> {
@@ -437,7 +437,7 @@ impl<F: Real> FrameLanes<F> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::Frame;
+    use lumis_api::Frame;
     use lumis_sampling::Pcg32;
 
     /// The lane restatement of the frame gives its bits.

@@ -1,9 +1,9 @@
 //! `spot`: a point light emitting in a cone with a smooth falloff (a delta
 //! distribution in position; pbrt-v4 `SpotLight`, section 12.2.1).
 
-use lumis_core::interaction::LightSampleContext;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::interaction::LightSampleContext;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Aabb, Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
     PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };

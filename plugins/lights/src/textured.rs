@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use lumis_core::{
+use lumis_api::{
     Light, LightBounds, LightKind, LightSample, LightSampleContext, Rgb, Texture, TextureQuery,
     Vec2, Vec3,
 };

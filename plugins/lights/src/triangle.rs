@@ -1,9 +1,9 @@
 //! `triangle`: one emissive triangle of a mesh, sampled uniformly by area or
 //! uniformly over the spherical triangle it subtends (Arvo 1995).
 
-use lumis_core::math::gamma;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::math::gamma;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Aabb, Error, Light, LightShape, Params, PluginKind, PluginParams, PluginSpec, Result, Vec2,
     Vec3,
 };
@@ -176,7 +176,7 @@ impl PlanarShape for Triangle {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lumis_core::{Light, LightSampleContext, Rgb};
+    use lumis_api::{Light, LightSampleContext, Rgb};
     use lumis_sampling::Pcg32;
 
     #[test]

@@ -10,7 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lumis_core::Result;
+use lumis_api::Result;
 
 use crate::grid::{Grid, Parameterization};
 use crate::merl::{content_hash, write_atomic};

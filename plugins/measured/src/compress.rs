@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use lumis_core::{Error, ParamChoice, Result};
+use lumis_api::{Error, ParamChoice, Result};
 
 use crate::cache::{self, CacheKey};
 use crate::cp::{AlsReport, AlsSettings};

@@ -43,7 +43,7 @@
 //! (Hesterberg 1995's defensive mixture), at a cost of 1% of the samples.
 
 use indicatif::ProgressBar;
-use lumis_core::Vec3;
+use lumis_api::Vec3;
 use lumis_sampling::{Distribution1D, Pcg32};
 
 use crate::grid::Grid;
@@ -370,7 +370,7 @@ impl Factored {
     /// Draws `wi` (or `None` when the coordinates send it below the
     /// horizon or faces away from `wo`).
     #[inline]
-    pub fn sample(&self, wo: Vec3, u1: f32, u2: lumis_core::Vec2) -> Option<Vec3> {
+    pub fn sample(&self, wo: Vec3, u1: f32, u2: lumis_api::Vec2) -> Option<Vec3> {
         let rows = self.grid.rows(wo);
         let mut l = self.terms - 1;
         let mut acc = 0.0;

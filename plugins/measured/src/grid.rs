@@ -34,7 +34,7 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 
 use indicatif::ProgressBar;
-use lumis_core::{ParamChoice, Rgb, Vec3};
+use lumis_api::{ParamChoice, Rgb, Vec3};
 use lumis_sampling::halfdiff::{
     half_coords_from_wi, half_coords_jacobian, spherical_direction, wi_from_half_coords,
 };

@@ -24,9 +24,9 @@ pub use merl::MerlTable;
 
 use std::sync::Arc;
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers the `measured` BSDF.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_bsdf(SPEC, |p| Ok(Arc::new(Measured::from_params(p)?)))
 }

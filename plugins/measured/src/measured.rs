@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Result, Rgb, Vec2, Vec3,
 };

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use lumis_core::{Result, Rgb, Vec3};
+use lumis_api::{Result, Rgb, Vec3};
 
 use crate::cache::{self, CacheKey};
 use crate::factored::{factorize, Factored, Factors, NMF_ITERATIONS, REFINE_ITERATIONS};

@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use lumis_core::{Rgb, Vec3};
+use lumis_api::{Rgb, Vec3};
 
 use crate::merl::{content_hash, MerlTable};
 use crate::tensor::TensorBrdf;

@@ -6,7 +6,7 @@
 //! than silently averaged into something else.
 
 use indicatif::ProgressBar;
-use lumis_core::{Bsdf, BsdfContext, BsdfFlags, Error, Result, Vec3};
+use lumis_api::{Bsdf, BsdfContext, BsdfFlags, Error, Result, Vec3};
 use lumis_sampling::halfdiff::spherical_direction;
 use lumis_sampling::Pcg32;
 use rayon::prelude::*;
@@ -56,7 +56,7 @@ pub fn check_representable(bsdf: &dyn Bsdf, name: &str) -> Result<()> {
             .max_component()
             .max(rotated.max_component())
             .max(swapped.max_component());
-        let differs = |g: lumis_core::Rgb| {
+        let differs = |g: lumis_api::Rgb| {
             (f - g).map(f32::abs).max_component() > CHECK_TOLERANCE * scale + 1e-6
         };
         if differs(rotated) {

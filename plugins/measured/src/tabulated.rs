@@ -13,7 +13,7 @@
 
 use std::sync::Arc;
 
-use lumis_core::{Vec2, Vec3};
+use lumis_api::{Vec2, Vec3};
 use lumis_sampling::Distribution1D;
 
 use crate::factored::DEFENSIVE;

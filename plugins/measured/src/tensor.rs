@@ -40,7 +40,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-use lumis_core::{Rgb, Vec3};
+use lumis_api::{Rgb, Vec3};
 use lumis_sampling::halfdiff::{spherical_direction, HalfDiff};
 use lumis_sampling::pdv::{pdv_from_w, w_from_pdv};
 use rayon::prelude::*;

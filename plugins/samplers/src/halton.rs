@@ -1,6 +1,6 @@
 //! `halton`: the Halton sequence over the whole image, scrambled.
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
     Sampler, SamplerLanes, UVec2, Vec2,
 };

@@ -1,7 +1,7 @@
 //! `hammersley`: the finite Hammersley point set of the pixel's samples,
 //! Owen-scrambled per pixel.
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };

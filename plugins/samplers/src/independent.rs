@@ -1,6 +1,6 @@
 //! `independent`: uniform random numbers, no stratification.
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
     UVec2, Vec2,
 };

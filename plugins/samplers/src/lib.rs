@@ -22,10 +22,10 @@ pub use sobol::{
 pub use stratified::{strata_grid, StratifiedSampler};
 pub use zsobol::ZSobolSampler;
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers every sampler of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_sampler(independent::SPEC, |p| {
         Ok(Box::new(IndependentSampler::from_params(p)?))
     })?;

@@ -1,6 +1,6 @@
 //! Test helper: the (0,m,2)-net property of 2D sample points.
 
-use lumis_core::Vec2;
+use lumis_api::Vec2;
 
 /// Whether every elementary interval of area 2^-m (2^a x 2^(m-a) cells,
 /// a = 0..m) holds exactly one of the 2^m points.

@@ -1,6 +1,6 @@
 //! `poisson-disk`: Poisson disk patterns for the film plane.
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };

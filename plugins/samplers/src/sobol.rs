@@ -3,7 +3,7 @@
 use std::fmt;
 use std::marker::PhantomData;
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
     Sampler, SamplerLanes, UVec2, Vec2,
 };

@@ -1,6 +1,6 @@
 //! The `spp` parameter every sampler shares.
 
-use lumis_core::{Params, PluginParams, Result};
+use lumis_api::{Params, PluginParams, Result};
 
 /// Flattened into every sampler's parameters.
 #[derive(Debug, Clone, Copy, PluginParams)]

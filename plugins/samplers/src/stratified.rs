@@ -1,7 +1,7 @@
 //! `stratified`: jittered strata in every dimension pair, decorrelated
 //! across dimensions by per-pixel random permutations (padding).
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
     SamplerLanes, UVec2, Vec2,
 };

@@ -1,7 +1,7 @@
 //! `zsobol`: one Sobol' sequence over the image in Morton (Z) order of the
 //! pixels, for blue-noise error between neighbouring pixels.
 
-use lumis_core::{
+use lumis_api::{
     ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
     Sampler, SamplerLanes, UVec2, Vec2,
 };

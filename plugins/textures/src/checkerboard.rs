@@ -2,7 +2,7 @@
 //! unit square (Mitsuba 3's `checkerboard`; pbrt-v4's `checkerboard`
 //! without its filtering).
 
-use lumis_core::{
+use lumis_api::{
     Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery, UvTransform,
 };
 
@@ -43,7 +43,7 @@ impl Checkerboard {
     /// Which value covers `uv`: squares of side 1/2, alternating in both
     /// directions, so each value covers half of any whole square of uv.
     #[inline]
-    fn square(uv: lumis_core::Vec2) -> usize {
+    fn square(uv: lumis_api::Vec2) -> usize {
         let cells = (uv * 2.0).floor();
         (cells.x + cells.y).rem_euclid(2.0) as usize
     }
@@ -62,7 +62,7 @@ impl Texture for Checkerboard {
 
 #[cfg(test)]
 mod tests {
-    use lumis_core::Vec2;
+    use lumis_api::Vec2;
 
     use super::*;
 

@@ -1,8 +1,6 @@
 //! `constant`: one value everywhere.
 
-use lumis_core::{
-    Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery,
-};
+use lumis_api::{Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Texture,

@@ -1,6 +1,6 @@
 //! Standard textures: `constant`, `checkerboard` and `image` (PNG, JPEG or
 //! EXR, wrapped and filtered). Every texture but `constant` takes the
-//! [`UvTransform`](lumis_core::UvTransform) keys.
+//! [`UvTransform`](lumis_api::UvTransform) keys.
 
 mod checkerboard;
 mod constant;
@@ -12,10 +12,10 @@ pub use image::{Encoding, ImageFilter, ImageParams, ImageTexture, Texels, Wrap};
 
 use std::sync::Arc;
 
-use lumis_core::{Registry, Result};
+use lumis_api::{Registrar, Result};
 
 /// Registers every texture of this crate.
-pub fn register(registry: &mut Registry) -> Result<()> {
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_texture(constant::SPEC, |p| Ok(Arc::new(Constant::from_params(p)?)))?;
     registry.add_texture(checkerboard::SPEC, |p| {
         Ok(Arc::new(Checkerboard::from_params(p)?))

@@ -9,9 +9,9 @@
 use std::f32::consts::FRAC_1_PI;
 use std::sync::Arc;
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec,
-    Registry, Result, Rgb, Vec2, Vec3,
+    Registrar, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::warp;
 
@@ -34,14 +34,14 @@ pub struct LambertianParams {
     pub reflectance: Rgb,
 }
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_bsdf(SPEC, |params| {
         Ok(Arc::new(Lambertian::from_params(params)?))
     })
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 #[derive(Debug, Clone)]
 pub struct Lambertian {

@@ -9,8 +9,8 @@
 //! integrator with the same `max_depth`; without light sampling it is
 //! noisier, and it cannot see point lights (which no ray hits).
 
-use lumis_core::{
-    BsdfContext, Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, Registry,
+use lumis_api::{
+    BsdfContext, Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, Registrar,
     RenderStats, Result, Rgb, Sampler, Scene, Vec3,
 };
 
@@ -29,14 +29,14 @@ pub struct BsdfPathParams {
     pub max_depth: u32,
 }
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_integrator(SPEC, |params| {
         Ok(Box::new(BsdfPathTracer::from_params(params)?))
     })
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 #[derive(Debug, Clone)]
 pub struct BsdfPathTracer {

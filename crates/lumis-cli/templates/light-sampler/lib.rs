@@ -7,8 +7,8 @@
 //! `pmf` must agree, and every light that can contribute needs a
 //! probability above zero.
 
-use lumis_core::{
-    Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, Registry, Result, SampledLight,
+use lumis_api::{
+    Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, Registrar, Result, SampledLight,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -18,14 +18,14 @@ pub const SPEC: PluginSpec = PluginSpec {
     params: &[],
 };
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_light_sampler(SPEC, |_params, lights| {
         Ok(Box::new(PowerSampler::new(lights)))
     })
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 #[derive(Debug, Clone)]
 pub struct PowerSampler {

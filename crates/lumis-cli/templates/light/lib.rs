@@ -14,11 +14,11 @@
 
 use std::f32::consts::PI;
 
-use lumis_core::math::gamma;
-use lumis_core::ray::SurfacePoint;
-use lumis_core::{
+use lumis_api::math::gamma;
+use lumis_api::ray::SurfacePoint;
+use lumis_api::{
     Aabb, Error, Light, LightBounds, LightKind, LightSample, LightSampleContext, LightShape,
-    Params, PluginKind, PluginParams, PluginSpec, Registry, Result, Rgb, Vec2, Vec3,
+    Params, PluginKind, PluginParams, PluginSpec, Registrar, Result, Rgb, Vec2, Vec3,
 };
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -36,14 +36,14 @@ pub struct QuadEmitterParams {
     pub radiance: Rgb,
 }
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_light(SPEC, |params, shape| {
         Ok(Box::new(QuadEmitter::from_params(params, shape)?))
     })
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 /// The parallelogram `corner + s edge_u + t edge_v`, `s, t` in `[0, 1]`,
 /// emitting `radiance` toward `edge_u x edge_v`.

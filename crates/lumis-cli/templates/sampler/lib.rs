@@ -10,8 +10,8 @@
 //! sit in the same stratum in every dimension, and the dimensions of a path
 //! would be correlated ("padding", pbrt-v4 section 8.5).
 
-use lumis_core::{
-    Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Registry, Result, Sampler, UVec2,
+use lumis_api::{
+    Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Registrar, Result, Sampler, UVec2,
     Vec2,
 };
 use lumis_sampling::{
@@ -32,14 +32,14 @@ pub struct JitteredParams {
     pub strata: u32,
 }
 
-/// Registers the plugin; exported through [`lumis_core::lumis_plugin!`].
-pub fn register(registry: &mut Registry) -> Result<()> {
+/// Registers the plugin; exported through [`lumis_api::lumis_plugin!`].
+pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     registry.add_sampler(SPEC, |params| {
         Ok(Box::new(JitteredSampler::from_params(params)?))
     })
 }
 
-lumis_core::lumis_plugin!(register);
+lumis_api::lumis_plugin!(register);
 
 /// The largest `strata`, so that `strata^2` samples stay well within `u32`.
 pub const MAX_STRATA: u32 = 1024;

@@ -3,7 +3,7 @@
 //! [`Bsdf::eval_batch`] or [`Light::sample_li_batch`] call, so that a
 //! plugin computing lanes together sees one material at a time.
 
-use lumis_core::{
+use lumis_api::{
     Bsdf, BsdfContext, BsdfSample, Light, LightSample, LightSampleContext, Rgb, Vec2, Vec3,
 };
 

@@ -5,10 +5,10 @@
 //! Each bounce runs as stages over every live path of the wave: draw the
 //! vertex's numbers, trace all rays ([`Scene::intersect_batch`]: SIMD
 //! packets in the renderer's scene), add the emission they find, sample
-//! every BSDF grouped by material ([`lumis_core::Bsdf::sample_f_batch`]),
+//! every BSDF grouped by material ([`lumis_api::Bsdf::sample_f_batch`]),
 //! sample the lights grouped by light
-//! ([`lumis_core::Light::sample_li_batch`]), evaluate the BSDFs at the
-//! light samples grouped by material ([`lumis_core::Bsdf::eval_batch`]),
+//! ([`lumis_api::Light::sample_li_batch`]), evaluate the BSDFs at the
+//! light samples grouped by material ([`lumis_api::Bsdf::eval_batch`]),
 //! trace all shadow rays ([`Scene::occluded_batch`]), and continue each path
 //! as `path` does ([`PathState`]). Every stage sees many independent lanes
 //! of one kind, which a plugin may compute with SIMD.
@@ -20,7 +20,7 @@
 
 mod batched;
 
-use lumis_core::{
+use lumis_api::{
     BsdfSample, Integrator, LightKind, LightSample, LightSampleContext, Params, PluginKind,
     PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, SampledLight, Sampler, SamplerLanes,
     Scene, SurfaceInteraction, Vec2, Vec3,

@@ -6,7 +6,7 @@
 
 use std::f32::consts::PI;
 
-use lumis_core::{Rgb, Vec2, Vec3};
+use lumis_api::{Rgb, Vec2, Vec3};
 use lumis_sampling::special::{atan2, sin_cos_turns};
 
 /// `floor(x)` as an integer, without the library call `f32::floor` makes

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use lumis_core::files::{read_bounded, IMAGE_FILE};
-use lumis_core::Rgb;
+use lumis_api::files::{read_bounded, IMAGE_FILE};
+use lumis_api::Rgb;
 
 /// An image as stored: its texel values before any decoding of their
 /// encoding.

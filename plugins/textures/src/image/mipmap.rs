@@ -2,7 +2,7 @@
 //! trilinear and EWA (pbrt-v4 `MIPMap`, section 10.4.3; EWA after Heckbert
 //! 1989 and Greene and Heckbert 1986, as pbrt-v4 writes it).
 
-use lumis_core::{Rgb, TextureQuery, Vec2};
+use lumis_api::{Rgb, TextureQuery, Vec2};
 
 use super::texels::{Texels, Wrap};
 

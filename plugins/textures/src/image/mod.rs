@@ -7,7 +7,7 @@ mod texels;
 
 use std::path::PathBuf;
 
-use lumis_core::{
+use lumis_api::{
     ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery,
     UvTransform,
 };

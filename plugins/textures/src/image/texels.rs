@@ -1,7 +1,7 @@
 //! A grid of linear texels and its lookups: wrapped texel access, nearest
 //! and bilinear reconstruction (pbrt-v4 `Image::Bilerp`).
 
-use lumis_core::{ParamChoice, Rgb, Vec2};
+use lumis_api::{ParamChoice, Rgb, Vec2};
 
 /// How coordinates outside the image map back into it (pbrt-v4
 /// `WrapMode`, Mitsuba 3's `wrap_mode`).

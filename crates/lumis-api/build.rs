@@ -27,7 +27,7 @@ fn main() {
     let manifest = crate_dir.join("../../Cargo.toml");
     let workspace = std::fs::read_to_string(&manifest).unwrap_or_else(|e| {
         panic!(
-            "lumis-core is built inside the lumis workspace, whose {} cannot be read: {e}",
+            "lumis-api is built inside the lumis workspace, whose {} cannot be read: {e}",
             manifest.display()
         )
     });

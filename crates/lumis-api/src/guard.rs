@@ -4,115 +4,46 @@
 //! a panic unwinding out of it into lumis is a foreign exception, which
 //! aborts the process: the host cannot catch it. So the catching is done
 //! where the plugin's code runs. [`lumis_plugin!`](crate::lumis_plugin)
-//! wraps `register`, and while a library registers, the registry wraps
+//! wraps `register`, and hands it a registrar ([`Guarding`]) that wraps
 //! every factory it is given, and every plugin those factories make, in
 //! the guards below. All of that is this module, compiled into the
-//! plugin's own copy of lumis-core, so its `catch_unwind` is the plugin's.
+//! plugin's own copy of lumis-api, so its `catch_unwind` is the plugin's.
 //!
 //! A caught panic becomes an [`Error`] naming the plugin, its library, the
-//! method and the parameters, kept in the registry's [`FaultSink`]; the
+//! method and the parameters, kept by the host's [`FaultReport`]; the
 //! call returns a neutral value (no sample, zero radiance) and the host
-//! stops at its next check of the sink. Built-in plugins are not wrapped:
+//! stops at its next check of its record. Built-in plugins are not wrapped:
 //! their panics are the host's own, and unwind normally.
 
 use std::any::Any;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
-use crate::audit::{Answer, Defects, Tally};
+use crate::audit::{Answer, Tally};
 use crate::error::{Error, Result};
-use crate::registry::Registry;
+use crate::registrar::{Factory, PluginSpec, Registrar};
 use crate::wrap::{CallHook, Fault, Wrapped};
 
-/// The faults of guarded plugins; shared by a registry and every guard it
-/// made.
-#[derive(Default)]
-pub struct FaultSink {
-    faulted: AtomicBool,
-    /// The first fault of each plugin (by label), in the order they came.
-    faults: Mutex<Vec<(Arc<str>, Error)>>,
-    /// What each plugin's answers held that no correct plugin gives, by
-    /// the plugin's name with its library ([`crate::audit`]).
-    tallies: Mutex<Vec<(Arc<str>, Arc<Tally>)>>,
+/// Where guarded plugins report, implemented by the host: a library's
+/// guards call it through this trait object, so they never assume the
+/// layout of the host's records.
+pub trait FaultReport: Send + Sync {
+    /// Keeps `error`, the panic of the plugin labelled `plugin`, if it is
+    /// that plugin's first.
+    fn record(&self, plugin: &str, error: Error);
+
+    /// The tally of the plugin named `name` (its label and library),
+    /// shared by every object made under that name.
+    fn tally(&self, name: &str) -> Arc<Tally>;
 }
 
-impl std::fmt::Debug for FaultSink {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("FaultSink")
-            .field("faulted", &self.has_fault())
-            .finish_non_exhaustive()
-    }
-}
-
-impl FaultSink {
-    /// Keeps `error` if it is the first of `plugin`'s.
-    fn record(&self, plugin: &str, error: Error) {
-        let mut faults = self.faults.lock().unwrap_or_else(|e| e.into_inner());
-        if !faults.iter().any(|(p, _)| **p == *plugin) {
-            faults.push((Arc::from(plugin), error));
-        }
-        self.faulted.store(true, Ordering::Release);
-    }
-
-    /// Whether any guarded call has panicked: cheap, for polling.
-    pub fn has_fault(&self) -> bool {
-        self.faulted.load(Ordering::Acquire)
-    }
-
-    /// The first fault as an error, if there was one.
-    pub fn check(&self) -> Result<()> {
-        if !self.has_fault() {
-            return Ok(());
-        }
-        let faults = self.faults.lock().unwrap_or_else(|e| e.into_inner());
-        Err(faults
-            .first()
-            .map(|(_, e)| e.clone())
-            .unwrap_or_else(|| Error::msg("a plugin panicked")))
-    }
-
-    /// The tally of the plugin named `name`, shared by every object made
-    /// under that name.
-    fn tally(&self, name: &str) -> Arc<Tally> {
-        let mut tallies = self.tallies.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, tally)) = tallies.iter().find(|(n, _)| **n == *name) {
-            return tally.clone();
-        }
-        let tally = Arc::new(Tally::default());
-        tallies.push((Arc::from(name), tally.clone()));
-        tally
-    }
-
-    /// The loaded plugins whose answers held defects so far (NaN or
-    /// infinite, negative, energy created), each named with its library.
-    pub fn defects(&self) -> Vec<(Arc<str>, Defects)> {
-        let tallies = self.tallies.lock().unwrap_or_else(|e| e.into_inner());
-        tallies
-            .iter()
-            .map(|(name, tally)| (name.clone(), tally.defects()))
-            .filter(|(_, defects)| defects.any())
-            .collect()
-    }
-
-    /// The faults of the plugins whose label starts with `owner` (the
-    /// owner they were created with), for telling apart the cases of a
-    /// check that made each its own plugin.
-    pub fn faults_of(&self, owner: &str) -> Vec<Error> {
-        let faults = self.faults.lock().unwrap_or_else(|e| e.into_inner());
-        faults
-            .iter()
-            .filter(|(plugin, _)| plugin.starts_with(owner))
-            .map(|(_, e)| e.clone())
-            .collect()
-    }
-}
-
-/// Runs a library's `register` under the library's `catch_unwind`: what
+/// Runs a library's `register` under the library's `catch_unwind`, with
+/// every factory it registers guarded ([`Guarding`]): what
 /// [`lumis_plugin!`](crate::lumis_plugin) exports.
 pub fn register_guarded(
-    registry: &mut Registry,
-    register: fn(&mut Registry) -> Result<()>,
+    registrar: &mut dyn Registrar,
+    register: fn(&mut dyn Registrar) -> Result<()>,
 ) -> Result<()> {
     // The library's panics report through its own copy of the standard
     // library's hook, once per call that panics: a faulty BSDF would print
@@ -128,12 +59,71 @@ pub fn register_guarded(
             }
         }));
     });
-    catch_unwind(AssertUnwindSafe(|| register(registry))).unwrap_or_else(|payload| {
+    let guard = PluginGuard::new(registrar.source(), registrar.faults());
+    let mut guarding = Guarding {
+        host: registrar,
+        guard,
+    };
+    catch_unwind(AssertUnwindSafe(|| register(&mut guarding))).unwrap_or_else(|payload| {
         Err(Error::msg(format!(
             "panicked in register: {}",
             panic_message(payload.as_ref())
         )))
     })
+}
+
+/// The registrar a library's `register` is given: the host's, with every
+/// factory guarded on its way in. Runs in the library's copy of this code,
+/// so the closures it makes, and their `catch_unwind`, are the library's.
+pub struct Guarding<'h> {
+    host: &'h mut dyn Registrar,
+    guard: PluginGuard,
+}
+
+impl Registrar for Guarding<'_> {
+    fn add(&mut self, spec: PluginSpec, factory: Factory) -> Result<()> {
+        self.host.add(spec, guarded_factory(&self.guard, factory))
+    }
+
+    fn source(&self) -> &str {
+        self.host.source()
+    }
+
+    fn faults(&self) -> Arc<dyn FaultReport> {
+        self.host.faults()
+    }
+}
+
+/// `factory`, called under `guard`, and what it makes guarded.
+fn guarded_factory(guard: &PluginGuard, factory: Factory) -> Factory {
+    /// The guarded closure for one kind: `$boxed` boxes what is made.
+    macro_rules! guarded {
+        ($make:ident, $boxed:path, |$params:ident $(, $input:ident: $ty:ty)?|) => {{
+            let guard = guard.clone();
+            Arc::new(move |$params: &crate::params::Params $(, $input: $ty)?| {
+                let label: Arc<str> =
+                    Arc::from(format!("{} {{ {} }}", $params.owner(), $params.written()));
+                let made = guard.call(&label, "its factory", || $make($params $(, $input)?))??;
+                Ok($boxed(Guarded::new(made, Guard::new(guard.clone(), label))))
+            })
+        }};
+    }
+    use crate::light::{Light, LightShape};
+    match factory {
+        Factory::Sampler(make) => Factory::Sampler(guarded!(make, Box::new, |params|)),
+        Factory::Texture(make) => Factory::Texture(guarded!(make, Arc::new, |params|)),
+        Factory::Bsdf(make) => Factory::Bsdf(guarded!(make, Arc::new, |params|)),
+        Factory::Light(make) => {
+            Factory::Light(guarded!(make, Box::new, |params, shape: &LightShape|))
+        }
+        Factory::LightSampler(make) => Factory::LightSampler(guarded!(
+            make,
+            Box::new,
+            |params, lights: &[Box<dyn Light>]|
+        )),
+        Factory::Integrator(make) => Factory::Integrator(guarded!(make, Box::new, |params|)),
+        Factory::Denoiser(make) => Factory::Denoiser(guarded!(make, Box::new, |params|)),
+    }
 }
 
 /// The text of a panic's payload.
@@ -151,11 +141,17 @@ pub fn panic_message(payload: &(dyn Any + Send)) -> String {
 #[derive(Clone, Debug)]
 pub struct PluginGuard {
     library: Arc<str>,
-    faults: Arc<FaultSink>,
+    faults: Arc<dyn FaultReport>,
+}
+
+impl std::fmt::Debug for dyn FaultReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("FaultReport")
+    }
 }
 
 impl PluginGuard {
-    pub fn new(library: &str, faults: Arc<FaultSink>) -> Self {
+    pub fn new(library: &str, faults: Arc<dyn FaultReport>) -> Self {
         Self {
             library: Arc::from(library),
             faults,
@@ -183,7 +179,7 @@ impl PluginGuard {
 /// interrupts.
 ///
 /// Every answer that comes back is audited ([`crate::audit`]): the counts
-/// go to the plugin's tally in the registry's [`FaultSink`].
+/// go to the plugin's tally, which the host keeps ([`FaultReport`]).
 pub struct Guard {
     guard: PluginGuard,
     label: Arc<str>,
@@ -247,12 +243,38 @@ pub type Guarded<C> = Wrapped<C, Guard>;
 
 #[cfg(test)]
 mod tests {
+    use std::sync::Mutex;
+
     use glam::{Vec2, Vec3};
 
     use super::*;
     use crate::bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample};
     use crate::denoiser::{DenoiseInput, Denoiser};
     use crate::spectrum::Rgb;
+
+    /// The faults and tallies of the plugins a test guards.
+    #[derive(Default)]
+    struct Recorded {
+        faults: Mutex<Vec<Error>>,
+    }
+
+    impl FaultReport for Recorded {
+        fn record(&self, _plugin: &str, error: Error) {
+            self.faults.lock().unwrap().push(error);
+        }
+        fn tally(&self, _name: &str) -> Arc<Tally> {
+            Arc::default()
+        }
+    }
+
+    impl Recorded {
+        fn check(&self) -> Result<()> {
+            match self.faults.lock().unwrap().first() {
+                Some(e) => Err(e.clone()),
+                None => Ok(()),
+            }
+        }
+    }
 
     struct Faulty;
 
@@ -274,7 +296,7 @@ mod tests {
 
     #[test]
     fn a_panic_is_a_recorded_error_and_a_neutral_value() {
-        let faults = Arc::new(FaultSink::default());
+        let faults = Arc::new(Recorded::default());
         let guard = PluginGuard::new("libfaulty.so", faults.clone());
         let bsdf: Arc<dyn Bsdf> = Arc::new(Faulty);
         let guarded = Guarded::new(
@@ -303,7 +325,7 @@ mod tests {
 
     #[test]
     fn a_panicking_denoiser_is_an_error() {
-        let faults = Arc::new(FaultSink::default());
+        let faults = Arc::new(Recorded::default());
         let guard = PluginGuard::new("libdenoise.so", faults.clone());
         let denoiser: Box<dyn Denoiser> = Box::new(Panicking);
         let guarded = Guarded::new(

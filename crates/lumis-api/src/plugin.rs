@@ -1,27 +1,29 @@
 //! The declaration a dynamically loaded plugin exports.
 //!
 //! Rust has no stable ABI, so a plugin library is only sound to use when it
-//! was built by the same rustc from the same lumis-core as the host. The
+//! was built by the same rustc from the same lumis-api as the host. The
 //! declaration carries both, the fingerprint of the plugin interface (a
-//! hash of lumis-core's declarations, the layouts of its types and the
+//! hash of lumis-api's declarations, the layouts of its types and the
 //! signatures of its public functions but not their bodies, comments or
 //! tests, and of the versions of the crates whose types cross the
 //! boundary; `lumis-fingerprint`, run by the build script), and an ABI version
 //! that comes first so it can always be read; the host checks all four
-//! before calling anything else.
+//! before calling anything else. The host's own code (its document parser,
+//! registry and records) is not in the interface: it changes without
+//! refusing a plugin.
 
 use crate::error::Result;
-use crate::registry::Registry;
+use crate::registrar::Registrar;
 
 /// Bumped whenever [`PluginDeclaration`] changes shape, the one thing a
 /// host reads before it can compare fingerprints (which see the traits).
-pub const PLUGIN_ABI_VERSION: u32 = 10;
-/// The compiler that built this copy of lumis-core.
+pub const PLUGIN_ABI_VERSION: u32 = 11;
+/// The compiler that built this copy of lumis-api.
 pub const RUSTC_VERSION: &str = env!("LUMIS_RUSTC_VERSION");
-/// The version of this copy of lumis-core.
-pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// The version of this copy of lumis-api.
+pub const API_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// The fingerprint of this copy's plugin interface, 16 hex digits: two
-/// lumis-cores with the same version whose traits differ have different
+/// lumis-apis with the same version whose traits differ have different
 /// fingerprints (`lumis-fingerprint`).
 pub const INTERFACE_FINGERPRINT: &str = env!("LUMIS_INTERFACE_FINGERPRINT");
 /// What the symbol [`lumis_plugin!`](crate::lumis_plugin) exports begins
@@ -46,10 +48,10 @@ const TEXT: usize = 128;
 pub struct PluginDeclaration {
     pub abi_version: u32,
     rustc_version: [u8; TEXT],
-    core_version: [u8; TEXT],
+    api_version: [u8; TEXT],
     interface_fingerprint: [u8; TEXT],
     /// Called by the host with its registry once the versions match.
-    pub register: fn(&mut Registry) -> Result<()>,
+    pub register: fn(&mut dyn Registrar) -> Result<()>,
 }
 
 const fn text(s: &str) -> [u8; TEXT] {
@@ -69,12 +71,12 @@ fn read_text(bytes: &[u8; TEXT]) -> String {
 }
 
 impl PluginDeclaration {
-    /// The declaration of a plugin built against this lumis-core.
-    pub const fn new(register: fn(&mut Registry) -> Result<()>) -> Self {
+    /// The declaration of a plugin built against this lumis-api.
+    pub const fn new(register: fn(&mut dyn Registrar) -> Result<()>) -> Self {
         Self {
             abi_version: PLUGIN_ABI_VERSION,
             rustc_version: text(RUSTC_VERSION),
-            core_version: text(CORE_VERSION),
+            api_version: text(API_VERSION),
             interface_fingerprint: text(INTERFACE_FINGERPRINT),
             register,
         }
@@ -86,14 +88,14 @@ impl PluginDeclaration {
     pub const fn with_versions(
         abi_version: u32,
         rustc_version: &str,
-        core_version: &str,
+        api_version: &str,
         interface_fingerprint: &str,
-        register: fn(&mut Registry) -> Result<()>,
+        register: fn(&mut dyn Registrar) -> Result<()>,
     ) -> Self {
         Self {
             abi_version,
             rustc_version: text(rustc_version),
-            core_version: text(core_version),
+            api_version: text(api_version),
             interface_fingerprint: text(interface_fingerprint),
             register,
         }
@@ -103,8 +105,8 @@ impl PluginDeclaration {
         read_text(&self.rustc_version)
     }
 
-    pub fn core_version(&self) -> String {
-        read_text(&self.core_version)
+    pub fn api_version(&self) -> String {
+        read_text(&self.api_version)
     }
 
     pub fn interface_fingerprint(&self) -> String {
@@ -116,16 +118,18 @@ impl PluginDeclaration {
 /// `crate-type = ["cdylib", "rlib"]`):
 ///
 /// ```ignore
-/// pub fn register(registry: &mut lumis_core::Registry) -> lumis_core::Result<()> {
+/// use lumis_api::Registrar;
+///
+/// pub fn register(registry: &mut dyn Registrar) -> lumis_api::Result<()> {
 ///     registry.add_bsdf(MY_SPEC, |p| Ok(std::sync::Arc::new(MyBsdf::from_params(p)?)))
 /// }
-/// lumis_core::lumis_plugin!(register);
+/// lumis_api::lumis_plugin!(register);
 /// ```
 ///
 /// The entry point, `lumis_plugin_declaration_<crate name>`
 /// ([`entry_point`]), only returns a pointer to a static, so no panic can
 /// cross it. `register` runs under the plugin's own `catch_unwind`, and so
-/// do the factories it adds and the plugins they make (`crate::guard`): a
+/// do the factories it adds and the plugins they make ([`crate::guard`]): a
 /// panic in the plugin is an error the host reports, not an abort.
 #[macro_export]
 macro_rules! lumis_plugin {
@@ -133,7 +137,7 @@ macro_rules! lumis_plugin {
         #[allow(unsafe_code)]
         #[export_name = concat!("lumis_plugin_declaration_", env!("CARGO_CRATE_NAME"))]
         pub extern "C" fn lumis_plugin_declaration() -> *const $crate::plugin::PluginDeclaration {
-            fn register_guarded(registry: &mut $crate::Registry) -> $crate::Result<()> {
+            fn register_guarded(registry: &mut dyn $crate::Registrar) -> $crate::Result<()> {
                 $crate::guard::register_guarded(registry, $register)
             }
             static DECLARATION: $crate::plugin::PluginDeclaration =
@@ -156,10 +160,8 @@ mod tests {
             "{}",
             d.rustc_version()
         );
-        assert_eq!(d.core_version(), CORE_VERSION);
+        assert_eq!(d.api_version(), API_VERSION);
         assert_eq!(d.interface_fingerprint(), INTERFACE_FINGERPRINT);
         assert_eq!(INTERFACE_FINGERPRINT.len(), 16);
-        let mut r = Registry::new();
-        (d.register)(&mut r).unwrap();
     }
 }
