@@ -22,7 +22,6 @@ pub mod bsdf;
 pub mod denoiser;
 pub mod doc;
 pub mod error;
-pub mod files;
 pub mod footprint;
 pub mod guard;
 pub mod integrator;

@@ -66,6 +66,13 @@ impl Rgb {
     }
 }
 
+/// As a scene writes a colour: `[0.5, 0.25, inf]`.
+impl std::fmt::Display for Rgb {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "[{}, {}, {}]", self.r, self.g, self.b)
+    }
+}
+
 impl From<[f32; 3]> for Rgb {
     fn from(v: [f32; 3]) -> Self {
         Self::new(v[0], v[1], v[2])
@@ -132,5 +139,18 @@ impl Mul<Rgb> for f32 {
     #[inline]
     fn mul(self, c: Rgb) -> Rgb {
         c * self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_colour_displays_as_a_scene_writes_it() {
+        assert_eq!(
+            Rgb::new(0.5, f32::INFINITY, 0.0).to_string(),
+            "[0.5, inf, 0]"
+        );
     }
 }

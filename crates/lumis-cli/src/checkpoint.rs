@@ -26,6 +26,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
+use lumis_files::{read_bounded, FileKind, GIB};
 use lumis_render::{AdaptiveSampling, Aov, Film, FirstHitSums};
 use lumis_scene::Fnv1a;
 
@@ -38,6 +39,9 @@ const FIRST_HIT_VALUES: usize = 7;
 const ADAPTIVE_BIT: u32 = 1 << 31;
 /// Bytes per pixel of the adaptive state: count, odd sums, active flag.
 const ADAPTIVE_PIXEL_BYTES: usize = 4 + 24 + 1;
+/// A checkpoint: a film's sums, far below this for any film lumis
+/// renders (a 16k x 16k film with every output is 40 GiB).
+const CHECKPOINT_FILE: FileKind = FileKind::new("checkpoint", 64 * GIB);
 
 /// A render's state between passes.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,13 +128,14 @@ impl Checkpoint {
             .map_err(|e| Error::msg(e.to_string()))
     }
 
-    /// Reads a checkpoint; `None` where there is no file.
+    /// Reads a checkpoint; `None` where there is no file. Only a regular
+    /// file is read (a FIFO would block, `/dev/zero` never end).
     pub fn read(path: &Path) -> Result<Option<Self>> {
-        let bytes = match std::fs::read(path) {
-            Ok(bytes) => bytes,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-            Err(e) => return Err(Error::msg(format!("{}: {e}", path.display()))),
-        };
+        if std::fs::symlink_metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+        {
+            return Ok(None);
+        }
+        let bytes = read_bounded(path, CHECKPOINT_FILE).map_err(Error::msg)?;
         Self::from_bytes(&bytes)
             .map(Some)
             .map_err(|why| Error::msg(format!("{}: not a lumis checkpoint: {why}", path.display())))

@@ -12,8 +12,8 @@ use lumis_analysis::convergence::loglog_slope;
 use lumis_analysis::image_error::{check_same_size, error_metrics};
 use lumis_analysis::plot::{self, Axes, Series};
 use lumis_core::doc::{self, Value};
-use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Registry, Result};
+use lumis_files::{read_text_bounded, FileKind, MIB};
 use lumis_image::{read_exr, Image};
 
 use crate::metadata::ImageMetadata;
@@ -301,6 +301,9 @@ pub fn converge(
                 quiet: true,
                 no_checkpoint: true,
                 pass_spp: Some(spp),
+                // `renders/` is this command's own: each render replaces
+                // the variant's last, whatever its samples.
+                force: true,
                 ..Default::default()
             };
             let context = |e: Error| Error::msg(format!("variant \"{}\": {e}", variant.name));

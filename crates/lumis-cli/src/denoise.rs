@@ -256,4 +256,44 @@ mod tests {
         let err = header_table("\"oidn\"", image).unwrap_err().to_string();
         assert!(err.contains("found a string"), "{err}");
     }
+
+    /// A denoiser that fails leaves the raw render where it is, and the
+    /// error says so; nothing is written for the denoised image.
+    #[test]
+    fn a_failed_denoise_names_the_raw_render_it_leaves() {
+        struct Failing;
+        impl Denoiser for Failing {
+            fn denoise(&self, _: &DenoiseInput<'_>) -> Result<Vec<[f32; 3]>> {
+                Err(Error::msg("no device"))
+            }
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let raw = dir.path().join("plates.exr");
+        let (exr, png) = denoised_paths(&raw);
+        let outputs = Outputs::claim(&exr, Some(&png)).unwrap();
+        let denoiser = ConfiguredDenoiser {
+            denoiser: Box::new(Failing),
+            toml: "{ type = \"failing\" }".into(),
+        };
+        let err = write_denoised(
+            &denoiser,
+            &Image::new(2, 2),
+            None,
+            None,
+            &outputs,
+            Vec::new(),
+            &raw,
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains(&format!(
+                "denoising failed; the raw render is in {}: no device",
+                raw.display()
+            )),
+            "{err}"
+        );
+        drop(outputs);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
 }

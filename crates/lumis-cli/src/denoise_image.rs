@@ -93,7 +93,7 @@ struct Input {
 /// render, an image already denoised).
 fn read_input(path: &Path) -> Result<Input> {
     let attributes = lumis_image::read_exr_metadata(path).map_err(|e| match e {
-        ImageError::Io { .. } => Error::msg(e.to_string()),
+        ImageError::Io { .. } | ImageError::Refused { .. } => Error::msg(e.to_string()),
         ImageError::Format { .. } => Error::msg(format!(
             "'{}' is not an EXR image ({e}): lumis denoise reads the EXR a render writes",
             path.display()
@@ -163,13 +163,38 @@ fn read_input(path: &Path) -> Result<Input> {
         }
         Ok(Some(image))
     };
-    Ok(Input {
+    let input = Input {
         albedo: layer(Aov::Albedo)?,
         normal: layer(Aov::Normal)?,
         color,
         attributes,
         metadata,
-    })
+    };
+    // Said first: no denoiser, guided or not, takes a non-finite pixel.
+    let layers = [
+        ("colour", Some(&input.color)),
+        ("albedo", input.albedo.as_ref()),
+        ("normal", input.normal.as_ref()),
+    ];
+    for (name, image) in layers {
+        let Some(image) = image else { continue };
+        if let Some(i) = image
+            .pixels
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            let [r, g, b] = image.pixels[i];
+            return Err(Error::msg(format!(
+                "'{}': its {name} holds a value that is not finite, [{r}, {g}, {b}] at pixel \
+                 ({}, {}); a denoiser needs finite values (`lumis render` leaves out NaN and \
+                 infinite samples: this image was made or changed elsewhere)",
+                path.display(),
+                i % image.width,
+                i / image.width
+            )));
+        }
+    }
+    Ok(input)
 }
 
 /// The denoiser `args` name (`--denoiser`, else the header's, else

@@ -9,9 +9,11 @@ use lumis_analysis::image_error::{
 };
 use lumis_analysis::plot::{self, Grid};
 use lumis_core::doc::{self, Node, Value};
-use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{Error, Result};
-use lumis_image::{read_exr, Image};
+use lumis_files::{read_text_bounded, FileKind, MIB};
+use lumis_image::{read_exr, Image, OutputLock};
+
+use crate::outputs::same_file;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct DiffArgs {
@@ -145,6 +147,23 @@ fn row(label: &str, m: &ErrorMetrics) -> String {
 
 /// Runs `lumis diff` and returns the printed report.
 pub fn diff(args: &DiffArgs) -> Result<String> {
+    // The error image is an output like a render's: locked against other
+    // writers, and never one of the inputs.
+    let _lock = match &args.error_image {
+        Some(path) => {
+            if [&args.image, &args.reference]
+                .iter()
+                .any(|input| same_file(input, path))
+            {
+                return Err(Error::msg(format!(
+                    "--error-image {} is one of the images compared; name another file",
+                    path.display()
+                )));
+            }
+            Some(OutputLock::acquire(path).map_err(|e| Error::msg(e.to_string()))?)
+        }
+        None => None,
+    };
     let (a, b) = (read(&args.image)?, read(&args.reference)?);
     check_same_size(&a, &b).map_err(|e| {
         Error::msg(format!(

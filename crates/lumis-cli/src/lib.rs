@@ -13,6 +13,7 @@ mod integrator_check;
 mod interrupt;
 mod lecture;
 mod listing;
+mod memory;
 mod merge;
 mod metadata;
 mod new_plugin;

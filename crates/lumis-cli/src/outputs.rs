@@ -10,6 +10,16 @@ use lumis_render::Aov;
 use crate::checkpoint::checkpoint_path;
 use crate::metadata::ImageMetadata;
 
+/// `NAME.partial.EXT` for `NAME.EXT`: where an unfinished render's image
+/// goes, so that it never replaces a finished one.
+pub fn partial_path(path: &Path) -> PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    match path.extension() {
+        Some(ext) => path.with_file_name(format!("{stem}.partial.{}", ext.to_string_lossy())),
+        None => path.with_file_name(format!("{stem}.partial")),
+    }
+}
+
 /// The EXR and PNG of one render, locked against other writers for as long
 /// as this value lives.
 pub struct Outputs {
@@ -47,10 +57,15 @@ impl Outputs {
                 )));
             }
         }
+        for path in [Some(exr), png].into_iter().flatten() {
+            lumis_files::check_replaceable(path).map_err(Error::msg)?;
+        }
         let lock = OutputLock::acquire(exr).map_err(image_error)?;
         let checkpoint = checkpoint_path(exr);
+        let partials = [Some(partial_path(exr)), png.map(partial_path)];
         for path in [Some(exr), png, Some(checkpoint.as_path())]
             .into_iter()
+            .chain(partials.iter().map(Option::as_deref))
             .flatten()
         {
             lumis_image::remove_stale_temporaries(path);
@@ -77,6 +92,45 @@ impl Outputs {
         self.write_with_channels(image, aovs, &[], &metadata.attributes())
     }
 
+    /// The image of an unfinished render, beside the outputs
+    /// ([`partial_path`]): a finished image there stays until the render
+    /// that replaces it finishes.
+    pub fn write_unfinished(
+        &self,
+        image: &Image,
+        aovs: &[(Aov, Image)],
+        metadata: &ImageMetadata,
+    ) -> Result<()> {
+        let png = self.png.as_deref().map(partial_path);
+        write_pair(
+            &partial_path(&self.exr),
+            png.as_deref(),
+            image,
+            aovs,
+            &[],
+            &metadata.attributes(),
+        )
+    }
+
+    /// Removes the unfinished render's image, once the finished one is
+    /// written.
+    pub fn remove_unfinished(&self) -> Result<()> {
+        let png = self.png.as_deref().map(partial_path);
+        for path in [Some(partial_path(&self.exr)), png].into_iter().flatten() {
+            match std::fs::remove_file(&path) {
+                Ok(()) => {}
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+                Err(e) => {
+                    return Err(Error::msg(format!(
+                        "{}: cannot remove the unfinished image: {e}",
+                        path.display()
+                    )))
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// [`Outputs::write`] with whole-number channels in the EXR too and
     /// the header `attributes` as given (a partial image's).
     pub fn write_with_channels(
@@ -86,24 +140,44 @@ impl Outputs {
         uints: &[ExrUintChannel],
         attributes: &[(String, String)],
     ) -> Result<()> {
-        let png = match &self.png {
-            Some(path) => Some(lumis_image::stage_png(path, image).map_err(image_error)?),
-            None => None,
-        };
-        let layers: Vec<ExrLayer> = aovs
-            .iter()
-            .map(|(aov, image)| ExrLayer {
-                name: aov.name(),
-                channels: aov.channels(),
-                image,
-            })
-            .collect();
-        let exr =
-            lumis_image::stage_exr_with_channels(&self.exr, image, &layers, uints, attributes)
-                .map_err(image_error)?;
-        if let Some(png) = png {
-            png.commit().map_err(image_error)?;
-        }
-        exr.commit().map_err(image_error)
+        write_pair(
+            &self.exr,
+            self.png.as_deref(),
+            image,
+            aovs,
+            uints,
+            attributes,
+        )
     }
+}
+
+/// Writes `exr` (with `aovs` as layers, `uints` as channels and
+/// `attributes` in its header) and `png`: both staged in full, then the
+/// PNG renamed into place and the EXR last.
+fn write_pair(
+    exr: &Path,
+    png: Option<&Path>,
+    image: &Image,
+    aovs: &[(Aov, Image)],
+    uints: &[ExrUintChannel],
+    attributes: &[(String, String)],
+) -> Result<()> {
+    let png = match png {
+        Some(path) => Some(lumis_image::stage_png(path, image).map_err(image_error)?),
+        None => None,
+    };
+    let layers: Vec<ExrLayer> = aovs
+        .iter()
+        .map(|(aov, image)| ExrLayer {
+            name: aov.name(),
+            channels: aov.channels(),
+            image,
+        })
+        .collect();
+    let exr = lumis_image::stage_exr_with_channels(exr, image, &layers, uints, attributes)
+        .map_err(image_error)?;
+    if let Some(png) = png {
+        png.commit().map_err(image_error)?;
+    }
+    exr.commit().map_err(image_error)
 }

@@ -17,8 +17,9 @@ use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
 use crate::denoise::{claim_denoised_outputs, denoise_film, ConfiguredDenoiser};
+use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
-use crate::outputs::Outputs;
+use crate::outputs::{partial_path, Outputs};
 use crate::partial::Partial;
 use crate::slice::SampleSlice;
 
@@ -30,8 +31,9 @@ pub struct RenderArgs {
     /// Samples per pixel (overrides sampler.spp).
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Random seed (overrides the scene's top-level seed).
-    #[arg(long)]
+    /// Random seed (overrides the scene's top-level seed), at most
+    /// 2^63 - 1 as a scene's is.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(..=i64::MAX as u64))]
     pub seed: Option<u64>,
     /// Worker threads; 0 or absent means one per core.
     #[arg(long, default_value_t = 0)]
@@ -74,6 +76,14 @@ pub struct RenderArgs {
     /// seed); the image is the one an uninterrupted render makes.
     #[arg(long)]
     pub resume: bool,
+    /// The memory the render may use, scene included (8G, 512M) [default:
+    /// the film must fit in what the system has available].
+    #[arg(long, value_name = "SIZE", value_parser = crate::memory::parse_bytes)]
+    pub max_memory: Option<u64>,
+    /// Replace an image of this scene with more samples than this render
+    /// makes, instead of refusing.
+    #[arg(long)]
+    pub force: bool,
     /// Samples per pixel per pass [default: passes of about two seconds].
     /// The image does not depend on it.
     #[arg(long, value_name = "N")]
@@ -91,8 +101,15 @@ pub struct RenderArgs {
     /// slice `--part K/N` renders is summed on its own and added to the
     /// slices before it, so the image is, bit for bit, what `lumis merge`
     /// makes of the N parts (one plain run sums every sample in turn,
-    /// which rounds the sums differently in their last bits).
-    #[arg(long, value_name = "N", conflicts_with_all = ["part", "samples", "resume"])]
+    /// which rounds the sums differently in their last bits). It
+    /// checkpoints and resumes like any render; a part interrupted midway
+    /// is then summed in two pieces, equal to `merge`'s to rounding.
+    #[arg(
+        long,
+        value_name = "N",
+        value_parser = clap::value_parser!(u32).range(1..),
+        conflicts_with_all = ["part", "samples"]
+    )]
     pub parts: Option<u32>,
 }
 
@@ -115,6 +132,9 @@ pub struct RenderReport {
     pub spp: u32,
     /// Stopped by a signal: the image holds the passes finished before it.
     pub interrupted: bool,
+    /// `--resume` found the render finished: nothing was rendered, and the
+    /// image is the one on disk.
+    pub finished_before: bool,
     pub seconds: f64,
     pub stats: RenderStats,
     /// Time by stage, with `--stats`.
@@ -148,6 +168,13 @@ impl RenderReport {
     }
     /// The one-line summary printed at the end of a render.
     pub fn summary(&self) -> String {
+        if self.finished_before {
+            return format!(
+                "{} is finished ({} spp of this scene and seed): nothing to resume",
+                self.exr.display(),
+                self.spp
+            );
+        }
         let secs = self.seconds.max(1e-9);
         let interrupted = if self.interrupted {
             "interrupted, "
@@ -426,6 +453,17 @@ pub fn render_scene_file(
         return Err(Error::msg("spp must be at least 1"));
     }
     let slice = sample_slice(args, spp)?;
+    let memory = MemoryEstimate::of(
+        loaded.scene.load_report(),
+        loaded.camera.resolution(),
+        &loaded.aovs,
+        loaded.adaptive.is_some(),
+    );
+    let budget = MemoryBudget::of(args.max_memory);
+    if !args.quiet {
+        eprintln!("{}", memory.line(&budget));
+    }
+    memory.check(&budget)?;
     if (slice.is_some() || args.parts.is_some()) && loaded.adaptive.is_some() {
         return Err(Error::msg(
             "--part, --samples and --parts cannot split a render with [sampler] adaptive: \
@@ -474,6 +512,12 @@ pub fn render_scene_file(
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
     let checkpoint_file = checkpoint_path(&exr);
     let resolution = loaded.camera.resolution();
+    if slice.is_none() {
+        let this = (scene_hash, loaded.seed, spp);
+        if let Some(existing) = finished_or_kept(args, &exr, &checkpoint_file, this)? {
+            return finished_before(exr, png, &existing);
+        }
+    }
     let mut state = match slice {
         Some(slice) => Checkpoint {
             film: Film::try_with_aovs(resolution, &loaded.aovs)?.starting_at(slice.start),
@@ -529,9 +573,15 @@ pub fn render_scene_file(
         slice,
         denoiser: denoiser.as_ref().map(|d| d.toml.clone()),
     };
+    // An unfinished render's image goes beside the outputs, never over a
+    // finished image, which stays until this render finishes.
     let save = |state: &Checkpoint| -> Result<()> {
         state.write(&checkpoint_file)?;
-        write_film(&outputs, &state.film, &metadata(state))
+        outputs.write_unfinished(
+            &state.film.image(),
+            &state.film.aov_images(),
+            &metadata(state),
+        )
     };
     let profile = args.stats.then(Profile::start);
     let mut stats = RenderStats::default();
@@ -616,7 +666,7 @@ pub fn render_scene_file(
         eprintln!(
             "interrupted at {} of {spp} spp: {} holds the image so far; --resume continues it",
             state.film.samples,
-            exr.display()
+            partial_path(&exr).display()
         );
     } else {
         write_film(&outputs, &state.film, &metadata(&state))?;
@@ -632,6 +682,7 @@ pub fn render_scene_file(
                 )))
             }
         }
+        outputs.remove_unfinished()?;
         interrupted = false;
     }
     // Only a finished render is denoised, after its raw image is on disk.
@@ -655,10 +706,65 @@ pub fn render_scene_file(
         denoised,
         spp: state.film.samples - state.film.start,
         interrupted,
+        finished_before: false,
         seconds,
         stats,
         profile,
         defects: registry.faults().defects(),
+    })
+}
+
+/// What the image already at `exr` means for a render of `(scene hash,
+/// seed, spp)`: its metadata where `--resume` finds that render finished
+/// (no checkpoint beside it: nothing to do); an error where it holds more
+/// samples of the same scene and `--force` is not given. Any other file is
+/// replaced when the render finishes.
+fn finished_or_kept(
+    args: &RenderArgs,
+    exr: &Path,
+    checkpoint: &Path,
+    (scene_hash, seed, spp): (u64, u64, u32),
+) -> Result<Option<ImageMetadata>> {
+    let existing = ImageMetadata::read(exr).ok().flatten();
+    let Some(existing) = existing.filter(|m| m.scene_hash == scene_hash) else {
+        return Ok(None);
+    };
+    let finished = existing.command == "render"
+        && existing.slice.is_none()
+        && existing.seed == seed
+        && existing.spp == spp;
+    if args.resume && finished && !checkpoint.exists() {
+        return Ok(Some(existing));
+    }
+    if existing.spp > spp && !args.force {
+        return Err(Error::msg(format!(
+            "{}: refusing to replace it: it holds {} spp of this scene (`lumis {}`), more \
+             than the {spp} this render makes; --force replaces it",
+            exr.display(),
+            existing.spp,
+            existing.command
+        )));
+    }
+    Ok(None)
+}
+
+/// The report of a `--resume` that finds its render finished: the image on
+/// disk, nothing rendered.
+fn finished_before(exr: PathBuf, png: PathBuf, existing: &ImageMetadata) -> Result<RenderReport> {
+    let image = lumis_image::read_exr(&exr).map_err(|e| Error::msg(e.to_string()))?;
+    Ok(RenderReport {
+        image,
+        aovs: Vec::new(),
+        exr,
+        png,
+        denoised: None,
+        spp: existing.spp,
+        interrupted: false,
+        finished_before: true,
+        seconds: existing.seconds,
+        stats: RenderStats::default(),
+        profile: None,
+        defects: Vec::new(),
     })
 }
 

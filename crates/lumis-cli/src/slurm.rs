@@ -47,8 +47,9 @@ pub struct SlurmSubmitArgs {
     /// Samples per pixel of the whole render (overrides sampler.spp).
     #[arg(long)]
     pub spp: Option<u32>,
-    /// Random seed (overrides the scene's top-level seed).
-    #[arg(long)]
+    /// Random seed (overrides the scene's top-level seed), at most
+    /// 2^63 - 1 as a scene's is.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(..=i64::MAX as u64))]
     pub seed: Option<u64>,
     /// Override a scene value in every part, as `lumis render --set`.
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]

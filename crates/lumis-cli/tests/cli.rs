@@ -7,6 +7,35 @@ use std::process::Command;
 
 use common::*;
 
+/// `--parts` checkpoints and resumes like any render: it takes
+/// `--checkpoint` and `--resume` alike.
+#[test]
+fn parts_take_checkpoint_and_resume_alike() {
+    let tmp = scratch("parts-resume");
+    let out = path_in(tmp.path(), "plates.exr");
+    let mut args = small_render(&out, "4");
+    args.extend(["--parts", "2", "--checkpoint", "--resume"]);
+    let result = lumis(&args);
+    assert!(result.status.success(), "{result:?}");
+    assert_eq!(header(&tmp.path().join("plates.exr"), "spp"), "4");
+}
+
+/// A number the scene could not take is refused where it is parsed,
+/// naming the flag: a seed past 2^63 - 1 (a scene's integers are signed),
+/// zero parts.
+#[test]
+fn flags_out_of_range_are_refused_by_the_parser() {
+    for (flag, value) in [("--seed", "9223372036854775808"), ("--parts", "0")] {
+        let run = lumis(&["render", &scene("cornell-box.toml"), flag, value, "-q"]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert!(
+            stderr.contains(&format!("invalid value '{value}' for '{flag}")),
+            "{stderr}"
+        );
+    }
+}
+
 #[test]
 fn help_documents_every_flag() {
     let top = String::from_utf8(lumis(&["--help"]).stdout).unwrap();
@@ -25,6 +54,8 @@ fn help_documents_every_flag() {
         "--no-checkpoint",
         "--resume",
         "--pass-spp",
+        "--force",
+        "--max-memory",
     ] {
         assert!(help.contains(flag), "render --help lacks {flag}:\n{help}");
     }
@@ -216,13 +247,20 @@ fn scene_errors_exit_nonzero_with_the_location() {
             && stderr.contains("unknown key 'max_dpeth'"),
         "{stderr}"
     );
-    // A film beyond any memory is an error before rendering, not an abort
-    // (its byte count exceeds what an allocation may ask for, so the
-    // answer does not depend on the machine's memory or overcommit policy).
+    // A colour is said as a scene writes it, not as Rust prints it.
+    let stderr = render_error("bsdf.red.reflectance=[2, 0.5, 0]");
+    assert!(
+        stderr.contains("got [2, 0.5, 0]") && !stderr.contains("Rgb {"),
+        "{stderr}"
+    );
+    // A film beyond any memory is an error before rendering, not an abort:
+    // the memory estimate refuses it, or, where the system does not say
+    // what it has, the allocation (whose byte count exceeds what one may
+    // ask for, whatever the machine's memory or overcommit policy).
     let stderr = render_error("film.resolution=[4000000000, 4000000000]");
     assert!(
         stderr.starts_with("error: film resolution 4000000000x4000000000")
-            && stderr.contains("GB of memory"),
+            && stderr.contains(" GB"),
         "{stderr}"
     );
 }
@@ -559,6 +597,31 @@ fn diff_of_an_image_with_itself_draws_its_error_picture() {
         out.status.success() && picture.exists(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// The error picture is an output like a render's: a run holding its lock
+/// keeps `diff` from writing it, and an input is never overwritten.
+#[test]
+fn diff_locks_its_error_picture_and_never_writes_an_input() {
+    let tmp = scratch("diff-lock");
+    let (image, picture) = (tmp.path().join("x.exr"), tmp.path().join("e.png"));
+    write_exr(&image, 4, 2, &[0.5, 1.0, 0.0, 2.0, 0.25, 0.5, 1.0, 3.0]);
+    let x = image.to_str().unwrap();
+    let lock = lumis_image::OutputLock::acquire(&picture).unwrap();
+    let out = lumis(&["diff", x, x, "--error-image", picture.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("another lumis"),
+        "{stderr}"
+    );
+    assert!(!picture.exists());
+    drop(lock);
+    let out = lumis(&["diff", x, x, "--error-image", x]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("is one of the images compared"),
+        "{stderr}"
     );
 }
 

@@ -186,6 +186,20 @@ fn denoise_refuses_what_it_cannot_denoise_by_name() {
     let err = denoise_error(&[&file("plates.png")]);
     assert!(err.contains("plates.png' is not an EXR image"), "{err}");
 
+    // A NaN is said first, before the guides the image lacks.
+    let nan = file("nan.exr");
+    exr::prelude::write_rgb_file(&nan, 2, 2, |x, y| match (x, y) {
+        (1, 0) => (f32::NAN, 0.5, 0.5),
+        _ => (0.5f32, 0.5f32, 0.5f32),
+    })
+    .unwrap();
+    let err = denoise_error(&[&nan]);
+    assert!(
+        err.starts_with("error: '") && err.contains("nan.exr': its colour holds a value that is not finite, [NaN, 0.5, 0.5] at pixel (1, 0)")
+            && !err.contains("guides"),
+        "{err}"
+    );
+
     // An EXR with a luminance channel alone.
     let grey = file("grey.exr");
     let channel = exr::image::AnyChannel::new("Y", exr::image::FlatSamples::F32(vec![0.5; 4]));
@@ -255,6 +269,7 @@ fn denoise_refuses_what_it_cannot_denoise_by_name() {
         [
             "foreign.exr",
             "grey.exr",
+            "nan.exr",
             "part.exr",
             "plates.denoised.exr",
             "plates.denoised.png",

@@ -6,8 +6,9 @@ mod common;
 use common::*;
 
 /// The first SIGINT, SIGTERM or SIGHUP abandons the pass in flight, writes the
-/// passes done with their true sample count and exits 130; the image is
-/// the one a render of that many samples makes, bit for bit.
+/// passes done with their true sample count (`NAME.partial.exr`) and exits
+/// 130; the image is the one a render of that many samples makes, bit for
+/// bit.
 #[test]
 fn an_interrupt_writes_the_passes_done_and_exits_130() {
     for sig in ["INT", "TERM", "HUP"] {
@@ -22,7 +23,8 @@ fn an_interrupt_writes_the_passes_done_and_exits_130() {
         let stderr = String::from_utf8(result.stderr).unwrap();
         assert_eq!(result.status.code(), Some(130), "SIG{sig}: {stderr}");
         assert!(stderr.contains("interrupted at"), "{stderr}");
-        let exr = tmp.path().join("plates.exr");
+        // Beside the output, which an unfinished render never replaces.
+        let exr = tmp.path().join("plates.partial.exr");
         let spp = header(&exr, "spp");
         let n: u32 = spp.parse().unwrap();
         assert!(n > 0 && n < 1_000_000 && n.is_multiple_of(2), "{n} spp");
@@ -34,8 +36,8 @@ fn an_interrupt_writes_the_passes_done_and_exits_130() {
             files_in(tmp.path()),
             [
                 "plates.checkpoint",
-                "plates.exr",
-                "plates.png",
+                "plates.partial.exr",
+                "plates.partial.png",
                 "whole.exr",
                 "whole.png"
             ]

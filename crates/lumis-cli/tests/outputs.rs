@@ -137,11 +137,11 @@ fn a_denoiser_writes_its_image_beside_the_raw_one() {
     assert_eq!(header(&tmp.path().join("plates.denoised.exr"), "spp"), "2");
 }
 
-/// A denoise that cannot be written (its PNG's path is a directory here)
-/// fails the command and says where the raw render is, which is written.
+/// An output that cannot be replaced (the denoised PNG's path is a
+/// directory here) is refused before anything is rendered or written.
 #[test]
-fn a_failed_denoise_keeps_the_raw_render() {
-    let tmp = scratch("denoise-fails");
+fn an_output_in_the_way_is_refused_before_rendering() {
+    let tmp = scratch("denoise-in-the-way");
     std::fs::create_dir_all(tmp.path().join("plates.denoised.png/in-the-way")).unwrap();
     let out = path_in(tmp.path(), "plates.exr");
     let mut args = small_render(&out, "1");
@@ -150,12 +150,8 @@ fn a_failed_denoise_keeps_the_raw_render() {
     assert!(!result.status.success(), "{result:?}");
     let stderr = String::from_utf8(result.stderr).unwrap();
     assert!(
-        stderr.contains("denoising failed; the raw render is in") && stderr.contains("plates.exr"),
+        stderr.contains("plates.denoised.png' is a directory; an output must be a file"),
         "{stderr}"
     );
-    assert_eq!(header(&tmp.path().join("plates.exr"), "spp"), "1");
-    assert_eq!(
-        files_in(tmp.path()),
-        ["plates.denoised.png", "plates.exr", "plates.png"]
-    );
+    assert_eq!(files_in(tmp.path()), ["plates.denoised.png"]);
 }

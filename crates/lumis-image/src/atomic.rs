@@ -1,5 +1,7 @@
 //! Write to a temporary file beside the target, then rename it into place:
 //! readers see the old file or the complete new one, never a partial one.
+//! Only a regular file (or nothing) is replaced: a rename over a device
+//! node, a FIFO or a socket would put the file where it was.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -46,8 +48,10 @@ impl StagedFile {
         &self.target
     }
 
-    /// Renames the staged file to its target.
+    /// Renames the staged file to its target, if the target is a regular
+    /// file or absent.
     pub fn commit(mut self) -> Result<(), ImageError> {
+        replaceable(&self.target)?;
         std::fs::rename(&self.temporary, &self.target).map_err(|source| ImageError::Io {
             path: self.target.clone(),
             source,
@@ -65,12 +69,22 @@ impl Drop for StagedFile {
     }
 }
 
+/// Refuses a target that exists and is not a regular file.
+fn replaceable(path: &Path) -> Result<(), ImageError> {
+    lumis_files::check_replaceable(path).map_err(|message| ImageError::Format {
+        path: path.to_path_buf(),
+        message,
+    })
+}
+
 /// Calls `write` on a temporary file in the target's directory, synced to
-/// disk; on any error the temporary file is removed.
+/// disk; on any error the temporary file is removed. A target that is not
+/// a regular file is refused before anything is written.
 pub fn stage<F>(path: &Path, write: F) -> Result<StagedFile, ImageError>
 where
     F: FnOnce(&mut BufWriter<File>) -> Result<(), String>,
 {
+    replaceable(path)?;
     let io_err = |source| ImageError::Io {
         path: path.to_path_buf(),
         source,
@@ -210,6 +224,27 @@ mod tests {
         }
         assert_eq!(remove_stale_temporaries(&target), 1);
         assert!(!stale.exists() && live.exists() && other.exists());
+    }
+
+    #[test]
+    fn special_files_are_never_replaced() {
+        for device in ["/dev/null", "/dev/full"] {
+            let target = Path::new(device);
+            let err = write_atomically(target, |w| w.write_all(b"x").map_err(|e| e.to_string()))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("not a regular file"), "{err}");
+            let metadata = std::fs::metadata(target).unwrap();
+            assert!(!metadata.is_file(), "{device} is still a device");
+        }
+        let tmp = scratch("fifo");
+        let fifo = tmp.path().join("out.png");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        if made.is_ok_and(|s| s.success()) {
+            let err = write_atomically(&fifo, |_| Ok(())).unwrap_err().to_string();
+            assert!(err.contains("not a regular file"), "{err}");
+            assert!(!std::fs::metadata(&fifo).unwrap().is_file());
+        }
     }
 
     #[test]

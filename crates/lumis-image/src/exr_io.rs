@@ -1,15 +1,17 @@
 //! OpenEXR files: linear float32 RGB, with optional named layers beside
 //! the colour (`albedo.R`, `depth.Z`).
 
+use std::fs::File;
+use std::io::{BufReader, Seek, SeekFrom};
 use std::path::Path;
 
 use exr::image::{AnyChannel, AnyChannels, FlatSamples};
+use exr::meta::attribute::{AttributeValue, Text};
+use exr::meta::MetaData;
 use exr::prelude::{ReadChannels, ReadLayers, WritableImage};
 
-use exr::meta::attribute::{AttributeValue, Text};
-
 use crate::atomic::{flush, stage, StagedFile};
-use crate::{Image, ImageError};
+use crate::{limits, open_image, Image, ImageError};
 
 /// Text attributes of an EXR header, `(name, value)`: what an image was
 /// made from, kept in the file itself so image and description cannot
@@ -169,10 +171,53 @@ fn unreadable_exr(path: &Path, e: exr::error::Error) -> ImageError {
     }
 }
 
+/// The EXR file `path`, opened where it is a regular file within an
+/// image's size bound, with its header.
+fn open_exr(path: &Path) -> Result<(BufReader<File>, MetaData), ImageError> {
+    let (file, _) = open_image(path)?;
+    let mut reader = BufReader::new(file);
+    let meta =
+        MetaData::read_from_buffered(&mut reader, false).map_err(|e| unreadable_exr(path, e))?;
+    reader
+        .seek(SeekFrom::Start(0))
+        .map_err(|source| ImageError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok((reader, meta))
+}
+
+/// [`open_exr`], for reading the pixels: refused where the header claims
+/// more than lumis decodes ([`crate::limits`]), before any is allocated.
+fn open_exr_pixels(path: &Path) -> Result<BufReader<File>, ImageError> {
+    let (reader, meta) = open_exr(path)?;
+    let refused = |message: String| ImageError::Refused {
+        path: path.to_path_buf(),
+        message,
+    };
+    let sizes: Vec<(u64, u64)> = meta
+        .headers
+        .iter()
+        .map(|h| (h.layer_size.width() as u64, h.layer_size.height() as u64))
+        .collect();
+    for &(width, height) in &sizes {
+        limits::check_claimed_size("EXR", width, height).map_err(refused)?;
+    }
+    let pixels = sizes
+        .iter()
+        .map(|&(w, h)| w * h)
+        .fold(0u64, u64::saturating_add);
+    limits::check_claimed_pixels(
+        &format!("its EXR header claims {} layers", sizes.len()),
+        pixels,
+    )
+    .map_err(refused)?;
+    Ok(reader)
+}
+
 /// The text attributes of an EXR file's header (not its pixels).
 pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
-    let meta =
-        exr::meta::MetaData::read_from_file(path, false).map_err(|e| unreadable_exr(path, e))?;
+    let (_, meta) = open_exr(path)?;
     let mut out = ExrMetadata::new();
     for header in &meta.headers {
         let attributes = header
@@ -193,8 +238,7 @@ pub fn read_exr_metadata(path: &Path) -> Result<ExrMetadata, ImageError> {
 /// Every channel of an EXR file's layers, by full name (`R`,
 /// `albedo.G`), row-major, converted to `f32`.
 pub fn read_exr_channels(path: &Path) -> Result<Vec<(String, Vec<f32>)>, ImageError> {
-    let image = exr::image::read::read_all_flat_layers_from_file(path)
-        .map_err(|e| unreadable_exr(path, e))?;
+    let image = read_flat_layers(path)?;
     let mut out = Vec::new();
     for layer in &image.layer_data {
         let prefix = layer
@@ -218,8 +262,7 @@ pub type ExrUintChannels = ((usize, usize), Vec<(String, Vec<u32>)>);
 
 /// Reads the [`ExrUintChannels`] of an EXR file.
 pub fn read_exr_uint_channels(path: &Path) -> Result<ExrUintChannels, ImageError> {
-    let image = exr::image::read::read_all_flat_layers_from_file(path)
-        .map_err(|e| unreadable_exr(path, e))?;
+    let image = read_flat_layers(path)?;
     let size = image.attributes.display_window.size;
     let mut out = Vec::new();
     for layer in &image.layer_data {
@@ -232,8 +275,21 @@ pub fn read_exr_uint_channels(path: &Path) -> Result<ExrUintChannels, ImageError
     Ok(((size.width(), size.height()), out))
 }
 
+/// Every layer and channel of an EXR file, at its largest resolution.
+fn read_flat_layers(path: &Path) -> Result<exr::image::FlatImage, ImageError> {
+    exr::image::read::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(open_exr_pixels(path)?)
+        .map_err(|e| unreadable_exr(path, e))
+}
+
 /// Reads the RGB channels of the first layer of an EXR file.
 pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
+    let reader = open_exr_pixels(path)?;
     let result = exr::image::read::read()
         .no_deep_data()
         .largest_resolution_level()
@@ -245,7 +301,7 @@ pub fn read_exr(path: &Path) -> Result<Image, ImageError> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_file(path);
+        .from_buffered(reader);
     match result {
         Ok(image) => Ok(image.layer_data.channel_data.pixels),
         Err(exr::error::Error::Io(source)) => Err(ImageError::Io {

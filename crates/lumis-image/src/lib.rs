@@ -6,6 +6,7 @@
 mod atomic;
 mod exr_io;
 mod hdr_io;
+pub mod limits;
 mod output_lock;
 mod png_io;
 mod process;
@@ -19,7 +20,7 @@ pub use exr_io::{
 pub use hdr_io::{is_hdr, read_hdr};
 pub use output_lock::{lock_path, OutputLock};
 pub use png_io::{linear_to_srgb8, stage_png, write_png, write_rgb8_png};
-pub use process::process_is_running;
+pub use process::{process_is_running, process_start};
 
 use std::path::PathBuf;
 
@@ -94,6 +95,29 @@ pub enum ImageError {
     },
     #[error("{path}: {message}")]
     Format { path: PathBuf, message: String },
+    /// A file lumis does not read: not a regular file, past its kind's
+    /// size bound, or an image claiming more pixels than lumis decodes
+    /// ([`limits`]).
+    #[error("{path}: {message}")]
+    Refused { path: PathBuf, message: String },
+}
+
+/// Opens the image file `path` for reading: a missing file is the
+/// system's error, a file lumis does not read (`lumis_files`) is
+/// [`ImageError::Refused`].
+pub(crate) fn open_image(path: &std::path::Path) -> Result<(std::fs::File, u64), ImageError> {
+    if let Err(source) = std::fs::metadata(path) {
+        return Err(ImageError::Io {
+            path: path.to_path_buf(),
+            source,
+        });
+    }
+    lumis_files::open_bounded(path, lumis_files::IMAGE_FILE).map_err(|message| {
+        ImageError::Refused {
+            path: path.to_path_buf(),
+            message,
+        }
+    })
 }
 
 #[cfg(test)]

@@ -13,15 +13,26 @@ pub fn process_is_running(pid: u32) -> bool {
     if !proc_root.join("self").exists() {
         return true;
     }
-    match std::fs::read_to_string(proc_root.join(pid.to_string()).join("stat")) {
-        // `PID (COMMAND) STATE ...`; the command may hold spaces and ')'.
-        Ok(stat) => !matches!(
-            stat.rsplit_once(')')
-                .map(|(_, rest)| rest.trim_start().chars().next()),
-            Some(Some('Z' | 'X'))
-        ),
-        Err(_) => false,
+    match stat_fields(pid) {
+        Some(fields) => !matches!(fields.first().map(String::as_str), Some("Z" | "X")),
+        None => false,
     }
+}
+
+/// When process `pid` started, in clock ticks since boot (`/proc`'s
+/// `starttime`): with its pid, what names one process, since a pid is
+/// reused once its process ends. `None` where it is not running or there
+/// is no `/proc`.
+pub fn process_start(pid: u32) -> Option<u64> {
+    stat_fields(pid)?.get(19)?.parse().ok()
+}
+
+/// The fields of `/proc/PID/stat` after the command, from the state on.
+fn stat_fields(pid: u32) -> Option<Vec<String>> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // `PID (COMMAND) STATE ...`; the command may hold spaces and ')'.
+    let (_, rest) = stat.rsplit_once(')')?;
+    Some(rest.split_whitespace().map(str::to_owned).collect())
 }
 
 #[cfg(test)]
@@ -48,6 +59,10 @@ mod tests {
         child.wait().unwrap();
         if std::path::Path::new("/proc/self").exists() {
             assert!(!process_is_running(pid));
+            assert_eq!(process_start(pid), None);
+            let mine = process_start(std::process::id()).unwrap();
+            assert_eq!(process_start(std::process::id()), Some(mine));
+            assert_ne!(process_start(1), Some(mine));
         }
     }
 }

@@ -30,6 +30,11 @@ use lumis_core::plugin::{
 };
 use lumis_core::{Error, Registry, Result};
 
+/// A plugin library, as the files a user names are bounded
+/// (`lumis_files`).
+const PLUGIN_LIBRARY: lumis_files::FileKind =
+    lumis_files::FileKind::new("plugin library", 4 * lumis_files::GIB);
+
 /// The environment variable listing directories whose plugin libraries are
 /// loaded at start-up, separated by `:`.
 pub const PLUGIN_PATH_VAR: &str = "LUMIS_PLUGIN_PATH";
@@ -96,6 +101,8 @@ pub fn load_library(path: &Path, registry: &mut Registry) -> Result<()> {
     {
         return Ok(());
     }
+    // A FIFO would block `dlopen`, and a device is no library.
+    lumis_files::open_regular(&path, PLUGIN_LIBRARY).map_err(Error::msg)?;
     if cfg!(target_os = "linux") {
         elf::check(&path).map_err(|why| {
             Error::msg(format!("'{shown}' is not a loadable shared library: {why}"))
@@ -226,6 +233,23 @@ mod tests {
         std::fs::remove_file(&text).unwrap();
         assert!(
             err.message.contains("not a loadable shared library"),
+            "{err}"
+        );
+        let fifo = std::env::temp_dir().join(format!("lumis-fifo-{}.so", std::process::id()));
+        if std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            let err = load_library(&fifo, &mut r).unwrap_err();
+            std::fs::remove_file(&fifo).unwrap();
+            assert!(err.message.contains("not a regular file"), "{err}");
+        }
+        assert!(
+            load_library(Path::new("/dev/null"), &mut r)
+                .unwrap_err()
+                .message
+                .contains("not a regular file"),
             "{err}"
         );
     }

@@ -73,7 +73,30 @@ fn try_buffer<T: Clone>(count: usize, value: T, too_large: impl Fn() -> Error) -
     Ok(buffer)
 }
 
+/// The bytes per pixel of a film's sums: the colour's, the squares' for
+/// the variance output, and the first hits' for the albedo, normal and
+/// depth outputs.
+fn sums_bytes_per_pixel(aovs: &[Aov]) -> usize {
+    let wants_squares = aovs.contains(&Aov::Variance);
+    let wants_first_hits = aovs.iter().any(|a| a.needs_first_hit());
+    std::mem::size_of::<[f64; 3]>() * (1 + wants_squares as usize)
+        + std::mem::size_of::<FirstHitSums>() * wants_first_hits as usize
+}
+
+/// The bytes per pixel of adaptive sampling's state: a count, a
+/// half-buffer and a flag.
+const ADAPTIVE_BYTES_PER_PIXEL: usize =
+    std::mem::size_of::<u32>() + std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<bool>();
+
 impl Film {
+    /// The bytes a film of `resolution` with `aovs` (and adaptive
+    /// sampling's state, if `adaptive`) holds: what [`Film::try_with_aovs`]
+    /// and [`Film::with_adaptive`] allocate, known before they do.
+    pub fn memory_bytes(resolution: UVec2, aovs: &[Aov], adaptive: bool) -> u64 {
+        let per_pixel = sums_bytes_per_pixel(aovs) + ADAPTIVE_BYTES_PER_PIXEL * adaptive as usize;
+        (u64::from(resolution.x) * u64::from(resolution.y)).saturating_mul(per_pixel as u64)
+    }
+
     /// An empty film, or an error saying how much memory it needed where
     /// that cannot be allocated.
     pub fn try_new(resolution: UVec2) -> Result<Self> {
@@ -85,8 +108,7 @@ impl Film {
         let (width, height) = (resolution.x as usize, resolution.y as usize);
         let wants_squares = aovs.contains(&Aov::Variance);
         let wants_first_hits = aovs.iter().any(|a| a.needs_first_hit());
-        let bytes_per_pixel = std::mem::size_of::<[f64; 3]>() * (1 + wants_squares as usize)
-            + std::mem::size_of::<FirstHitSums>() * wants_first_hits as usize;
+        let bytes_per_pixel = sums_bytes_per_pixel(aovs);
         let too_large = || {
             Error::msg(format!(
                 "film resolution {width}x{height}: a {width}x{height} image needs {:.1} GB of memory, which cannot be allocated",
@@ -419,6 +441,35 @@ mod tests {
         assert_eq!(film.image().pixels[1], [1.0, 2.0, 0.0]);
         let err = Film::try_new(UVec2::new(u32::MAX, u32::MAX)).unwrap_err();
         assert!(err.to_string().contains("GB of memory"), "{err}");
+    }
+
+    #[test]
+    fn the_memory_estimate_is_what_a_film_allocates() {
+        let resolution = UVec2::new(7, 3);
+        for aovs in [&[][..], &[Aov::Variance], &[Aov::Albedo, Aov::Spp]] {
+            for adaptive in [false, true] {
+                let mut film = Film::try_with_aovs(resolution, aovs).unwrap();
+                if adaptive {
+                    film = film
+                        .with_adaptive(AdaptiveSampling {
+                            min_spp: 4,
+                            max_spp: 16,
+                            threshold: 0.1,
+                        })
+                        .unwrap();
+                }
+                let held = film.sums.len() * 24
+                    + film.squares.as_ref().map_or(0, |s| s.len() * 24)
+                    + film
+                        .first_hits
+                        .as_ref()
+                        .map_or(0, |f| f.len() * std::mem::size_of::<FirstHitSums>())
+                    + film.adaptive.as_ref().map_or(0, |a| {
+                        a.counts.len() * 4 + a.odd_sums.len() * 24 + a.active.len()
+                    });
+                assert_eq!(Film::memory_bytes(resolution, aovs, adaptive), held as u64);
+            }
+        }
     }
 
     #[test]

@@ -5,10 +5,10 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use lumis_core::doc;
-use lumis_core::files::{read_text_bounded, FileKind, MIB};
 use lumis_core::{
     Denoiser, Error, Integrator, LightSampler, Location, PluginEntity, Registry, Result, Sampler,
 };
+use lumis_files::{read_text_bounded, FileKind, MIB};
 use lumis_render::{Aov, PerspectiveCamera};
 
 use crate::assembly::assemble;

@@ -9,8 +9,8 @@
 use std::io::{BufRead, Read};
 use std::path::Path;
 
-use lumis_core::files::{read_bounded, FileKind, GIB};
 use lumis_core::Vec3;
+use lumis_files::{read_bounded, FileKind, GIB};
 
 use crate::triangle_mesh::TriangleMesh;
 

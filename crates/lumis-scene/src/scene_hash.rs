@@ -18,8 +18,8 @@ use std::io::{BufRead, Read};
 use std::path::Path;
 
 use lumis_core::doc::{self, Node, Table, Value};
-use lumis_core::files::{open_bounded, read_text_bounded, FileKind, GIB};
 use lumis_core::{Error, Result};
+use lumis_files::{open_bounded, read_text_bounded, FileKind, GIB};
 
 use crate::load::SCENE_FILE;
 

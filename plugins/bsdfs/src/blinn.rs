@@ -99,7 +99,7 @@ impl Blinn {
             if !(reflectance.min_component() >= 0.0 && reflectance.max_component() <= 1.0) {
                 return Err(params.error(
                     BlinnParams::KEYS.reflectance,
-                    format!("each channel must be in [0, 1], got {reflectance:?}"),
+                    format!("each channel must be in [0, 1], got {reflectance}"),
                 ));
             }
         }

@@ -61,7 +61,7 @@ impl Diffuse {
             if !(r.min_component() >= 0.0 && r.max_component() <= 1.0) {
                 return Err(params.error(
                     DiffuseParams::KEYS.reflectance,
-                    format!("each channel must be in [0, 1] (energy conservation), got {r:?}"),
+                    format!("each channel must be in [0, 1] (energy conservation), got {r}"),
                 ));
             }
         }

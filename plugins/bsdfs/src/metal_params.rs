@@ -78,7 +78,7 @@ impl MetalParams {
                 if eta.min_component() <= 0.0 || k.min_component() < 0.0 {
                     return Err(params.error(
                         keys.eta,
-                        format!("eta must be > 0 and k >= 0 per channel, got eta {eta:?}, k {k:?}"),
+                        format!("eta must be > 0 and k >= 0 per channel, got eta {eta}, k {k}"),
                     ));
                 }
                 Ok(MetalFresnel::Fixed(ConductorFresnel::Complex { eta, k }))
@@ -96,7 +96,7 @@ impl MetalParams {
         if !(scale.min_component() >= 0.0 && scale.max_component() <= 1.0) {
             return Err(params.error(
                 Self::KEYS.specular_reflectance,
-                format!("each channel must be in [0, 1], got {scale:?}"),
+                format!("each channel must be in [0, 1], got {scale}"),
             ));
         }
         Ok(scale)

@@ -96,7 +96,7 @@ impl NormalMap {
             if !(c.min_component() >= 0.0 && c.max_component() <= 1.0) {
                 return Err(params.error(
                     NormalMapParams::KEYS.normals,
-                    format!("each channel must be in [0, 1], got {c:?}"),
+                    format!("each channel must be in [0, 1], got {c}"),
                 ));
             }
         }

@@ -132,7 +132,7 @@ impl Plastic {
         ] {
             let Some(v) = v else { continue };
             if !(v.min_component() >= 0.0 && v.max_component() <= 1.0) {
-                return Err(params.error(key, format!("each channel must be in [0, 1], got {v:?}")));
+                return Err(params.error(key, format!("each channel must be in [0, 1], got {v}")));
             }
         }
         Ok(Self::new(

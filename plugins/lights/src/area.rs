@@ -56,7 +56,7 @@ impl Emission {
         if !(radiance.min_component() >= 0.0 && radiance.is_finite()) {
             return Err(params.error(
                 EmissionParams::KEYS.radiance,
-                format!("must be finite and non-negative, got {radiance:?}"),
+                format!("must be finite and non-negative, got {radiance}"),
             ));
         }
         Ok(Self {

@@ -28,8 +28,8 @@
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
-use lumis_api::files::{read_bounded, FileKind};
 use lumis_api::{Error, Result, Rgb, Vec3};
+use lumis_files::{read_bounded, FileKind};
 use lumis_sampling::halfdiff::HalfDiff;
 
 pub const THETA_H_RES: usize = 90;

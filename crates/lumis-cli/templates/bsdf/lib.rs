@@ -62,7 +62,7 @@ impl Lambertian {
         if !(r.min_component() >= 0.0 && r.max_component() <= 1.0) {
             return Err(params.error(
                 LambertianParams::KEYS.reflectance,
-                format!("each channel must be in [0, 1] to conserve energy, got {r:?}"),
+                format!("each channel must be in [0, 1] to conserve energy, got {r}"),
             ));
         }
         Ok(Self::new(r))

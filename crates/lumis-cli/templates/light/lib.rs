@@ -83,7 +83,7 @@ impl QuadEmitter {
         if !(p.radiance.min_component() >= 0.0 && p.radiance.is_finite()) {
             return Err(params.error(
                 QuadEmitterParams::KEYS.radiance,
-                format!("must be finite and non-negative, got {:?}", p.radiance),
+                format!("must be finite and non-negative, got {}", p.radiance),
             ));
         }
         match *shape {

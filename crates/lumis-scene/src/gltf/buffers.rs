@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use base64::Engine;
 use gltf::buffer::Source;
-use lumis_core::files::{read_bounded, read_prefix, FileKind, GIB};
+use lumis_files::{read_bounded, read_prefix, FileKind, GIB};
 
 /// A `.gltf` (JSON, perhaps with data URIs) or `.glb` file: GLB's length
 /// field is 32 bits, and no JSON asset lumis can hold in memory is larger.

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use lumis_core::files::IMAGE_FILE;
 use lumis_core::{Error, PluginEntity, Result, Rgb, Textures, UvTransform};
+use lumis_files::IMAGE_FILE;
 use lumis_textures::image::{
     self as image_texture, Encoding, ImageFilter, ImageTexture, StoredValues, Wrap,
 };

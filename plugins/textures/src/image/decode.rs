@@ -4,8 +4,9 @@
 
 use std::path::Path;
 
-use lumis_api::files::{read_bounded, IMAGE_FILE};
 use lumis_api::Rgb;
+use lumis_files::{read_bounded, IMAGE_FILE};
+use lumis_image::limits::{check_claimed_size, check_expansion, DEFLATE_MAX_RATIO};
 
 /// An image as stored: its texel values before any decoding of their
 /// encoding.
@@ -75,6 +76,15 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| format!("bad PNG: {e}"))?;
+    // The header's claim, checked before the pixels are allocated: the
+    // pixel count, and the bytes they take against what deflate can
+    // expand the file to.
+    let info = reader.info();
+    let (width, height) = (u64::from(info.width), u64::from(info.height));
+    check_claimed_size("PNG", width, height)?;
+    let bits_per_pixel = info.color_type.samples() as u64 * info.bit_depth as u64;
+    let packed = width.saturating_mul(height).saturating_mul(bits_per_pixel) / 8;
+    check_expansion("PNG", packed, bytes.len() as u64, DEFLATE_MAX_RATIO)?;
     let size = reader
         .output_buffer_size()
         .ok_or("PNG too large to decode")?;
@@ -136,6 +146,9 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
 
 fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
     let mut decoder = jpeg_decoder::Decoder::new(std::io::Cursor::new(bytes));
+    decoder.read_info().map_err(|e| format!("bad JPEG: {e}"))?;
+    let claimed = decoder.info().ok_or("bad JPEG: no frame")?;
+    check_claimed_size("JPEG", claimed.width.into(), claimed.height.into())?;
     let pixels = decoder.decode().map_err(|e| format!("bad JPEG: {e}"))?;
     let info = decoder.info().ok_or("bad JPEG: no frame")?;
     let (width, height) = (info.width as usize, info.height as usize);

@@ -1,9 +1,12 @@
-//! Reading the files a scene names, with a size bound fit for their kind.
+//! The files a user names: read with a size bound fit for their kind, and
+//! replaced only where they are regular files.
 //!
 //! A user's file can be anything: a directory, a device such as
 //! `/dev/zero` that never ends, a FIFO that never opens, or a regular file
 //! far larger than any file of its kind. Each is refused with a message
-//! instead of being read until memory runs out.
+//! instead of being read until memory runs out, or, as an output, instead
+//! of being replaced by a rename (which would put an image where a device
+//! node was).
 
 use std::fs::File;
 use std::io::Read;
@@ -97,7 +100,7 @@ pub fn read_prefix(path: &Path, len: u64, kind: FileKind) -> Result<Vec<u8>, Str
 
 /// Opens `path` if it is a regular file. The type is checked before
 /// opening, since opening a FIFO blocks until a writer comes.
-fn open_regular(path: &Path, kind: FileKind) -> Result<File, String> {
+pub fn open_regular(path: &Path, kind: FileKind) -> Result<File, String> {
     let (shown, what) = (path.display(), kind.name);
     let metadata =
         std::fs::metadata(path).map_err(|e| format!("cannot read {what} '{shown}': {e}"))?;
@@ -110,6 +113,26 @@ fn open_regular(path: &Path, kind: FileKind) -> Result<File, String> {
         ));
     }
     File::open(path).map_err(|e| format!("cannot read {what} '{shown}': {e}"))
+}
+
+/// Refuses an output path that exists and is not a regular file (through
+/// symbolic links): an output is written beside its target and renamed
+/// over it, which would replace a device node, a FIFO or a socket with
+/// the file. An absent path, or one that cannot be inspected (the write
+/// then reports why), is left to the writer.
+pub fn check_replaceable(path: &Path) -> Result<(), String> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => Err(format!(
+            "'{}' is a directory; an output must be a file",
+            path.display()
+        )),
+        Ok(m) if !m.is_file() => Err(format!(
+            "'{}' is not a regular file (a device, FIFO or socket); lumis replaces only \
+             regular files with its outputs",
+            path.display()
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// [`read_bounded`] for a text file, with the first invalid UTF-8 byte's
@@ -170,6 +193,19 @@ mod tests {
         assert!(err.contains("not a regular file"), "{err}");
         let err = read_prefix(Path::new("/dev/zero"), 4, SMALL).unwrap_err();
         assert!(err.contains("not a regular file"), "{err}");
+    }
+
+    #[test]
+    fn only_regular_files_are_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("f.exr");
+        assert!(check_replaceable(&file).is_ok());
+        std::fs::write(&file, b"x").unwrap();
+        assert!(check_replaceable(&file).is_ok());
+        let err = check_replaceable(Path::new("/dev/null")).unwrap_err();
+        assert!(err.contains("'/dev/null' is not a regular file"), "{err}");
+        let err = check_replaceable(dir.path()).unwrap_err();
+        assert!(err.contains("is a directory"), "{err}");
     }
 
     #[test]
