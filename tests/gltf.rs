@@ -162,6 +162,81 @@ fn node_transforms_compose_with_the_toml_transform() {
     ));
 }
 
+/// A node transform that is not one is an error naming the node, as a
+/// TOML transform's is; a mesh scaled to nothing is said, not dropped
+/// silently.
+#[test]
+fn bad_node_transforms_are_named_never_dropped_silently() {
+    let tmp = test_dir("bad-transforms");
+    let dir = tmp.path();
+    let named = |node: Node| Node {
+        name: "panel".into(),
+        ..node
+    };
+    let refused = [
+        (
+            "rotation",
+            named(Node {
+                rotation: Some([1e30, 0.0, 0.0, 0.0]),
+                ..mesh_node(0)
+            }),
+            "is not finite",
+        ),
+        (
+            "projective",
+            named(Node {
+                matrix: Some([
+                    1.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+                ]),
+                ..mesh_node(0)
+            }),
+            "is not affine",
+        ),
+        (
+            "far",
+            named(Node {
+                translation: Some([3.4e38, 0.0, 0.0]),
+                scale: Some([1e20, 1.0, 1.0]),
+                ..mesh_node(0)
+            }),
+            "beyond the 1.844e18 at which Embree drops triangles",
+        ),
+    ];
+    for (name, node, says) in refused {
+        let file = gltf_writer::write(
+            dir,
+            name,
+            &one_mesh(triangle(), vec![node], vec![0]),
+            Container::External,
+        );
+        let err = try_load(dir, &gltf_shape(&file, ""))
+            .err()
+            .unwrap_or_else(|| panic!("{name} loaded"));
+        assert!(
+            err.contains("node #0 \"panel\"") && err.contains(says),
+            "{name}: {err}"
+        );
+    }
+    let hidden = named(Node {
+        scale: Some([0.0, 1.0, 1.0]),
+        ..mesh_node(0)
+    });
+    let file = gltf_writer::write(
+        dir,
+        "hidden",
+        &one_mesh(triangle(), vec![hidden], vec![0]),
+        Container::External,
+    );
+    let scene = load(dir, &gltf_shape(&file, ""));
+    let warnings = &scene.scene.load_report().warnings;
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("node #0 \"panel\" scales its mesh #0 \"tri\" to nothing")),
+        "{warnings:?}"
+    );
+}
+
 #[test]
 fn a_mesh_used_by_several_nodes_is_instanced_once() {
     let tmp = test_dir("instancing");

@@ -24,5 +24,11 @@ pub use device::{Device, EmbreeError};
 pub use packet::{PacketWidth, Packets, MAX_PACKET};
 pub use scene::{BuildQuality, Hit, Ray, Scene, SceneBuilder, SceneOptions};
 
+/// The largest vertex coordinate Embree builds with: a triangle with a
+/// coordinate of this magnitude or more is invalid and left out of the BVH
+/// without a word (`FLT_LARGE`, Embree's `common/math/constants.h`, used
+/// by its triangle validity test). Loaders refuse such vertices instead.
+pub const MAX_COORDINATE: f32 = 1.844e18;
+
 /// The geometry id Embree reports when nothing was hit.
 pub const INVALID_ID: u32 = embree4_sys::RTC_INVALID_GEOMETRY_ID;

@@ -89,8 +89,10 @@ pub(crate) fn import(request: &ImportRequest) -> Result<GltfImport> {
 
     let mut warnings: Vec<String> = unmodelled::unmodelled_features(&asset.document)
         .into_iter()
+        .chain(uses.warnings)
         .map(|w| format!("'{}': {w}", request.label))
         .collect();
+    let uses = uses.placements;
     let resolved = resolve::resolve_materials(request, &asset)?;
     warnings.extend(resolved.warnings);
     let materials = resolved.materials;
@@ -125,15 +127,22 @@ pub(crate) fn import(request: &ImportRequest) -> Result<GltfImport> {
     let mut instanced = Vec::new();
     for (parts, placements) in decoded.into_iter().zip(uses) {
         let Some(mut parts) = parts else { continue };
+        for placement in &placements {
+            check_placed_bounds(&parts, placement)
+                .map_err(|e| err(format!("'{}': {e}", request.label)))?;
+        }
         match placements.as_slice() {
             [] => unreachable!("only meshes some node uses are decoded"),
-            [world] => {
+            [placement] => {
                 for part in &mut parts {
-                    bake(part, world);
+                    bake(part, &placement.world);
                 }
                 world_parts.extend(parts);
             }
-            [_, _, ..] => instanced.push(InstancedMesh { parts, placements }),
+            [_, _, ..] => instanced.push(InstancedMesh {
+                parts,
+                placements: placements.iter().map(|p| p.world).collect(),
+            }),
         }
     }
     Ok(GltfImport {
@@ -145,6 +154,42 @@ pub(crate) fn import(request: &ImportRequest) -> Result<GltfImport> {
         parse_time,
         attributes_time: start.elapsed(),
     })
+}
+
+/// Refuses a placement that carries the mesh's vertices to where Embree
+/// would drop them silently (a scale of 1e20, a translation of 3.4e38):
+/// the corners of the parts' bounds, placed, must lie within
+/// [`lumis_embree::MAX_COORDINATE`].
+fn check_placed_bounds(parts: &[Part], placement: &scene_graph::Placement) -> Result<(), String> {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for p in parts.iter().flat_map(|part| &part.positions) {
+        lo = lo.min(Vec3::from(*p));
+        hi = hi.max(Vec3::from(*p));
+    }
+    if lo.x > hi.x {
+        return Ok(());
+    }
+    let corners = (0..8).map(|i| {
+        Vec3::new(
+            if i & 1 == 0 { lo.x } else { hi.x },
+            if i & 2 == 0 { lo.y } else { hi.y },
+            if i & 4 == 0 { lo.z } else { hi.z },
+        )
+    });
+    for corner in corners {
+        let placed = placement.world.transform_point3(corner);
+        let within =
+            placed.is_finite() && placed.abs().max_element() < lumis_embree::MAX_COORDINATE;
+        if !within {
+            return Err(format!(
+                "{} places its mesh's vertices out of range: its world transform maps \
+                 {corner} to {placed}, beyond the {:e} at which Embree drops triangles",
+                placement.node,
+                lumis_embree::MAX_COORDINATE
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Transforms a part into world space. A mirroring transform (negative
