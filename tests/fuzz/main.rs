@@ -1,6 +1,8 @@
 //! Mutation fuzzing of every parser that reads a user's file: TOML scenes,
-//! OBJ meshes, glTF/GLB assets (JSON and binary), their PNG and JPEG
-//! textures, and MERL tables.
+//! OBJ meshes, glTF/GLB assets (JSON and binary) and their node
+//! transforms, their PNG and JPEG textures (bytes, and headers claiming
+//! other sizes), and MERL tables; and every file key given a special file
+//! (a FIFO, a device, a directory) in place of one.
 //!
 //! Each target mutates files of its seed corpus (the repository's own
 //! scenes and assets, plus `tests/fuzz/corpus/`) with a seeded stream and
@@ -291,11 +293,17 @@ fn gltf_texture_images() {
             bytes: jpeg,
         },
     ];
+    // A third of the mutants claim another size in their header, up to
+    // billions of pixels: a decoder that allocated the claim would abort
+    // this process, which fails the test as surely as a panic.
     fuzz(
         "image",
         &seeds,
         iterations(300),
-        |rng, seed| mutate::binary(rng, &seed.bytes),
+        |rng, seed| match rng.below(3) {
+            0 => mutate::image_claim(rng, &seed.bytes),
+            _ => mutate::binary(rng, &seed.bytes),
+        },
         |dir, seed, mutant| {
             let mime = if seed.name.ends_with(".png") {
                 "image/png"
@@ -311,6 +319,133 @@ fn gltf_texture_images() {
             located(load_scene(&scene, dir), "mutant.gltf")
         },
     );
+}
+
+/// glTF node transforms that are not finite, not affine, singular or out
+/// of Embree's range. The property is stronger than the other targets':
+/// a mutant that loads has every triangle of its seed, unless the load
+/// report says which node scaled its mesh to nothing.
+#[test]
+fn gltf_node_transforms() {
+    let seeds = [
+        seed(scenes_dir().join("gltf/boxes.gltf")),
+        seed(corpus_dir().join("sparse-ortho.gltf")),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let triangles_of = |seed: &Seed| {
+        std::fs::write(dir.path().join("seed.gltf"), &seed.bytes).unwrap();
+        let scene = scene_with_shape("gltf", "seed.gltf", PERSPECTIVE);
+        load_scene(&scene, dir.path())
+            .unwrap()
+            .scene
+            .counts()
+            .triangles
+    };
+    let triangles: Vec<(String, usize)> = seeds
+        .iter()
+        .map(|s| (s.name.clone(), triangles_of(s)))
+        .collect();
+    fuzz(
+        "transform",
+        &seeds,
+        iterations(400) / 4,
+        |rng, seed| {
+            let doc: Value = serde_json::from_slice(&seed.bytes).unwrap();
+            serde_json::to_vec(&mutate::node_transform(rng, &doc)).unwrap()
+        },
+        |dir, seed, mutant| {
+            std::fs::write(dir.join("mutant.gltf"), mutant).unwrap();
+            let scene = scene_with_shape("gltf", "mutant.gltf", PERSPECTIVE);
+            let loaded = match load_scene(&scene, dir) {
+                Ok(loaded) => loaded,
+                Err(e) => return located(Err(e), "mutant.gltf"),
+            };
+            let expected = triangles.iter().find(|(n, _)| *n == seed.name).unwrap().1;
+            let placed = loaded.scene.counts().triangles;
+            let said = loaded
+                .scene
+                .load_report()
+                .warnings
+                .iter()
+                .any(|w| w.contains("is not placed"));
+            if placed < expected && !said {
+                return Err(format!(
+                    "{} of {expected} triangles placed, and no warning says why",
+                    placed
+                ));
+            }
+            let camera = "[camera]\ntype = \"gltf\"\nfile = \"mutant.gltf\"";
+            located(
+                load_scene(&scene_with_shape("gltf", "mutant.gltf", camera), dir),
+                "mutant.gltf",
+            )
+        },
+    );
+}
+
+/// Every key that names a file, given a FIFO, a device or a directory:
+/// an error naming it, within a deadline (opening a FIFO would block).
+#[test]
+fn special_files_in_place_of_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo");
+    let have_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    if !have_fifo {
+        eprintln!("skipped the FIFO cases: mkfifo is missing");
+    }
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero")).unwrap();
+    std::fs::create_dir(dir.path().join("folder")).unwrap();
+    let specials = ["fifo", "zero", "folder"]
+        .into_iter()
+        .filter(|s| have_fifo || *s != "fifo");
+    let light = scenes_dir()
+        .join("cornell-box/light.obj")
+        .display()
+        .to_string();
+    let scenes = |file: &str| -> Vec<String> {
+        let lit = scene_with_shape("obj", &light, PERSPECTIVE);
+        let textured = format!(
+            "[[texture]]\nname = \"t\"\ntype = \"image\"\nfilename = \"{file}\"\n\
+             [[bsdf]]\nname = \"b\"\ntype = \"diffuse\"\nreflectance = {{ texture = \"t\" }}\n"
+        );
+        let envmap = format!("[[light]]\ntype = \"envmap\"\nfilename = \"{file}\"\n");
+        let measured = format!("[[bsdf]]\nname = \"m\"\ntype = \"measured\"\nfile = \"{file}\"\n");
+        vec![
+            scene_with_shape("obj", file, PERSPECTIVE),
+            scene_with_shape("gltf", file, PERSPECTIVE),
+            lit.clone() + &textured,
+            lit.clone() + &envmap,
+            lit + &measured,
+        ]
+    };
+    let mut failures = Vec::new();
+    for special in specials {
+        for scene in scenes(special) {
+            let at = dir.path().to_path_buf();
+            let (send, receive) = std::sync::mpsc::channel();
+            let text = scene.clone();
+            std::thread::spawn(move || {
+                let outcome = without_panic(|| load_scene(&text, &at).map(|_| ()));
+                let _ = send.send(outcome);
+            });
+            match receive.recv_timeout(std::time::Duration::from_secs(60)) {
+                Err(_) => failures.push(format!("{special}: blocked for a minute:\n{scene}")),
+                Ok(Err(panic)) => failures.push(format!("{special}: panicked: {panic}")),
+                Ok(Ok(Ok(()))) => failures.push(format!("{special}: loaded:\n{scene}")),
+                Ok(Ok(Err(e))) => {
+                    let e = e.to_string();
+                    let said = e.contains("not a regular file") || e.contains("is a directory");
+                    if !(said && e.contains(special)) {
+                        failures.push(format!("{special}: {e}"));
+                    }
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 /// A GLB with its JSON chunk mutated as JSON and the container's lengths

@@ -275,3 +275,98 @@ fn swap_lines(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
     }
     l.concat()
 }
+
+/// Sizes an image header may claim: small, at the pixel limit's edges,
+/// and the largest each format's fields hold.
+const CLAIMED_SIZES: &[u32] = &[1, 8, 16_384, 16_385, 65_535, 100_000, 1 << 30, u32::MAX];
+
+/// An image whose header claims another size, its pixels left as they
+/// are: a PNG's IHDR (with its CRC made right again, so the decoder reads
+/// the claim) or a JPEG's frame header.
+pub fn image_claim(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
+    let mut out = bytes.to_vec();
+    let (w, h) = (*rng.pick(CLAIMED_SIZES), *rng.pick(CLAIMED_SIZES));
+    if out.starts_with(b"\x89PNG\r\n\x1a\n") && out.len() >= 33 {
+        // Signature, IHDR length and type, then width and height.
+        out[16..20].copy_from_slice(&w.to_be_bytes());
+        out[20..24].copy_from_slice(&h.to_be_bytes());
+        let crc = crc32(&out[12..29]);
+        out[29..33].copy_from_slice(&crc.to_be_bytes());
+    } else if let Some(sof) = out
+        .windows(2)
+        .position(|m| m == [0xff, 0xc0] || m == [0xff, 0xc2])
+    {
+        // Marker, length, precision, then lines and samples per line.
+        if out.len() >= sof + 9 {
+            out[sof + 5..sof + 7].copy_from_slice(&(h.min(65_535) as u16).to_be_bytes());
+            out[sof + 7..sof + 9].copy_from_slice(&(w.min(65_535) as u16).to_be_bytes());
+        }
+    }
+    out
+}
+
+/// CRC-32 (ISO 3309, as PNG uses), bit by bit.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// Values a node transform may hold that do not make one, or make one
+/// that places its mesh nowhere or out of range.
+const EXTREME_TRANSFORMS: &[(&str, &str)] = &[
+    ("rotation", "[1e30, 0, 0, 0]"),
+    ("rotation", "[0, 0, 0, 0]"),
+    ("rotation", "[1e-30, 0, 0, 1e-30]"),
+    ("scale", "[0, 1, 1]"),
+    ("scale", "[1e20, 1e20, 1e20]"),
+    ("scale", "[1e-30, 1e-30, 1e-30]"),
+    ("scale", "[-1, 1, 1]"),
+    ("translation", "[3.4e38, 0, 0]"),
+    ("translation", "[1e19, 0, 0]"),
+    ("matrix", "[0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]"),
+    (
+        "matrix",
+        "[1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]",
+    ),
+    (
+        "matrix",
+        "[1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1e30, 0, 0, 0, 0, 1]",
+    ),
+];
+
+/// A glTF document with one node's transform replaced by an extreme one
+/// (a matrix replaces the node's TRS, and TRS its matrix, as glTF allows
+/// only one of the two).
+pub fn node_transform(rng: &mut Rng, doc: &Value) -> Value {
+    let mut doc = doc.clone();
+    let Some(nodes) = doc.get_mut("nodes").and_then(Value::as_array_mut) else {
+        return doc;
+    };
+    if nodes.is_empty() {
+        return doc;
+    }
+    let i = rng.below(nodes.len());
+    let (key, value) = *rng.pick(EXTREME_TRANSFORMS);
+    if let Some(node) = nodes[i].as_object_mut() {
+        let trs = ["translation", "rotation", "scale"];
+        if key == "matrix" {
+            trs.iter().for_each(|k| {
+                node.remove(*k);
+            });
+        } else {
+            node.remove("matrix");
+        }
+        node.insert(key.into(), serde_json::from_str(value).unwrap());
+    }
+    doc
+}
