@@ -100,6 +100,7 @@ fn check_texture(texture: &dyn Texture, how: &str) {
     assert_eq!(texture.eval(&query), TEXTURE_EVAL, "{how}");
     assert_eq!(texture.eval_float(&query), TEXTURE_FLOAT, "{how}");
     assert!(texture.uses_footprint(), "{how}");
+    assert_eq!(texture.memory_bytes(), TEXTURE_BYTES, "{how}");
 }
 
 fn check_light(light: &mut dyn Light, how: &str) {
@@ -121,6 +122,7 @@ fn check_light(light: &mut dyn Light, how: &str) {
     );
     assert_eq!(light.power(), LIGHT_POWER, "{how}");
     assert_eq!(light.bounds(), Some(light_bounds()), "{how}");
+    assert_eq!(light.memory_bytes(), LIGHT_BYTES, "{how}");
     light.preprocess(Vec3::ZERO, 2.5);
     assert_eq!(
         light.power(),

@@ -124,6 +124,13 @@ pub trait Light: Send + Sync {
         None
     }
 
+    /// Bytes the light holds (an environment map's image and sampling
+    /// tables), added to the memory a render reports and checks before it
+    /// starts; 0, the default, for a light of a few numbers.
+    fn memory_bytes(&self) -> usize {
+        0
+    }
+
     /// Lets infinite lights learn the scene's bounding sphere after loading.
     fn preprocess(&mut self, _scene_center: Vec3, _scene_radius: f32) {}
 }

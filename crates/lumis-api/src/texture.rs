@@ -83,6 +83,13 @@ pub trait Texture: Send + Sync {
     fn uses_footprint(&self) -> bool {
         false
     }
+
+    /// Bytes the texture holds (an image's texels and mip levels), added to
+    /// the memory a render reports and checks before it starts; 0 for a
+    /// procedural texture, the default.
+    fn memory_bytes(&self) -> usize {
+        0
+    }
 }
 
 /// Plugins of a scene by the name its tables give them: the `[[texture]]`s

@@ -7,6 +7,39 @@ use std::process::Command;
 
 use common::*;
 
+/// The start-up report counts what the scene's textures and environment
+/// map hold (each plugin's `memory_bytes`), at least the map's texels.
+#[test]
+fn the_start_up_report_counts_images() {
+    let sky = lumis_image::read_exr(Path::new(&scene("bench/sky.exr"))).unwrap();
+    let texel_bytes = (sky.width * sky.height * 12) as f64;
+    let tmp = scratch("memory-report");
+    let out = path_in(tmp.path(), "sky.exr");
+    let run = lumis(&[
+        "render",
+        &scene("bench/envmap-sky.toml"),
+        "--spp",
+        "1",
+        "--set",
+        "film.resolution=[8, 8]",
+        "-o",
+        &out,
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let megabytes: f64 = stderr
+        .split(" MB textures and environment maps")
+        .next()
+        .and_then(|before| before.rsplit("+ ").next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no texture memory in:\n{stderr}"));
+    assert!(
+        megabytes * 1e6 >= texel_bytes * 0.99,
+        "{megabytes} MB for {texel_bytes} bytes of texels"
+    );
+    assert!(stderr.contains("memory: "), "{stderr}");
+}
+
 /// `--parts` checkpoints and resumes like any render: it takes
 /// `--checkpoint` and `--resume` alike.
 #[test]

@@ -96,6 +96,15 @@ impl Distribution1D {
         self.mass.len()
     }
 
+    /// Bytes the distribution holds: its masses, cdf and guide table, and
+    /// its bin edges (which tables of distributions share: counted by each).
+    pub fn byte_size(&self) -> usize {
+        std::mem::size_of_val(&*self.edges)
+            + std::mem::size_of_val(self.mass.as_slice())
+            + std::mem::size_of_val(self.cdf.as_slice())
+            + self.guide.byte_size()
+    }
+
     pub fn is_empty(&self) -> bool {
         self.mass.is_empty()
     }

@@ -21,6 +21,15 @@ pub struct Distribution2D {
 }
 
 impl Distribution2D {
+    /// Bytes the distribution holds: every row's and the marginal.
+    pub fn byte_size(&self) -> usize {
+        self.conditional
+            .iter()
+            .map(Distribution1D::byte_size)
+            .sum::<usize>()
+            + self.marginal.byte_size()
+    }
+
     /// A distribution whose cell `(i, j)` (column `i`, row `j`) has
     /// probability proportional to `values[j * width + i]`. Negative or
     /// non-finite values count as zero. A row of zeros is never sampled;

@@ -21,6 +21,11 @@ pub struct GuideTable {
 }
 
 impl GuideTable {
+    /// Bytes the table holds.
+    pub fn byte_size(&self) -> usize {
+        std::mem::size_of_val(self.start.as_slice())
+    }
+
     /// The table of `cdf`, which must be non-decreasing (as a running
     /// sum is) with at least two entries.
     pub fn new(cdf: &[f32]) -> Self {

@@ -89,11 +89,7 @@ pub fn load_str(
         column: 1,
     };
     let description = SceneDescription::from_document(root, &file)?;
-    let report = LoadReport {
-        parse: parse_start.elapsed(),
-        ..LoadReport::default()
-    };
-
+    let parse = parse_start.elapsed();
     let extended = scene_registry(&description.plugin_libraries, registry)?;
     let registry = extended.as_ref().unwrap_or(registry);
     let plugins = instantiate(
@@ -105,6 +101,22 @@ pub fn load_str(
         &description.integrator,
         description.denoiser.as_ref(),
     )?;
+    // What the scene's own textures and lights hold (images, environment
+    // maps); a glTF asset's textures are added as it is imported.
+    let report = LoadReport {
+        parse,
+        texture_bytes: plugins
+            .textures
+            .values()
+            .map(|t| t.memory_bytes())
+            .sum::<usize>()
+            + plugins
+                .lights
+                .iter()
+                .map(|l| l.memory_bytes())
+                .sum::<usize>(),
+        ..LoadReport::default()
+    };
 
     let assembled = assemble(
         registry,

@@ -20,7 +20,8 @@ pub struct LoadReport {
     pub geometry_bytes: usize,
     /// Bytes Embree allocated for its BVHs (its device memory monitor).
     pub bvh_bytes: usize,
-    /// Bytes of decoded textures.
+    /// Bytes of decoded textures and environment maps (each plugin's
+    /// `memory_bytes`).
     pub texture_bytes: usize,
     /// Whether the BVHs were built compact (`RTC_SCENE_FLAG_COMPACT`)...
     pub compact: bool,
@@ -56,7 +57,7 @@ impl LoadReport {
         )];
         if self.texture_bytes > 0 {
             lines[0].push_str(&format!(
-                " + {:.1} MB textures",
+                " + {:.1} MB textures and environment maps",
                 self.texture_bytes as f64 * 1e-6
             ));
         }

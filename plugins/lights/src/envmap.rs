@@ -185,6 +185,14 @@ impl Light for EnvMapLight {
         LightKind::Infinite
     }
 
+    fn memory_bytes(&self) -> usize {
+        self.map.byte_size()
+            + self
+                .distribution
+                .as_ref()
+                .map_or(0, Distribution2D::byte_size)
+    }
+
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         let (wi, pdf, l) = match &self.distribution {
             None => {

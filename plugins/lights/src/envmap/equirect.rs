@@ -46,6 +46,11 @@ impl Equirect {
         self.width
     }
 
+    /// Bytes its texels hold.
+    pub fn byte_size(&self) -> usize {
+        std::mem::size_of_val(self.texels.as_slice())
+    }
+
     pub fn height(&self) -> usize {
         self.height
     }

@@ -157,6 +157,10 @@ impl Texture for ImageTexture {
         matches!(self.filter, ImageFilter::Trilinear | ImageFilter::Ewa)
     }
 
+    fn memory_bytes(&self) -> usize {
+        self.byte_size()
+    }
+
     #[inline]
     fn eval(&self, query: &TextureQuery) -> Rgb {
         let query = self.transform.apply(query);
