@@ -290,7 +290,7 @@ pub fn image_claim(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
         // Signature, IHDR length and type, then width and height.
         out[16..20].copy_from_slice(&w.to_be_bytes());
         out[20..24].copy_from_slice(&h.to_be_bytes());
-        let crc = crc32(&out[12..29]);
+        let crc = crc32fast::hash(&out[12..29]);
         out[29..33].copy_from_slice(&crc.to_be_bytes());
     } else if let Some(sof) = out
         .windows(2)
@@ -303,22 +303,6 @@ pub fn image_claim(rng: &mut Rng, bytes: &[u8]) -> Vec<u8> {
         }
     }
     out
-}
-
-/// CRC-32 (ISO 3309, as PNG uses), bit by bit.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = if crc & 1 != 0 {
-                (crc >> 1) ^ 0xedb8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
 }
 
 /// Values a node transform may hold that do not make one, or make one
