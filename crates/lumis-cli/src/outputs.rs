@@ -32,6 +32,18 @@ fn image_error(e: lumis_image::ImageError) -> Error {
     Error::msg(e.to_string())
 }
 
+/// Removes `what` at `path`, if it is there.
+pub fn remove_if_present(path: &Path, what: &str) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(Error::msg(format!(
+            "{}: cannot remove {what}: {e}",
+            path.display()
+        ))),
+    }
+}
+
 /// Whether `a` and `b` name one existing file (through links and `..`):
 /// a command must not write over what it reads.
 pub fn same_file(a: &Path, b: &Path) -> bool {
@@ -117,16 +129,7 @@ impl Outputs {
     pub fn remove_unfinished(&self) -> Result<()> {
         let png = self.png.as_deref().map(partial_path);
         for path in [Some(partial_path(&self.exr)), png].into_iter().flatten() {
-            match std::fs::remove_file(&path) {
-                Ok(()) => {}
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-                Err(e) => {
-                    return Err(Error::msg(format!(
-                        "{}: cannot remove the unfinished image: {e}",
-                        path.display()
-                    )))
-                }
-            }
+            remove_if_present(&path, "the unfinished image")?;
         }
         Ok(())
     }

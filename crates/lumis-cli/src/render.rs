@@ -19,7 +19,7 @@ use crate::checkpoint::{checkpoint_path, Checkpoint};
 use crate::denoise::{claim_denoised_outputs, denoise_film, ConfiguredDenoiser};
 use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
-use crate::outputs::{partial_path, Outputs};
+use crate::outputs::{partial_path, remove_if_present, Outputs};
 use crate::partial::Partial;
 use crate::slice::SampleSlice;
 
@@ -672,16 +672,7 @@ pub fn render_scene_file(
         write_film(&outputs, &state.film, &metadata(&state))?;
         // Last: a kill before this line leaves a checkpoint that resumes
         // to the same, finished image.
-        match std::fs::remove_file(&checkpoint_file) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => {
-                return Err(Error::msg(format!(
-                    "{}: cannot remove the finished render's checkpoint: {e}",
-                    checkpoint_file.display()
-                )))
-            }
-        }
+        remove_if_present(&checkpoint_file, "the finished render's checkpoint")?;
         outputs.remove_unfinished()?;
         interrupted = false;
     }
