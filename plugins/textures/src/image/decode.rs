@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use lumis_api::Rgb;
-use lumis_files::{read_bounded, IMAGE_FILE};
+use lumis_files::{read_bounded, read_prefix, IMAGE_FILE};
 use lumis_image::limits::{check_claimed_size, check_expansion, DEFLATE_MAX_RATIO};
 
 /// An image as stored: its texel values before any decoding of their
@@ -50,11 +50,14 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 /// Reads `path`; the message says what failed, not which file (the caller
 /// names it).
 pub fn read(path: &Path) -> Result<Stored, String> {
-    let bytes = read_bounded(path, IMAGE_FILE).map_err(|e| format!("cannot read the file: {e}"))?;
-    if bytes.starts_with(EXR_MAGIC) {
+    let cannot = |e: String| format!("cannot read the file: {e}");
+    // An EXR is read by its own reader, header first: its bytes are not
+    // read here (they would be held twice while it decodes).
+    let magic = read_prefix(path, EXR_MAGIC.len() as u64, IMAGE_FILE).map_err(cannot)?;
+    if magic == EXR_MAGIC {
         return exr(path);
     }
-    decode(&bytes)
+    decode(&read_bounded(path, IMAGE_FILE).map_err(cannot)?)
 }
 
 /// Decodes PNG or JPEG bytes (an image embedded in an asset).
