@@ -9,8 +9,9 @@
 
 use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 
-/// The integrators that trace paths: the scalar one and the wavefront one.
-const PATH_TRACERS: [&str; 2] = ["path", "wavefront"];
+/// The integrators that trace paths: the scalar one, the wavefront and the
+/// packet one.
+const PATH_TRACERS: [&str; 3] = ["path", "wavefront", "packet"];
 
 /// 2 integrators x 3 strategies x 6 scenes x 3 channels, overall
 /// false-alarm rate 1e-3.

@@ -7,7 +7,10 @@
 //! error in the fault sink, never an abort.
 
 use contract_plugin::answers::*;
+use lumis_core::bsdf::{BsdfEvalLanes, BsdfSampleLanes};
 use lumis_core::doc::{Table, Value};
+use lumis_core::lanes::{LaneMask, Vec2Lanes, Vec3Lanes, LANES};
+use lumis_core::light::LightSampleLanes;
 use lumis_core::wrap::Wrapped;
 use lumis_core::{
     Bsdf, BsdfContext, BsdfScope, DenoiseInput, Denoiser, Integrator, Light, LightInput,
@@ -93,6 +96,19 @@ fn check_bsdf(bsdf: &dyn Bsdf, how: &str) {
     let mut evaluated = [(Rgb::BLACK, 0.0); 2];
     bsdf.eval_batch(&[ctx; 2], &[wo; 2], &[wi; 2], &mut evaluated);
     assert_eq!(evaluated, [BSDF_EVAL_BATCH; 2], "{how}");
+    // Lanes 1 and 6 asked; the others keep what they held.
+    let active = LaneMask::lane(1) | LaneMask::lane(6);
+    let (w, u2) = (Vec3Lanes::default(), Vec2Lanes::default());
+    let mut samples = BsdfSampleLanes::default();
+    samples.set(0, Some(BSDF_SAMPLE));
+    bsdf.sample_f_lanes(&[ctx; LANES], &w, &[0.5; LANES], &u2, active, &mut samples);
+    assert_eq!(samples.valid, active | LaneMask::lane(0), "{how}");
+    assert_eq!(samples.get(0), Some(BSDF_SAMPLE), "{how}");
+    assert_eq!(samples.get(6), Some(BSDF_SAMPLE_LANES), "{how}");
+    let mut evals = BsdfEvalLanes::default();
+    bsdf.eval_lanes(&[ctx; LANES], &w, &w, active, &mut evals);
+    assert_eq!(evals.valid, active, "{how}");
+    assert_eq!(evals.get(1), BSDF_EVAL_LANES, "{how}");
 }
 
 fn check_texture(texture: &dyn Texture, how: &str) {
@@ -114,6 +130,11 @@ fn check_light(light: &mut dyn Light, how: &str) {
     let mut sampled = [None; 2];
     light.sample_li_batch(&[ctx; 2], &[Vec2::ZERO; 2], &mut sampled);
     assert_eq!(sampled, [Some(LIGHT_SAMPLE_BATCH); 2], "{how}");
+    let mut lanes = LightSampleLanes::default();
+    let active = LaneMask::lane(2) | LaneMask::lane(7);
+    light.sample_li_lanes(&[ctx; LANES], &Vec2Lanes::default(), active, &mut lanes);
+    assert_eq!(lanes.valid, active, "{how}");
+    assert_eq!(lanes.get(7), Some(LIGHT_SAMPLE_LANES), "{how}");
     assert_eq!(light.pdf_li(&ctx, Vec3::Y), LIGHT_PDF, "{how}");
     assert_eq!(
         light.l(Vec3::ZERO, Vec3::Z, Vec2::ZERO, Vec3::Z),

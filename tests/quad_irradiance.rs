@@ -114,7 +114,7 @@ fn point_light_matches_inverse_square_law() {
     let d2 = px * px + py * py + pz * pz;
     // L = rho/pi * I cos(theta) / d^2 with cos(theta) = py / d.
     let expected = RHO / std::f64::consts::PI * intensity * (py / d2.sqrt()) / d2;
-    for integrator in ["path", "wavefront"] {
+    for integrator in ["path", "wavefront", "packet"] {
         let integrator = format!("integrator.type=\"{integrator}\"");
         check(
             &scene(&light),

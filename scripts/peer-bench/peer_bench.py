@@ -7,8 +7,9 @@ so that drift of the machine touches all rows alike), renders the scene at
 `--spp` with:
 
 - lumis, the scene's own sampler, and with `--set sampler.type=independent`,
-  each with the scalar `path` integrator and with `wavefront` (unless
-  `--no-wavefront`);
+  each with the scalar `path` integrator and with the integrators of
+  `--batched` (default `wavefront,packet`: the same estimator on many
+  paths at once);
 - Mitsuba 3 `llvm_ad_rgb` and `scalar_rgb`, each with the samplers
   independent, stratified, multijitter and ldsampler,
 
@@ -305,7 +306,8 @@ def main():
     ap.add_argument("--samplers", default=",".join(SAMPLERS), help="Mitsuba samplers (comma-separated)")
     ap.add_argument("--refs-only", action="store_true", help="render the missing references, then stop")
     ap.add_argument("--no-mitsuba", action="store_true", help="lumis rows only (references still need Mitsuba)")
-    ap.add_argument("--no-wavefront", action="store_true", help="no rows for lumis's wavefront integrator")
+    ap.add_argument("--batched", default="wavefront,packet",
+                    help="lumis integrators besides `path` to time (comma-separated; empty for none)")
     ap.add_argument("--lumis", default=os.path.join(REPO, "target", "release", "lumis"))
     ap.add_argument("--out", default=os.path.join(REPO, "target", "peer-bench"))
     args = ap.parse_args()
@@ -347,13 +349,13 @@ def main():
         ref_mean = float(ref.mean())
         w, h = ref.shape[1], ref.shape[0]
 
-        # lumis's two path tracers: the scalar `path` the scenes name, and
-        # `wavefront` (the same estimator a wave of paths at a time).
+        # lumis's path tracers: the scalar `path` the scenes name, and the
+        # same estimator on many paths at once (`wavefront`, `packet`).
         configs = [("lumis", "path", "scene", ()), ("lumis", "path", "independent", ("sampler.type=independent",))]
-        if not args.no_wavefront:
-            wavefront = ('integrator.type="wavefront"',)
-            configs += [("lumis", "wavefront", "scene", wavefront),
-                        ("lumis", "wavefront", "independent", wavefront + ("sampler.type=independent",))]
+        for integrator in filter(None, args.batched.split(",")):
+            chosen = (f'integrator.type="{integrator}"',)
+            configs += [("lumis", integrator, "scene", chosen),
+                        ("lumis", integrator, "independent", chosen + ("sampler.type=independent",))]
         loaded = {}
         if not why_not and not args.no_mitsuba:
             for v in variants:

@@ -24,8 +24,8 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering::Relaxed};
 
 use glam::{Vec2, Vec3};
 
-use crate::bsdf::{BsdfFlags, BsdfSample};
-use crate::light::{LightKind, LightSample};
+use crate::bsdf::{BsdfEvalLanes, BsdfFlags, BsdfSample, BsdfSampleLanes};
+use crate::light::{LightKind, LightSample, LightSampleLanes};
 use crate::light_bounds::LightBounds;
 use crate::light_sampler::SampledLight;
 use crate::sampler::PixelPattern;
@@ -59,6 +59,32 @@ nothing_to_count!(
 impl<T: ?Sized> Answer for &T {}
 impl<T: ?Sized> Answer for Box<T> {}
 impl<T, E> Answer for Result<T, E> {}
+
+/// The lanes a batched method filled.
+impl<T: Answer> Answer for [T] {
+    #[inline]
+    fn audit(&self, tally: &Tally) {
+        for answer in self {
+            answer.audit(tally)
+        }
+    }
+}
+
+/// The lanes of a packet that a lane method answered.
+macro_rules! lanes_answer {
+    ($($ty:ty),* $(,)?) => {
+        $(impl Answer for $ty {
+            #[inline]
+            fn audit(&self, tally: &Tally) {
+                for i in self.valid.iter() {
+                    self.get(i).audit(tally)
+                }
+            }
+        })*
+    };
+}
+
+lanes_answer!(BsdfSampleLanes, BsdfEvalLanes, LightSampleLanes);
 
 impl<T: Answer> Answer for Option<T> {
     #[inline]

@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 use lumis_derive::plugin_interface;
 
+use crate::lanes::{Floats, LaneMask, RgbLanes, Vec2Lanes, Vec3Lanes, LANES};
 use crate::spectrum::Rgb;
 use crate::texture::TextureQuery;
 
@@ -112,6 +113,68 @@ impl BsdfSample {
     }
 }
 
+/// What `Bsdf::sample_f_lanes` answers: lane `i` holds a sample where
+/// `valid` holds lane `i`, as `sample_f` answers `Some`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BsdfSampleLanes {
+    pub f: RgbLanes,
+    pub wi: Vec3Lanes,
+    pub pdf: Floats,
+    pub eta: Floats,
+    pub flags: [BsdfFlags; LANES],
+    pub valid: LaneMask,
+}
+
+impl BsdfSampleLanes {
+    /// Lane `i`'s sample.
+    #[inline]
+    pub fn get(&self, i: usize) -> Option<BsdfSample> {
+        self.valid.contains(i).then(|| BsdfSample {
+            f: self.f.get(i),
+            wi: self.wi.get(i),
+            pdf: self.pdf[i],
+            flags: self.flags[i],
+            eta: self.eta[i],
+        })
+    }
+
+    /// Sets lane `i` to `sample`.
+    #[inline]
+    pub fn set(&mut self, i: usize, sample: Option<BsdfSample>) {
+        self.valid.set(i, sample.is_some());
+        if let Some(s) = sample {
+            self.f.set(i, s.f);
+            self.wi.set(i, s.wi);
+            self.pdf[i] = s.pdf;
+            self.flags[i] = s.flags;
+            self.eta[i] = s.eta;
+        }
+    }
+}
+
+/// What `Bsdf::eval_lanes` answers: the value and the density of lane
+/// `i`'s direction pair, for the lanes in `valid` (every lane asked).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BsdfEvalLanes {
+    pub f: RgbLanes,
+    pub pdf: Floats,
+    pub valid: LaneMask,
+}
+
+impl BsdfEvalLanes {
+    #[inline]
+    pub fn get(&self, i: usize) -> (Rgb, f32) {
+        (self.f.get(i), self.pdf[i])
+    }
+
+    #[inline]
+    pub fn set(&mut self, i: usize, (f, pdf): (Rgb, f32)) {
+        self.valid.set(i, true);
+        self.f.set(i, f);
+        self.pdf[i] = pdf;
+    }
+}
+
 /// A BSDF in its local shading frame (`z` = shading normal).
 ///
 /// Directions point away from the surface. `f` excludes the cosine factor;
@@ -174,5 +237,154 @@ pub trait Bsdf: Send + Sync {
         for (i, out) in out.iter_mut().enumerate() {
             *out = self.eval(&ctx[i], wo[i], wi[i]);
         }
+    }
+
+    /// [`Bsdf::sample_f`] for the lanes of `active` of a packet: lane `i`
+    /// with `ctx[i]`, `wo` lane `i`, `u1[i]` and `u2` lane `i`, its sample
+    /// into lane `i` of `out` and its bit of `out.valid` (set where it has
+    /// one); the lanes outside `active` are left as they are, so that the
+    /// calls for the packet's other BSDFs fill the same `out`. A packet
+    /// integrator calls it with the lanes whose hit has this BSDF.
+    /// The default loops over `sample_f`; a plugin overrides it to compute
+    /// the lanes with SIMD, giving `sample_f`'s answer (`lumis
+    /// check-plugin` compares the two).
+    #[on_fault(*out = BsdfSampleLanes::default())]
+    fn sample_f_lanes(
+        &self,
+        ctx: &[BsdfContext; LANES],
+        wo: &Vec3Lanes,
+        u1: &Floats,
+        u2: &Vec2Lanes,
+        active: LaneMask,
+        out: &mut BsdfSampleLanes,
+    ) {
+        sample_f_each_lane(self, ctx, wo, u1, u2, active, out)
+    }
+
+    /// [`Bsdf::eval`] for the lanes of `active` of a packet, as
+    /// [`Bsdf::sample_f_lanes`] is `sample_f`: it sets the bits of
+    /// `active` in `out.valid`, and leaves the other lanes as they are.
+    #[on_fault(*out = BsdfEvalLanes::default())]
+    fn eval_lanes(
+        &self,
+        ctx: &[BsdfContext; LANES],
+        wo: &Vec3Lanes,
+        wi: &Vec3Lanes,
+        active: LaneMask,
+        out: &mut BsdfEvalLanes,
+    ) {
+        eval_each_lane(self, ctx, wo, wi, active, out)
+    }
+}
+
+/// [`Bsdf::sample_f_lanes`] lane by lane through `sample_f`: the trait's
+/// default, and an override's answer for the settings it has no SIMD
+/// code for.
+pub fn sample_f_each_lane<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext; LANES],
+    wo: &Vec3Lanes,
+    u1: &Floats,
+    u2: &Vec2Lanes,
+    active: LaneMask,
+    out: &mut BsdfSampleLanes,
+) {
+    for i in active.iter() {
+        out.set(i, bsdf.sample_f(&ctx[i], wo.get(i), u1[i], u2.get(i)));
+    }
+}
+
+/// [`Bsdf::eval_lanes`] lane by lane through `eval`, as
+/// [`sample_f_each_lane`].
+pub fn eval_each_lane<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext; LANES],
+    wo: &Vec3Lanes,
+    wi: &Vec3Lanes,
+    active: LaneMask,
+    out: &mut BsdfEvalLanes,
+) {
+    for i in active.iter() {
+        out.set(i, bsdf.eval(&ctx[i], wo.get(i), wi.get(i)));
+    }
+}
+
+/// Answers [`Bsdf::sample_f_lanes`] through `bsdf`'s
+/// [`Bsdf::sample_f_batch`], for a plugin whose SIMD code reads its lanes
+/// from slices: the lanes of `active` gathered in order, and each answer
+/// put back in its lane.
+pub fn sample_f_lanes_by_batch<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext; LANES],
+    wo: &Vec3Lanes,
+    u1: &Floats,
+    u2: &Vec2Lanes,
+    active: LaneMask,
+    out: &mut BsdfSampleLanes,
+) {
+    let n = active.count() as usize;
+    let mut args = ([BsdfContext::default(); LANES], [Vec3::ZERO; LANES]);
+    let mut u = ([0.0; LANES], [Vec2::ZERO; LANES]);
+    for (k, i) in active.iter().enumerate() {
+        (args.0[k], args.1[k], u.0[k], u.1[k]) = (ctx[i], wo.get(i), u1[i], u2.get(i));
+    }
+    let mut samples = [None; LANES];
+    bsdf.sample_f_batch(
+        &args.0[..n],
+        &args.1[..n],
+        &u.0[..n],
+        &u.1[..n],
+        &mut samples[..n],
+    );
+    for (k, i) in active.iter().enumerate() {
+        out.set(i, samples[k]);
+    }
+}
+
+/// Answers [`Bsdf::eval_lanes`] through `bsdf`'s [`Bsdf::eval_batch`], as
+/// [`sample_f_lanes_by_batch`] does.
+pub fn eval_lanes_by_batch<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext; LANES],
+    wo: &Vec3Lanes,
+    wi: &Vec3Lanes,
+    active: LaneMask,
+    out: &mut BsdfEvalLanes,
+) {
+    let n = active.count() as usize;
+    let mut args = (
+        [BsdfContext::default(); LANES],
+        [Vec3::ZERO; LANES],
+        [Vec3::ZERO; LANES],
+    );
+    for (k, i) in active.iter().enumerate() {
+        (args.0[k], args.1[k], args.2[k]) = (ctx[i], wo.get(i), wi.get(i));
+    }
+    let mut evals = [(Rgb::BLACK, 0.0); LANES];
+    bsdf.eval_batch(&args.0[..n], &args.1[..n], &args.2[..n], &mut evals[..n]);
+    for (k, i) in active.iter().enumerate() {
+        out.set(i, evals[k]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lane_holds_what_was_set() {
+        let s = BsdfSample {
+            f: Rgb::new(0.1, 0.2, 0.3),
+            wi: Vec3::new(0.0, 0.6, 0.8),
+            pdf: 0.5,
+            flags: BsdfFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        };
+        let mut lanes = BsdfSampleLanes::default();
+        lanes.set(3, Some(s));
+        assert_eq!(lanes.get(3), Some(s));
+        assert_eq!(lanes.get(2), None);
+        lanes.set(3, None);
+        assert_eq!(lanes.get(3), None);
     }
 }

@@ -221,10 +221,8 @@ impl CallHook for Guard {
     }
 
     #[inline]
-    fn seen<T: Answer>(&self, out: &[T]) {
-        for answer in out {
-            answer.audit(&self.tally);
-        }
+    fn seen<A: Answer + ?Sized>(&self, out: &A) {
+        out.audit(&self.tally);
     }
 
     fn child(&self) -> Self {

@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3};
 use lumis_derive::plugin_interface;
 
 use crate::interaction::LightSampleContext;
+use crate::lanes::{Floats, LaneMask, RgbLanes, Vec2Lanes, Vec3Lanes, LANES};
 use crate::light_bounds::LightBounds;
 use crate::ray::SurfacePoint;
 use crate::spectrum::Rgb;
@@ -81,6 +82,53 @@ impl<'a> LightInput<'a> {
     }
 }
 
+/// What `Light::sample_li_lanes` answers: lane `i` holds a sample where
+/// `valid` holds lane `i`, as `sample_li` answers `Some`. The sampled
+/// points stay whole: each spawns its lane's shadow ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSampleLanes {
+    pub l: RgbLanes,
+    pub wi: Vec3Lanes,
+    pub pdf: Floats,
+    pub p: [SurfacePoint; LANES],
+    pub valid: LaneMask,
+}
+
+impl Default for LightSampleLanes {
+    fn default() -> Self {
+        Self {
+            l: RgbLanes::default(),
+            wi: Vec3Lanes::default(),
+            pdf: [0.0; LANES],
+            p: [SurfacePoint::isolated(Vec3::ZERO); LANES],
+            valid: LaneMask::NONE,
+        }
+    }
+}
+
+impl LightSampleLanes {
+    #[inline]
+    pub fn get(&self, i: usize) -> Option<LightSample> {
+        self.valid.contains(i).then(|| LightSample {
+            l: self.l.get(i),
+            wi: self.wi.get(i),
+            pdf: self.pdf[i],
+            p: self.p[i],
+        })
+    }
+
+    #[inline]
+    pub fn set(&mut self, i: usize, sample: Option<LightSample>) {
+        self.valid.set(i, sample.is_some());
+        if let Some(s) = sample {
+            self.l.set(i, s.l);
+            self.wi.set(i, s.wi);
+            self.pdf[i] = s.pdf;
+            self.p[i] = s.p;
+        }
+    }
+}
+
 /// A light source. Each shape brings its own sampling and density.
 #[plugin_interface]
 pub trait Light: Send + Sync {
@@ -103,6 +151,23 @@ pub trait Light: Send + Sync {
         for (i, out) in out.iter_mut().enumerate() {
             *out = self.sample_li(&ctx[i], u[i]);
         }
+    }
+
+    /// [`Light::sample_li`] for the lanes of `active` of a packet: lane `i`
+    /// from `ctx[i]` with `u` lane `i`, its sample into lane `i` of `out`
+    /// and its bit of `out.valid` (set where it has one); the lanes outside
+    /// `active` are left as they are. The default loops over
+    /// `sample_li`; a plugin overrides it to compute the lanes with SIMD,
+    /// giving `sample_li`'s answer.
+    #[on_fault(*out = LightSampleLanes::default())]
+    fn sample_li_lanes(
+        &self,
+        ctx: &[LightSampleContext; LANES],
+        u: &Vec2Lanes,
+        active: LaneMask,
+        out: &mut LightSampleLanes,
+    ) {
+        sample_li_each_lane(self, ctx, u, active, out)
     }
 
     /// Density w.r.t. solid angle with which `sample_li` from `ctx` returns
@@ -133,4 +198,45 @@ pub trait Light: Send + Sync {
 
     /// Lets infinite lights learn the scene's bounding sphere after loading.
     fn preprocess(&mut self, _scene_center: Vec3, _scene_radius: f32) {}
+}
+
+/// [`Light::sample_li_lanes`] lane by lane through `sample_li`: the
+/// trait's default, and an override's answer for the settings it has no
+/// SIMD code for.
+pub fn sample_li_each_lane<L: Light + ?Sized>(
+    light: &L,
+    ctx: &[LightSampleContext; LANES],
+    u: &Vec2Lanes,
+    active: LaneMask,
+    out: &mut LightSampleLanes,
+) {
+    for i in active.iter() {
+        out.set(i, light.sample_li(&ctx[i], u.get(i)));
+    }
+}
+
+/// Answers [`Light::sample_li_lanes`] through `light`'s
+/// [`Light::sample_li_batch`], for a plugin whose SIMD code reads its
+/// lanes from slices: the lanes of `active` gathered in order, and each
+/// answer put back in its lane.
+pub fn sample_li_lanes_by_batch<L: Light + ?Sized>(
+    light: &L,
+    ctx: &[LightSampleContext; LANES],
+    u: &Vec2Lanes,
+    active: LaneMask,
+    out: &mut LightSampleLanes,
+) {
+    let n = active.count() as usize;
+    let mut args = (
+        [LightSampleContext::at(Vec3::ZERO); LANES],
+        [Vec2::ZERO; LANES],
+    );
+    for (k, i) in active.iter().enumerate() {
+        (args.0[k], args.1[k]) = (ctx[i], u.get(i));
+    }
+    let mut samples = [None; LANES];
+    light.sample_li_batch(&args.0[..n], &args.1[..n], &mut samples[..n]);
+    for (k, i) in active.iter().enumerate() {
+        out.set(i, samples[k]);
+    }
 }

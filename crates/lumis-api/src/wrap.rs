@@ -28,7 +28,7 @@ pub trait CallHook: Send + Sync + Sized + 'static {
     /// What a batched method wrote into its `out` lanes, after the call
     /// completed: each lane is an answer too.
     #[inline]
-    fn seen<T: Answer>(&self, _out: &[T]) {}
+    fn seen<A: Answer + ?Sized>(&self, _out: &A) {}
 
     /// The hook for a plugin object the wrapped one made (a sampler's
     /// clone, its lanes): wrapped the same way, with state of its own.

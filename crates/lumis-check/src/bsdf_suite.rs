@@ -6,7 +6,9 @@
 //! - chi-square goodness of fit of `sample_f` against `pdf`;
 //! - `pdf` integrates to at most 1 (and to the fraction of samples returned);
 //! - `sample_f` returns the `f` and `pdf` that `f()` and `pdf()` give, and
-//!   `eval()` returns both exactly;
+//!   `eval()` returns both exactly; the batched and lane methods answer
+//!   what the scalar ones do, lane by lane (the lane methods under a mask
+//!   too, the masked-out lanes untouched);
 //! - energy: the directional albedo is at most 1 (a white furnace per lobe),
 //!   measured in importance transport so that the `1/eta^2` radiance
 //!   scaling of refraction (a change of units, not of energy) is left out;
@@ -17,11 +19,13 @@ use std::fmt::Write;
 use std::path::Path;
 use std::sync::Arc;
 
+use lumis_core::bsdf::{BsdfEvalLanes, BsdfSampleLanes};
 use lumis_core::doc;
+use lumis_core::lanes::{LaneMask, Vec2Lanes, Vec3Lanes, LANES};
 use lumis_core::texture::Named;
 use lumis_core::{
-    Bsdf, BsdfContext, BsdfFlags, BsdfScope, Error, Location, ParamType, PluginEntity, PluginKind,
-    Registry, Result, Rgb, TransportMode, Vec2, Vec3,
+    Bsdf, BsdfContext, BsdfFlags, BsdfSample, BsdfScope, Error, Location, ParamType, PluginEntity,
+    PluginKind, Registry, Result, Rgb, TransportMode, Vec2, Vec3,
 };
 use lumis_sampling::{warp, Pcg32};
 use rayon::prelude::*;
@@ -350,9 +354,6 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
         .collect();
     let u1: Vec<f32> = lanes.u.iter().map(|u| u.0).collect();
     let u2: Vec<Vec2> = lanes.u.iter().map(|u| u.1).collect();
-    let close =
-        |a: f32, b: f32| a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
-    let close_rgb = |a: Rgb, b: Rgb| close(a.r, b.r) && close(a.g, b.g) && close(a.b, b.b);
     let mut problems = Vec::new();
     for len in [n, 1, 3] {
         let len = len.min(n);
@@ -368,18 +369,7 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
         bsdf.eval_batch(&ctx[..len], &wos[..len], &lanes.wi[..len], &mut evals);
         for i in 0..len {
             let scalar = bsdf.sample_f(&ctx[i], wos[i], u1[i], u2[i]);
-            let agree = match (&scalar, &samples[i]) {
-                (None, None) => true,
-                (Some(a), Some(b)) => {
-                    close_rgb(a.f, b.f)
-                        && close(a.pdf, b.pdf)
-                        && (a.wi - b.wi).abs().max_element() <= 1e-4
-                        && a.flags == b.flags
-                        && close(a.eta, b.eta)
-                }
-                _ => false,
-            };
-            if !agree {
+            if !samples_agree(&scalar, &samples[i]) {
                 problems.push(format!(
                     "sample_f_batch lane {i} of {len} gave {:?} but sample_f gave {scalar:?} (wo = {:?}, u1 = {}, u2 = {:?}, {:?})",
                     samples[i], wos[i], u1[i], u2[i], ctx[i].mode
@@ -387,7 +377,7 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
             }
             let (f, pdf) = bsdf.eval(&ctx[i], wos[i], lanes.wi[i]);
             let (bf, bpdf) = evals[i];
-            if !(close_rgb(f, bf) && close(pdf, bpdf)) {
+            if !evals_agree((f, pdf), evals[i]) {
                 problems.push(format!(
                     "eval_batch lane {i} of {len} gave ({bf:?}, {bpdf}) but eval gave ({f:?}, {pdf}) (wo = {:?}, wi = {:?}, {:?})",
                     wos[i], lanes.wi[i], ctx[i].mode
@@ -398,7 +388,114 @@ fn check_batches(bsdf: &dyn Bsdf, wo: Vec3, lanes: &BatchLanes) -> Vec<String> {
             }
         }
     }
+    problems.extend(check_lanes(bsdf, &ctx, &wos, &u1, &u2, &lanes.wi));
     problems
+}
+
+/// Equal up to rounding: a relative 1e-4.
+fn close(a: f32, b: f32) -> bool {
+    a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs())
+}
+
+fn close_rgb(a: Rgb, b: Rgb) -> bool {
+    close(a.r, b.r) && close(a.g, b.g) && close(a.b, b.b)
+}
+
+/// Two answers of `sample_f`'s: the same sample up to rounding, or none.
+fn samples_agree(a: &Option<BsdfSample>, b: &Option<BsdfSample>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            close_rgb(a.f, b.f)
+                && close(a.pdf, b.pdf)
+                && (a.wi - b.wi).abs().max_element() <= 1e-4
+                && a.flags == b.flags
+                && close(a.eta, b.eta)
+        }
+        _ => false,
+    }
+}
+
+fn evals_agree((f, pdf): (Rgb, f32), (g, qdf): (Rgb, f32)) -> bool {
+    close_rgb(f, g) && close(pdf, qdf)
+}
+
+/// `sample_f_lanes` and `eval_lanes` against `sample_f` and `eval`, a
+/// packet of [`LANES`] of the batch's lanes at a time: with every lane
+/// active, and with a mask that leaves some out, whose lanes (filled with
+/// a marker beforehand) must come back untouched.
+fn check_lanes(
+    bsdf: &dyn Bsdf,
+    ctx: &[BsdfContext],
+    wo: &[Vec3],
+    u1: &[f32],
+    u2: &[Vec2],
+    wi: &[Vec3],
+) -> Vec<String> {
+    let marker = BsdfSample {
+        f: Rgb::splat(-1.0),
+        wi: Vec3::splat(-1.0),
+        pdf: -1.0,
+        flags: BsdfFlags::SPECULAR,
+        eta: -1.0,
+    };
+    for start in (0..wo.len().saturating_sub(LANES - 1)).step_by(LANES) {
+        let mut packet = (
+            [BsdfContext::default(); LANES],
+            Vec3Lanes::default(),
+            [0.0; LANES],
+            Vec2Lanes::default(),
+            Vec3Lanes::default(),
+        );
+        for i in 0..LANES {
+            packet.0[i] = ctx[start + i];
+            packet.1.set(i, wo[start + i]);
+            packet.2[i] = u1[start + i];
+            packet.3.set(i, u2[start + i]);
+            packet.4.set(i, wi[start + i]);
+        }
+        for active in [LaneMask::ALL, LaneMask::from_bits(0b0110_1001)] {
+            let mut samples = BsdfSampleLanes::default();
+            let mut evals = BsdfEvalLanes::default();
+            for i in (!active).iter() {
+                samples.set(i, Some(marker));
+                evals.set(i, (marker.f, marker.pdf));
+            }
+            bsdf.sample_f_lanes(
+                &packet.0,
+                &packet.1,
+                &packet.2,
+                &packet.3,
+                active,
+                &mut samples,
+            );
+            bsdf.eval_lanes(&packet.0, &packet.1, &packet.4, active, &mut evals);
+            for i in 0..LANES {
+                let k = start + i;
+                let (want_sample, want_eval) = if active.contains(i) {
+                    (
+                        bsdf.sample_f(&ctx[k], wo[k], u1[k], u2[k]),
+                        bsdf.eval(&ctx[k], wo[k], wi[k]),
+                    )
+                } else {
+                    (Some(marker), (marker.f, marker.pdf))
+                };
+                if !samples_agree(&want_sample, &samples.get(i)) {
+                    return vec![format!(
+                        "sample_f_lanes lane {i} of mask {:#010b} gave {:?} but {want_sample:?} was expected (wo = {:?}, u1 = {}, u2 = {:?}, {:?})",
+                        active.bits(), samples.get(i), wo[k], u1[k], u2[k], ctx[k].mode
+                    )];
+                }
+                if !(evals.valid.contains(i) && evals_agree(want_eval, evals.get(i))) {
+                    return vec![format!(
+                        "eval_lanes lane {i} of mask {:#010b} gave {:?} but {want_eval:?} was expected (wo = {:?}, wi = {:?}, {:?})",
+                        active.bits(), evals.get(i), wo[k], wi[k], ctx[k].mode
+                    )];
+                }
+            }
+        }
+    }
+    Vec::new()
 }
 
 /// Runs every check over the sweep of the plugin's declared parameters
@@ -658,6 +755,8 @@ mod tests {
         wrong_sample_batch: bool,
         /// `eval_batch` reads the first lane's `wo` for every lane.
         first_wo: bool,
+        /// `sample_f_lanes` answers every lane, not only the active ones.
+        every_lane: bool,
         /// `f` is NaN below the horizon.
         nan_below: bool,
         /// `pdf` claims samples bunched toward the normal as `cos^1.05`
@@ -732,6 +831,24 @@ mod tests {
                 };
             }
         }
+        fn sample_f_lanes(
+            &self,
+            ctx: &[BsdfContext; LANES],
+            wo: &Vec3Lanes,
+            u1: &[f32; LANES],
+            u2: &Vec2Lanes,
+            active: LaneMask,
+            out: &mut BsdfSampleLanes,
+        ) {
+            let lanes = if self.every_lane {
+                LaneMask::ALL
+            } else {
+                active
+            };
+            for i in lanes.iter() {
+                out.set(i, self.sample_f(&ctx[i], wo.get(i), u1[i], u2.get(i)));
+            }
+        }
     }
 
     #[test]
@@ -766,6 +883,17 @@ mod tests {
         assert!(
             first.iter().any(|p| p.starts_with("eval_batch lane 2 ")),
             "{first:?}"
+        );
+        // A lane method writes the lanes it is asked for, and no other.
+        let every = check(Lambert {
+            every_lane: true,
+            ..Default::default()
+        });
+        assert!(
+            every
+                .iter()
+                .any(|p| p.starts_with("sample_f_lanes lane 1 of mask 0b01101001")),
+            "{every:?}"
         );
     }
 

@@ -7,8 +7,9 @@
 //! - chi-square goodness of fit of `sample_li` against `pdf_li` (a
 //!   one-sided emitter seen from behind must give pdf 0 and no samples);
 //! - `sample_li` returns the pdf `pdf_li` gives for its direction and the
-//!   radiance `l()` gives at its point, and `sample_li_batch` returns what
-//!   `sample_li` does;
+//!   radiance `l()` gives at its point, and `sample_li_batch` and
+//!   `sample_li_lanes` (on every lane and under a mask, the masked-out
+//!   lanes untouched) return what `sample_li` does;
 //! - `power()` is finite and non-negative;
 //! - no NaN, infinite or negative radiance or pdf anywhere.
 //!
@@ -18,6 +19,8 @@
 
 use std::fmt::Write;
 
+use lumis_core::lanes::{LaneMask, Vec2Lanes, LANES};
+use lumis_core::light::LightSampleLanes;
 use lumis_core::params::ParamDefault;
 use lumis_core::ray::SurfacePoint;
 use lumis_core::{
@@ -537,26 +540,72 @@ fn check_batch(light: &dyn Light, ctx: &LightSampleContext, u: &[Vec2]) -> Vec<S
     let ctxs = vec![*ctx; u.len()];
     let mut out = vec![None; u.len()];
     light.sample_li_batch(&ctxs, u, &mut out);
-    let near =
-        |a: f32, b: f32| a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
     let lanes = u.len();
     for (i, (&u, batch)) in u.iter().zip(&out).enumerate() {
         let scalar = light.sample_li(ctx, u);
-        let agree = match (&scalar, batch) {
-            (None, None) => true,
-            (Some(a), Some(b)) => {
-                near(a.pdf, b.pdf)
-                    && near(a.l.r, b.l.r)
-                    && near(a.l.g, b.l.g)
-                    && near(a.l.b, b.l.b)
-                    && (a.wi - b.wi).abs().max_element() <= 1e-4
-            }
-            _ => false,
-        };
-        if !agree {
+        if !samples_agree(&scalar, batch) {
             return vec![format!(
                 "sample_li_batch lane {i} of {lanes} gave {batch:?} but sample_li gave {scalar:?} (u = {u:?})"
             )];
+        }
+    }
+    check_lanes(light, ctx, u)
+}
+
+/// Two answers of `sample_li`'s: the same sample up to rounding (a
+/// relative 1e-4), or none.
+fn samples_agree(a: &Option<LightSample>, b: &Option<LightSample>) -> bool {
+    let near =
+        |a: f32, b: f32| a.to_bits() == b.to_bits() || (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            near(a.pdf, b.pdf)
+                && near(a.l.r, b.l.r)
+                && near(a.l.g, b.l.g)
+                && near(a.l.b, b.l.b)
+                && (a.wi - b.wi).abs().max_element() <= 1e-4
+        }
+        _ => false,
+    }
+}
+
+/// `sample_li_lanes` against `sample_li`, a packet of [`LANES`] numbers
+/// at a time: with every lane active, and with a mask that leaves some
+/// out, whose lanes (filled with a marker beforehand) must come back
+/// untouched.
+fn check_lanes(light: &dyn Light, ctx: &LightSampleContext, u: &[Vec2]) -> Vec<String> {
+    let marker = LightSample {
+        l: Rgb::splat(-1.0),
+        wi: Vec3::splat(-1.0),
+        pdf: -1.0,
+        p: SurfacePoint::isolated(Vec3::splat(-1.0)),
+    };
+    for numbers in u.chunks_exact(LANES) {
+        let mut packet = Vec2Lanes::default();
+        for (i, &u) in numbers.iter().enumerate() {
+            packet.set(i, u);
+        }
+        for active in [LaneMask::ALL, LaneMask::from_bits(0b1001_0110)] {
+            let mut out = LightSampleLanes::default();
+            for i in (!active).iter() {
+                out.set(i, Some(marker));
+            }
+            light.sample_li_lanes(&[*ctx; LANES], &packet, active, &mut out);
+            for (i, &u) in numbers.iter().enumerate() {
+                let want = if active.contains(i) {
+                    light.sample_li(ctx, u)
+                } else {
+                    Some(marker)
+                };
+                if !samples_agree(&want, &out.get(i)) {
+                    return vec![format!(
+                        "sample_li_lanes lane {i} of mask {:#010b} gave {:?} but {want:?} was expected (u = {u:?})",
+                        active.bits(),
+                        out.get(i)
+                    )];
+                }
+            }
         }
     }
     Vec::new()

@@ -29,8 +29,8 @@ fn check_with(
 }
 
 /// `path` passes the full check in [`check_plugin_checks_a_builtin_integrator`];
-/// `direct` (whose exact values are those of depth 2) and `wavefront` pass
-/// it at half the samples, to keep this test short.
+/// `direct` (whose exact values are those of depth 2), `wavefront` and
+/// `packet` pass it at half the samples, to keep this test short.
 #[test]
 fn every_builtin_integrator_passes() {
     let registry = builtin_registry().unwrap();
@@ -39,7 +39,7 @@ fn every_builtin_integrator_passes() {
         compare_spp: 32,
         ..IntegratorCheckConfig::default()
     };
-    for name in ["direct", "wavefront"] {
+    for name in ["direct", "wavefront", "packet"] {
         let results = check_with(&registry, name, &cfg);
         let table = format_integrator_results(&results);
         assert!(results.iter().all(|r| r.passed()), "{table}");

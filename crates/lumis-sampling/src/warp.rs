@@ -24,31 +24,48 @@ pub fn square_to_concentric_disk(u: Vec2) -> Vec2 {
 /// knows before the angle.
 #[inline(always)]
 fn concentric_disk_and_radius(u: Vec2) -> (Vec2, f32) {
-    let o = 2.0 * u - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return (Vec2::ZERO, 0.0);
-    }
+    let ([x, y], r) = concentric_disk_and_radius_lanes([u.x, u.y]);
+    (Vec2::new(x, y), r)
+}
+
+/// [`concentric_disk_and_radius`] on lanes: each lane the bits of the
+/// scalar map, which is this with `F = f32`.
+#[inline(always)]
+fn concentric_disk_and_radius_lanes<F: Real>([u0, u1]: [F; 2]) -> ([F; 2], F) {
+    let (zero, one, two) = (F::splat(0.0), F::splat(1.0), F::splat(2.0));
+    let (ox, oy) = (two * u0 - one, two * u1 - one);
     // The wedge is a coin flip for every sample: selects, not branches, so
     // the processor has nothing to mispredict. In the top/bottom wedges
     // theta = pi/2 - phi, so cos theta = sin phi and sin theta = cos phi.
-    let vertical = o.y.abs() >= o.x.abs();
-    let (r, along) = if vertical { (o.y, o.x) } else { (o.x, o.y) };
-    let (sin, cos) = sin_cos_quarter_turn(FRAC_PI_4 * (along / r));
-    let (x, y) = if vertical { (sin, cos) } else { (cos, sin) };
-    (r * Vec2::new(x, y), r.abs())
+    let vertical = oy.abs().ge(ox.abs());
+    let (r, along) = (F::select(vertical, oy, ox), F::select(vertical, ox, oy));
+    let (sin, cos) = sin_cos_quarter_turn(F::splat(FRAC_PI_4) * (along / r));
+    let (x, y) = (F::select(vertical, sin, cos), F::select(vertical, cos, sin));
+    // The centre (0/0 above) maps to itself.
+    let centre = ox.eq(zero) & oy.eq(zero);
+    let keep = |v: F| F::select(centre, zero, v);
+    ([keep(r * x), keep(r * y)], keep(r.abs()))
 }
 
 /// Cosine-weighted hemisphere by Malley's method: project the concentric
 /// disk up onto the hemisphere. Density `cos theta / pi`.
 #[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let (d, r) = concentric_disk_and_radius(u);
+    let v = square_to_cosine_hemisphere_lanes([u.x, u.y]);
+    Vec3::new(v.x, v.y, v.z)
+}
+
+/// [`square_to_cosine_hemisphere`] on lanes, each lane the scalar map's
+/// bits.
+#[inline(always)]
+pub fn square_to_cosine_hemisphere_lanes<F: Real>(u: [F; 2]) -> V3<F> {
+    let ([x, y], r) = concentric_disk_and_radius_lanes(u);
     // From the radius rather than from |d|^2 (equal to within rounding):
     // the square root then runs alongside the division and the sine and
     // cosine instead of after them, off the chain of dependent latencies
     // that every diffuse bounce waits on before its next ray.
-    let z = (1.0 - r * r).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    let z = (F::splat(1.0) - r * r).max(F::splat(0.0)).sqrt();
+    V3::new(x, y, z)
 }
 
 #[inline]
@@ -141,6 +158,38 @@ mod tests {
             }
             assert!((square_to_uniform_sphere(u).length() - 1.0).abs() < 1e-5);
         }
+    }
+
+    /// Each lane of the cosine map on eight lanes is the scalar map's bits,
+    /// at the square's corners, edges and centre (where the wedge's angle
+    /// is 0/0) and at random points.
+    #[test]
+    fn cosine_hemisphere_lanes_are_the_scalar_bits() {
+        use crate::real::F32x8;
+        let top = 1.0 - f32::EPSILON / 2.0;
+        let mut rng = Pcg32::new(11, 3);
+        let mut points = vec![0.0, 0.5, top, 0.25, 0.75];
+        points.extend((0..40).map(|_| rng.next_f32()));
+        let us: Vec<Vec2> = points
+            .iter()
+            .flat_map(|&x| points.iter().map(move |&y| Vec2::new(x, y)))
+            .collect();
+        for chunk in us.chunks_exact(8) {
+            let lanes = square_to_cosine_hemisphere_lanes([
+                F32x8::from_fn(|i| chunk[i].x),
+                F32x8::from_fn(|i| chunk[i].y),
+            ]);
+            for (i, &u) in chunk.iter().enumerate() {
+                let w = square_to_cosine_hemisphere(u);
+                let lane = lanes.lane(i);
+                assert_eq!(
+                    w.to_array().map(f32::to_bits),
+                    lane.to_array().map(f32::to_bits),
+                    "u = {u:?}"
+                );
+            }
+        }
+        assert_eq!(square_to_cosine_hemisphere(Vec2::splat(0.5)), Vec3::Z);
     }
 
     /// Monte Carlo check of E[g(w)] against the exact integral of g pdf:

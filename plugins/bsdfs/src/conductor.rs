@@ -9,6 +9,10 @@
 //! delta limit, which `conductor` also becomes below a roughness of 1e-3.
 //! One-sided, like Mitsuba's: black from behind.
 
+use lumis_api::bsdf::{
+    eval_lanes_by_batch, sample_f_lanes_by_batch, BsdfEvalLanes, BsdfSampleLanes,
+};
+use lumis_api::lanes::{Floats, LaneMask, Vec2Lanes, Vec3Lanes, LANES};
 use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
     Rgb, TextureQuery, TexturedRgb, Vec2, Vec3,
@@ -466,6 +470,31 @@ impl Bsdf for Conductor {
                 *out = (Rgb::new(f[0][i], f[1][i], f[2][i]), pdf[i]);
             }
         }
+    }
+
+    /// A packet's lanes through the SIMD [`Bsdf::eval_batch`].
+    fn eval_lanes(
+        &self,
+        ctx: &[BsdfContext; LANES],
+        wo: &Vec3Lanes,
+        wi: &Vec3Lanes,
+        active: LaneMask,
+        out: &mut BsdfEvalLanes,
+    ) {
+        eval_lanes_by_batch(self, ctx, wo, wi, active, out)
+    }
+
+    /// A packet's lanes through the SIMD [`Bsdf::sample_f_batch`].
+    fn sample_f_lanes(
+        &self,
+        ctx: &[BsdfContext; LANES],
+        wo: &Vec3Lanes,
+        u1: &Floats,
+        u2: &Vec2Lanes,
+        active: LaneMask,
+        out: &mut BsdfSampleLanes,
+    ) {
+        sample_f_lanes_by_batch(self, ctx, wo, u1, u2, active, out)
     }
 
     /// [`Bsdf::sample_f`] a SIMD chunk of lanes at a time, for the

@@ -2,10 +2,13 @@
 
 use std::f32::consts::FRAC_1_PI;
 
+use lumis_api::bsdf::{sample_f_each_lane, BsdfSampleLanes};
+use lumis_api::lanes::{Floats, LaneMask, Vec2Lanes, Vec3Lanes, LANES};
 use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Result, Rgb, TexturedRgb, Vec2, Vec3,
 };
+use lumis_sampling::real::F32x8;
 use lumis_sampling::warp;
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -81,6 +84,32 @@ impl Diffuse {
         }
     }
 
+    /// The sample of direction `local` (drawn in the upper hemisphere) for
+    /// `wo`, mirrored to `wo`'s side where both sides reflect.
+    #[inline(always)]
+    fn sample_from(&self, ctx: &BsdfContext, wo: Vec3, local: Vec3) -> Option<BsdfSample> {
+        let flip = if wo.z > 0.0 {
+            1.0
+        } else if self.two_sided && wo.z < 0.0 {
+            -1.0
+        } else {
+            return None;
+        };
+        // A direction on the horizon (z = 0 exactly, reachable with u = 0)
+        // has no reflection: f() is zero there, so no sample either.
+        if local.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf_upper(local.z);
+        Some(BsdfSample {
+            f: self.reflectance.eval(&ctx.texture) * FRAC_1_PI,
+            wi: Vec3::new(local.x, local.y, local.z * flip),
+            pdf,
+            flags: BsdfFlags::DIFFUSE_REFLECTION,
+            eta: 1.0,
+        })
+    }
+
     #[inline]
     fn pdf_upper(&self, cos_theta: f32) -> f32 {
         match self.sampling {
@@ -105,30 +134,35 @@ impl Bsdf for Diffuse {
 
     #[inline]
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
-        let flip = if wo.z > 0.0 {
-            1.0
-        } else if self.two_sided && wo.z < 0.0 {
-            -1.0
-        } else {
-            return None;
-        };
         let local = match self.sampling {
             DiffuseSampling::Cosine => warp::square_to_cosine_hemisphere(u2),
             DiffuseSampling::Uniform => warp::square_to_uniform_hemisphere(u2),
         };
-        // A direction on the horizon (z = 0 exactly, reachable with u = 0)
-        // has no reflection: f() is zero there, so no sample either.
-        if local.z <= 0.0 {
-            return None;
+        self.sample_from(ctx, wo, local)
+    }
+
+    /// A packet's lanes with the cosine map on SIMD lanes, read from and
+    /// written to the lane arrays as whole registers
+    /// (`warp::square_to_cosine_hemisphere_lanes`, the scalar map's bits);
+    /// the reflectance per lane. Each lane is `sample_f`'s answer.
+    fn sample_f_lanes(
+        &self,
+        ctx: &[BsdfContext; LANES],
+        wo: &Vec3Lanes,
+        u1: &Floats,
+        u2: &Vec2Lanes,
+        active: LaneMask,
+        out: &mut BsdfSampleLanes,
+    ) {
+        if self.sampling != DiffuseSampling::Cosine {
+            return sample_f_each_lane(self, ctx, wo, u1, u2, active, out);
         }
-        let pdf = self.pdf_upper(local.z);
-        Some(BsdfSample {
-            f: self.reflectance.eval(&ctx.texture) * FRAC_1_PI,
-            wi: Vec3::new(local.x, local.y, local.z * flip),
-            pdf,
-            flags: BsdfFlags::DIFFUSE_REFLECTION,
-            eta: 1.0,
-        })
+        let local = warp::square_to_cosine_hemisphere_lanes([F32x8::from(u2.x), F32x8::from(u2.y)]);
+        let [x, y, z] = [local.x, local.y, local.z].map(F32x8::to_array);
+        for i in active.iter() {
+            let local = Vec3::new(x[i], y[i], z[i]);
+            out.set(i, self.sample_from(&ctx[i], wo.get(i), local));
+        }
     }
 
     #[inline]

@@ -1,8 +1,10 @@
-//! Standard integrators: `path` (unidirectional path tracing) and `direct`
-//! (direct lighting only), sharing one direct-lighting estimator.
+//! Standard integrators: `path` (unidirectional path tracing), `direct`
+//! (direct lighting only), and `wavefront` and `packet` (`path`'s estimator
+//! on many paths at once), sharing one direct-lighting estimator.
 
 mod direct;
 mod estimator;
+mod packet;
 mod path;
 mod path_state;
 mod specialize;
@@ -13,6 +15,7 @@ pub use estimator::{
     Estimator, EstimatorParams, Heuristic, HeuristicName, MisEstimator, SceneView, Strategy,
     VertexPlan,
 };
+pub use packet::{PacketIntegrator, PacketParams};
 pub use path::{PathIntegrator, PathParams};
 pub use specialize::{Specialized, Trace};
 pub use wavefront::{WavefrontIntegrator, WavefrontParams};
@@ -29,6 +32,9 @@ pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     })?;
     registry.add_integrator(wavefront::SPEC, |p| {
         Ok(Box::new(WavefrontIntegrator::from_params(p)?))
+    })?;
+    registry.add_integrator(packet::SPEC, |p| {
+        Ok(Box::new(PacketIntegrator::from_params(p)?))
     })
 }
 
@@ -46,9 +52,12 @@ pub fn register_specialized<S: Scene + 'static>(registry: &mut dyn Registrar) ->
             DirectIntegrator::from_params(p)?,
         )))
     })?;
-    // Its scene queries are one virtual call per wave, not per ray: it
-    // needs no loop compiled for the scene type.
+    // Their scene queries are one virtual call per wave or packet, not per
+    // ray: they need no loop compiled for the scene type.
     registry.add_integrator(wavefront::SPEC, |p| {
         Ok(Box::new(WavefrontIntegrator::from_params(p)?))
+    })?;
+    registry.add_integrator(packet::SPEC, |p| {
+        Ok(Box::new(PacketIntegrator::from_params(p)?))
     })
 }

@@ -6,6 +6,8 @@
 
 use std::f32::consts::PI;
 
+use lumis_api::lanes::{LaneMask, Vec2Lanes, LANES};
+use lumis_api::light::{sample_li_lanes_by_batch, LightSampleLanes};
 use lumis_api::math::gamma;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
@@ -257,6 +259,17 @@ impl Light for SphereLight {
         } else {
             self.sample_area(ctx, u)
         }
+    }
+
+    /// A packet's lanes through the SIMD [`Light::sample_li_batch`].
+    fn sample_li_lanes(
+        &self,
+        ctx: &[LightSampleContext; LANES],
+        u: &Vec2Lanes,
+        active: LaneMask,
+        out: &mut LightSampleLanes,
+    ) {
+        sample_li_lanes_by_batch(self, ctx, u, active, out)
     }
 
     /// [`Light::sample_li`] eight lanes at a time for the cone sampling

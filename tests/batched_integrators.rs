@@ -1,7 +1,7 @@
-//! The wavefront integrator against the scalar `path`: the same estimator,
-//! so the same image bit for bit where every query keeps its scalar
-//! default, and the same mean where packets and SIMD plugins round
-//! differently.
+//! The integrators that advance many paths at once (`wavefront`,
+//! `packet`) against the scalar `path`: the same estimator, so the same
+//! image bit for bit where every query keeps its scalar default, and the
+//! same mean where packets and SIMD plugins round differently.
 
 use lumis_render::{render, RenderOutput, RenderSettings};
 use lumis_scene::LoadedScene;
@@ -39,7 +39,8 @@ fn render_opaque(loaded: &LoadedScene) -> RenderOutput {
 /// so with scalar scene queries the two integrators agree bit for bit, in
 /// the image and in every counter: for each strategy, several light and
 /// BSDF samples per vertex, the one-sample estimator, specular chains and
-/// roulette (glass and plastic), and waves that do not divide the samples.
+/// roulette (glass and plastic), waves that do not divide the samples, and
+/// packets that refill only below five live lanes.
 #[test]
 fn same_image_as_path_bit_for_bit() {
     let (cornell, glass) = ("cornell-box.toml", "bench/glass-plastic.toml");
@@ -60,18 +61,22 @@ fn same_image_as_path_bit_for_bit() {
         ];
         overrides.extend(settings.iter().map(|s| s.to_string()));
         let path = render_opaque(&load(scene, &overrides));
-        overrides.push("integrator.type=\"wavefront\"".into());
-        overrides.push("integrator.wave_size=100".into());
-        let wavefront = render_opaque(&load(scene, &overrides));
         assert!(path.image.pixels.iter().any(|p| p[0] > 0.0));
-        assert_eq!(path.image, wavefront.image, "{settings:?}");
-        assert_eq!(path.stats, wavefront.stats, "{settings:?}");
+        for batched in [
+            &["integrator.type=\"wavefront\"", "integrator.wave_size=100"],
+            &["integrator.type=\"packet\"", "integrator.refill_below=5"],
+        ] {
+            let overrides = [&overrides[..], &batched.map(String::from)].concat();
+            let other = render_opaque(&load(scene, &overrides));
+            assert_eq!(path.image, other.image, "{batched:?} {settings:?}");
+            assert_eq!(path.stats, other.stats, "{batched:?} {settings:?}");
+        }
     }
 }
 
 /// With Embree packets (`[accel] packets`) and the built-in plugins'
-/// batched overrides, the wavefront image has the same mean as `path`'s,
-/// block by block, on a diffuse and a glossy scene.
+/// batched and lane overrides, the wavefront and packet images have the
+/// same mean as `path`'s, block by block, on a diffuse and a glossy scene.
 #[test]
 fn same_mean_as_path_with_packets_and_simd() {
     let scenes = [
@@ -79,25 +84,28 @@ fn same_mean_as_path_with_packets_and_simd() {
         ("bench/glossy-beckmann.toml", "film.resolution=[96, 64]"),
     ];
     let block = 16;
-    let z = bonferroni_z(1e-3, scenes.len() * 4 * 6 * 3);
+    let integrators = ["wavefront", "packet"];
+    let z = bonferroni_z(1e-3, integrators.len() * scenes.len() * 4 * 6 * 3);
     for (name, resolution) in scenes {
         let scene = read_scene(name);
         let common = [resolution, "sampler.spp=16"];
         let path = render_toml(&scene, &[&common[..], &["seed=1"]].concat(), 0);
-        let wavefront = render_toml(
-            &scene,
-            &[
-                &common[..],
+        for integrator in integrators {
+            let other = render_toml(
+                &scene,
                 &[
-                    "seed=2",
-                    "integrator.type=\"wavefront\"",
-                    "accel.packets=true",
-                ],
-            ]
-            .concat(),
-            0,
-        );
-        assert_eq!(wavefront.stats.nonfinite, 0);
-        assert_same_mean(&wavefront.image, &path.image, block, z, name);
+                    &common[..],
+                    &[
+                        "seed=2",
+                        &format!("integrator.type=\"{integrator}\""),
+                        "accel.packets=true",
+                    ],
+                ]
+                .concat(),
+                0,
+            );
+            assert_eq!(other.stats.nonfinite, 0);
+            assert_same_mean(&other.image, &path.image, block, z, name);
+        }
     }
 }

@@ -1,0 +1,134 @@
+//! `packet`: the `path` estimator run on a packet of [`LANES`] paths at a
+//! time, one path per lane (the layout of OSPRay's path tracer and of
+//! Embree's ISPC path-tracing tutorial, where a `varying` path is one
+//! lane of a SIMD register).
+//!
+//! The paths' state is held as structure of arrays ([`PathLanes`]). Each
+//! bounce traces the live lanes' rays as one packet
+//! ([`Scene::intersect_batch`]), then hands every BSDF the lanes that hit
+//! it in one [`Bsdf::sample_f_lanes`] and [`Bsdf::eval_lanes`] call and
+//! every light the lanes that chose it in one [`Light::sample_li_lanes`]
+//! call, with their arguments as lane arrays and the lanes as a
+//! [`LaneMask`]; a plugin that overrides those methods computes the lanes
+//! with SIMD, one that does not answers lane by lane through the trait's
+//! defaults. A lane whose path ends takes the next camera ray of the batch
+//! while fewer than `refill_below` lanes are live.
+//!
+//! The estimator is `path`'s: each path draws its sampler's numbers in
+//! `path`'s order and advances with the same [`PathState`] steps, so with
+//! plugins that keep the lane methods' defaults the two integrators give
+//! the same image bit for bit; lane overrides change it only by their
+//! rounding.
+//!
+//! [`Bsdf::sample_f_lanes`]: lumis_api::Bsdf::sample_f_lanes
+//! [`Bsdf::eval_lanes`]: lumis_api::Bsdf::eval_lanes
+//! [`Light::sample_li_lanes`]: lumis_api::Light::sample_li_lanes
+//! [`PathState`]: crate::path_state::PathState
+
+mod shade;
+mod state;
+
+use lumis_api::lanes::LANES;
+use lumis_api::{
+    Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
+    Sampler, SamplerLanes, Scene,
+};
+
+use crate::estimator::SceneView;
+use crate::path::{PathIntegrator, PathParams};
+use shade::Bounce;
+use state::PathLanes;
+
+pub const SPEC: PluginSpec = PluginSpec {
+    kind: PluginKind::Integrator,
+    name: "packet",
+    doc: "the path tracer run on a packet of 8 paths, one per lane: rays traced as packets, each BSDF and light called once per packet with the lanes that need it (SIMD where the plugin overrides the lane methods); same estimate as path",
+    params: PacketParams::SPECS,
+};
+
+#[derive(Debug, Clone, Copy, PluginParams)]
+pub struct PacketParams {
+    #[param(flatten)]
+    pub path: PathParams,
+    /// a lane whose path ended takes a new camera ray while fewer than this
+    /// many lanes are live: 8 keeps every lane busy, 1 runs each packet's
+    /// paths to their end before starting new ones
+    #[param(default = 8, range = (1, 8))]
+    pub refill_below: u32,
+}
+
+/// Camera rays per [`Integrator::li_batch`] call: enough for the lanes to
+/// refill many times from one batch.
+const BATCH: usize = 32 * LANES;
+
+pub struct PacketIntegrator {
+    /// The estimator's settings, and the scalar loop for a single ray.
+    path: PathIntegrator,
+    refill_below: u32,
+}
+
+impl PacketIntegrator {
+    pub fn new(path: PathIntegrator, refill_below: u32) -> Self {
+        Self {
+            path,
+            refill_below: refill_below.clamp(1, LANES as u32),
+        }
+    }
+
+    pub fn from_params(params: &Params) -> Result<Self> {
+        let p = PacketParams::read(params)?;
+        Ok(Self::new(
+            PathIntegrator::from_read(&p.path, params)?,
+            p.refill_below,
+        ))
+    }
+}
+
+impl Integrator for PacketIntegrator {
+    /// A single ray is a packet of one: `path`'s scalar loop.
+    fn li(
+        &self,
+        ray: &Ray,
+        scene: &dyn Scene,
+        sampler: &mut dyn Sampler,
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        self.path.li(ray, scene, sampler, stats)
+    }
+
+    fn batch_size(&self) -> usize {
+        BATCH
+    }
+
+    fn li_batch(
+        &self,
+        rays: &[Ray],
+        scene: &dyn Scene,
+        samplers: &mut dyn SamplerLanes,
+        stats: &mut RenderStats,
+        out: &mut [Rgb],
+    ) {
+        let scene = SceneView::new(scene);
+        let mut paths = PathLanes::default();
+        let mut bounce = Bounce::new(&self.path, &scene);
+        let mut unstarted = 0..rays.len();
+        loop {
+            if paths.live.count() < self.refill_below {
+                for lane in (!paths.live).iter() {
+                    let Some(path) = unstarted.next() else {
+                        break;
+                    };
+                    paths.start(lane, path, &rays[path]);
+                }
+            }
+            if paths.live.is_empty() {
+                break;
+            }
+            let ended = bounce.run(&mut paths, samplers, stats);
+            for lane in ended.iter() {
+                out[paths.path[lane]] = paths.radiance(lane);
+            }
+            paths.live = paths.live & !ended;
+        }
+    }
+}
