@@ -109,3 +109,54 @@ fn same_mean_as_path_with_packets_and_simd() {
         }
     }
 }
+
+/// On every scene of the bench suite, through lumis's own scene (Embree's
+/// packets, the built-in plugins' SIMD overrides), the wavefront and
+/// packet images have the same mean as `path`'s, block by block. A scene
+/// whose uncommitted asset under `scenes/bench/assets/` is missing (the
+/// scanned mesh and the measured table, which the peer bench makes) is
+/// skipped, and said so.
+#[test]
+fn same_mean_as_path_on_every_bench_scene() {
+    let mut scenes: Vec<_> = std::fs::read_dir(scenes_dir().join("bench"))
+        .expect("scenes/bench exists")
+        .map(|entry| entry.expect("a directory entry").path())
+        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    assert!(scenes.len() >= 10, "{scenes:?}");
+    let integrators = ["wavefront", "packet"];
+    let block = 8;
+    let z = bonferroni_z(1e-3, scenes.len() * integrators.len() * 4 * 3 * 3);
+    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let common = ["film.resolution=[32, 24]", "sampler.spp=16"];
+    for scene in &scenes {
+        let name = scene.file_name().unwrap().to_string_lossy().into_owned();
+        let load = |extra: &[&str]| {
+            let overrides: Vec<String> =
+                common.iter().chain(extra).map(|s| s.to_string()).collect();
+            lumis_scene::load_file(scene, &overrides, &registry)
+        };
+        let path = match load(&["seed=1"]) {
+            Ok(loaded) => lumis_tests::render_loaded(&loaded, 2),
+            Err(e) if e.to_string().contains("/assets/") => {
+                println!("{name} skipped: its asset is not made ({e})");
+                continue;
+            }
+            Err(e) => panic!("{name}: {e}"),
+        };
+        for integrator in integrators {
+            let chosen = format!("integrator.type=\"{integrator}\"");
+            let loaded = load(&["seed=2", &chosen]).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let other = lumis_tests::render_loaded(&loaded, 2);
+            assert_eq!(other.stats.nonfinite, 0, "{name} {integrator}");
+            assert_same_mean(
+                &other.image,
+                &path.image,
+                block,
+                z,
+                &format!("{name} {integrator}"),
+            );
+        }
+    }
+}

@@ -62,18 +62,29 @@ fn estimators_agree_in_the_mean() {
     }
 }
 
-/// The same scene, seed and spp give a bit-identical image on 1 and 2 threads.
+/// The same scene, seed and spp give a bit-identical image on 1, 2 and 3
+/// threads, with `path` and with the integrators that batch paths.
 #[test]
 fn bit_identical_for_any_thread_count() {
     let scene = read_scene("cornell-box.toml");
+    for integrator in ["path", "wavefront", "packet"] {
+        let integrator = format!("integrator.type=\"{integrator}\"");
+        let overrides = [
+            "film.resolution=[48, 40]",
+            "sampler.spp=4",
+            "seed=7",
+            &integrator,
+        ];
+        let one = render_toml(&scene, &overrides, 1);
+        let two = render_toml(&scene, &overrides, 2);
+        let three = render_toml(&scene, &overrides, 3);
+        assert!(one.image.pixels.iter().any(|p| p[0] > 0.0));
+        assert_eq!(one.image, two.image, "{integrator}");
+        assert_eq!(one.image, three.image, "{integrator}");
+        assert_eq!(one.stats, two.stats, "{integrator}");
+    }
     let overrides = ["film.resolution=[48, 40]", "sampler.spp=4", "seed=7"];
     let one = render_toml(&scene, &overrides, 1);
-    let two = render_toml(&scene, &overrides, 2);
-    let three = render_toml(&scene, &overrides, 3);
-    assert!(one.image.pixels.iter().any(|p| p[0] > 0.0));
-    assert_eq!(one.image, two.image);
-    assert_eq!(one.image, three.image);
-    assert_eq!(one.stats, two.stats);
     let other_seed = render_toml(
         &scene,
         &["film.resolution=[48, 40]", "sampler.spp=4", "seed=8"],

@@ -84,17 +84,24 @@ impl Diffuse {
         }
     }
 
-    /// The sample of direction `local` (drawn in the upper hemisphere) for
-    /// `wo`, mirrored to `wo`'s side where both sides reflect.
+    /// The factor on `z` that takes the upper hemisphere to `wo`'s side: 1
+    /// above, -1 below where both sides reflect; `None` where `wo`'s side
+    /// does not reflect.
     #[inline(always)]
-    fn sample_from(&self, ctx: &BsdfContext, wo: Vec3, local: Vec3) -> Option<BsdfSample> {
-        let flip = if wo.z > 0.0 {
-            1.0
+    fn side(&self, wo: Vec3) -> Option<f32> {
+        if wo.z > 0.0 {
+            Some(1.0)
         } else if self.two_sided && wo.z < 0.0 {
-            -1.0
+            Some(-1.0)
         } else {
-            return None;
-        };
+            None
+        }
+    }
+
+    /// The sample of direction `local`, drawn in the upper hemisphere, its
+    /// `z` multiplied by `flip` ([`Diffuse::side`]).
+    #[inline(always)]
+    fn sample_from(&self, ctx: &BsdfContext, flip: f32, local: Vec3) -> Option<BsdfSample> {
         // A direction on the horizon (z = 0 exactly, reachable with u = 0)
         // has no reflection: f() is zero there, so no sample either.
         if local.z <= 0.0 {
@@ -134,11 +141,12 @@ impl Bsdf for Diffuse {
 
     #[inline]
     fn sample_f(&self, ctx: &BsdfContext, wo: Vec3, _u1: f32, u2: Vec2) -> Option<BsdfSample> {
+        let flip = self.side(wo)?;
         let local = match self.sampling {
             DiffuseSampling::Cosine => warp::square_to_cosine_hemisphere(u2),
             DiffuseSampling::Uniform => warp::square_to_uniform_hemisphere(u2),
         };
-        self.sample_from(ctx, wo, local)
+        self.sample_from(ctx, flip, local)
     }
 
     /// A packet's lanes with the cosine map on SIMD lanes, read from and
@@ -161,7 +169,10 @@ impl Bsdf for Diffuse {
         let [x, y, z] = [local.x, local.y, local.z].map(F32x8::to_array);
         for i in active.iter() {
             let local = Vec3::new(x[i], y[i], z[i]);
-            out.set(i, self.sample_from(&ctx[i], wo.get(i), local));
+            let sample = self
+                .side(wo.get(i))
+                .and_then(|flip| self.sample_from(&ctx[i], flip, local));
+            out.set(i, sample);
         }
     }
 

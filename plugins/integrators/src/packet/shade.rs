@@ -18,8 +18,9 @@ use crate::path::PathIntegrator;
 pub struct Bounce<'a, 's> {
     path: &'a PathIntegrator,
     scene: &'a SceneView<'s, dyn Scene + 's>,
-    /// The live lanes in increasing order, and their sampler lanes: the
-    /// order in which rays and numbers are batched.
+    /// The live lanes in increasing order, and the sampler lanes of a
+    /// batched request for numbers: the order in which rays and numbers
+    /// are batched.
     lanes: Vec<usize>,
     samplers_of: Vec<usize>,
     bsdf_u: Vec<(f32, Vec2)>,
@@ -224,12 +225,7 @@ impl<'a, 's> Bounce<'a, 's> {
             .map(|lane| self.plans[lane].light_samples)
             .max();
         for round in 0..rounds.unwrap_or(0) {
-            let takers = LaneMask::from_bits(
-                lanes
-                    .iter()
-                    .filter(|&lane| self.plans[lane].light_samples > round)
-                    .fold(0, |bits, lane| bits | 1 << lane),
-            );
+            let takers = mask_where(lanes, |lane| self.plans[lane].light_samples > round);
             // The first round's numbers came with the vertex's; later
             // rounds draw theirs here.
             let mut numbers = [(0.0, Vec2::ZERO); LANES];
@@ -238,10 +234,13 @@ impl<'a, 's> Bounce<'a, 's> {
                     numbers[lane] = self.light_u[k];
                 }
             } else {
-                let of: Vec<usize> = takers.iter().map(|lane| paths.path[lane]).collect();
+                self.samplers_of.clear();
+                self.samplers_of
+                    .extend(takers.iter().map(|lane| paths.path[lane]));
                 self.numbers.clear();
-                self.numbers.resize(of.len(), (0.0, Vec2::ZERO));
-                samplers.get_1d_2d_batch(&of, &mut self.numbers);
+                self.numbers
+                    .resize(self.samplers_of.len(), (0.0, Vec2::ZERO));
+                samplers.get_1d_2d_batch(&self.samplers_of, &mut self.numbers);
                 for (lane, &u) in takers.iter().zip(&self.numbers) {
                     numbers[lane] = u;
                 }
@@ -257,12 +256,7 @@ impl<'a, 's> Bounce<'a, 's> {
                 u.set(lane, numbers[lane].1);
             }
             let mut light_samples = LightSampleLanes::default();
-            let mut rest = LaneMask::from_bits(
-                takers
-                    .iter()
-                    .filter(|&lane| chosen[lane].is_some())
-                    .fold(0, |bits, lane| bits | 1 << lane),
-            );
+            let mut rest = mask_where(takers, |lane| chosen[lane].is_some());
             while let Some(first) = rest.iter().next() {
                 let index = chosen[first].map(|c| c.index);
                 let group = mask_where(rest, |lane| chosen[lane].map(|c| c.index) == index);
