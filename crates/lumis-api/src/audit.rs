@@ -6,7 +6,7 @@
 //! Every answer a guarded plugin returns (and every lane a batched method
 //! fills) passes [`Answer::audit`] on its way to the host; a [`Tally`] per
 //! plugin keeps the counts, and the host that keeps the tallies
-//! ([`crate::guard::FaultReport`]) lists them when the render ends, for the
+//! ([`crate::registrar::FaultReport`]) lists them when the render ends, for the
 //! command line to warn about (or, with `--strict`, refuse).
 //!
 //! Energy: a BSDF sample's weight `f |cos θi| / pdf` has the BSDF's

@@ -10,8 +10,6 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::texture::TextureQuery;
-
 /// A pinhole camera's pixel spacing, as the footprint of a surface point
 /// needs it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,13 +61,13 @@ impl PixelFootprint {
         (offset(self.per_pixel_x), offset(self.per_pixel_y))
     }
 
-    /// The texture lookup at `uv` on a surface point `p`, normal `n`,
-    /// whose parameterization has partial derivatives `dpdu`, `dpdv`.
+    /// `(du/dx, dv/dx)` and `(du/dy, dv/dy)` at a surface point `p`,
+    /// normal `n`, whose parameterization has partial derivatives `dpdu`,
+    /// `dpdv`: what a texture lookup there filters over.
     #[inline]
-    pub fn query(&self, uv: Vec2, p: Vec3, n: Vec3, dpdu: Vec3, dpdv: Vec3) -> TextureQuery {
+    pub fn uv_footprint(&self, p: Vec3, n: Vec3, dpdu: Vec3, dpdv: Vec3) -> (Vec2, Vec2) {
         let (dpdx, dpdy) = self.dp_dxy(p, n);
-        let (duv_dx, duv_dy) = uv_derivatives(dpdu, dpdv, dpdx, dpdy);
-        TextureQuery::new(uv, duv_dx, duv_dy)
+        uv_derivatives(dpdu, dpdv, dpdx, dpdy)
     }
 }
 
@@ -227,17 +225,9 @@ mod tests {
         let (dpdu, dpdv) = triangle_dp_duv(p, uv).unwrap();
         assert!((dpdu - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-6);
         assert!((dpdv - Vec3::new(0.0, 2.0, 0.0)).length() < 1e-6);
-        let q = camera().query(
-            Vec2::splat(0.5),
-            Vec3::new(0.0, 0.0, -4.0),
-            Vec3::Z,
-            dpdu,
-            dpdv,
-        );
-        let (dx, dy) = q.derivatives();
-        // (to the half precision a query stores it in)
-        assert!((dx - Vec2::new(0.02, 0.0)).length() < 2e-5, "{q:?}");
-        assert!((dy - Vec2::new(0.0, -0.02)).length() < 2e-5, "{q:?}");
+        let (dx, dy) = camera().uv_footprint(Vec3::new(0.0, 0.0, -4.0), Vec3::Z, dpdu, dpdv);
+        assert!((dx - Vec2::new(0.02, 0.0)).length() < 1e-6, "{dx:?}");
+        assert!((dy - Vec2::new(0.0, -0.02)).length() < 1e-6, "{dy:?}");
         // Degenerate uvs give no derivatives and no footprint.
         assert!(triangle_dp_duv(p, [Vec2::ZERO; 3]).is_none());
         assert_eq!(
@@ -278,7 +268,6 @@ mod tests {
             (Vec2::new(0.25, -0.5), Vec2::new(0.0, 2.0))
         );
         assert_eq!(PackedFootprint::NONE.unpack(), (Vec2::ZERO, Vec2::ZERO));
-        assert!(!TextureQuery::new(Vec2::ZERO, Vec2::ZERO, Vec2::ZERO).has_footprint());
     }
 
     #[test]

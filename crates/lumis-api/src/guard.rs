@@ -22,21 +22,8 @@ use std::sync::Arc;
 
 use crate::audit::{Answer, Tally};
 use crate::error::{Error, Result};
-use crate::registrar::{Factory, PluginSpec, Registrar};
+use crate::registrar::{Factory, FaultReport, PluginSpec, Registrar};
 use crate::wrap::{CallHook, Fault, Wrapped};
-
-/// Where guarded plugins report, implemented by the host: a library's
-/// guards call it through this trait object, so they never assume the
-/// layout of the host's records.
-pub trait FaultReport: Send + Sync {
-    /// Keeps `error`, the panic of the plugin labelled `plugin`, if it is
-    /// that plugin's first.
-    fn record(&self, plugin: &str, error: Error);
-
-    /// The tally of the plugin named `name` (its label and library),
-    /// shared by every object made under that name.
-    fn tally(&self, name: &str) -> Arc<Tally>;
-}
 
 /// Runs a library's `register` under the library's `catch_unwind`, with
 /// every factory it registers guarded ([`Guarding`]): what

@@ -9,10 +9,10 @@
 use std::fmt;
 use std::sync::Arc;
 
+use crate::audit::Tally;
 use crate::bsdf::Bsdf;
 use crate::denoiser::Denoiser;
-use crate::error::Result;
-use crate::guard::FaultReport;
+use crate::error::{Error, Result};
 use crate::integrator::Integrator;
 use crate::light::{Light, LightShape};
 use crate::light_sampler::LightSampler;
@@ -122,6 +122,19 @@ impl Factory {
             Factory::Denoiser(_) => PluginKind::Denoiser,
         }
     }
+}
+
+/// Where guarded plugins report, implemented by the host: a library's
+/// guards call it through this trait object, so they never assume the
+/// layout of the host's records.
+pub trait FaultReport: Send + Sync {
+    /// Keeps `error`, the panic of the plugin labelled `plugin`, if it is
+    /// that plugin's first.
+    fn record(&self, plugin: &str, error: Error);
+
+    /// The tally of the plugin named `name` (its label and library),
+    /// shared by every object made under that name.
+    fn tally(&self, name: &str) -> Arc<Tally>;
 }
 
 /// Where plugins register: the host's registry, or, while a library

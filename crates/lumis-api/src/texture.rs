@@ -254,6 +254,13 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_query_without_derivatives_has_no_footprint() {
+        assert!(!TextureQuery::new(Vec2::ZERO, Vec2::ZERO, Vec2::ZERO).has_footprint());
+        assert!(TextureQuery::new(Vec2::ZERO, Vec2::X, Vec2::ZERO).has_footprint());
+        assert!(!TextureQuery::at(Vec2::ONE).has_footprint());
+    }
+
+    #[test]
     fn uv_transform_scales_rotates_then_offsets() {
         let t = UvTransform {
             uv_scale: Vec2::new(2.0, 3.0),

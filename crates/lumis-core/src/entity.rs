@@ -8,7 +8,7 @@
 
 use crate::doc::{Node, Table, Value};
 use crate::error::{Error, Location, Result};
-use crate::registry::PluginKind;
+use lumis_api::registrar::PluginKind;
 
 /// One plugin of a scene (or of a tool), before it is created.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use lumis_api::audit::{Defects, Tally};
-use lumis_api::guard::FaultReport;
+use lumis_api::registrar::FaultReport;
 
 use crate::error::{Error, Result};
 

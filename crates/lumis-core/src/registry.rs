@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use lumis_api::guard::FaultReport;
+use lumis_api::registrar::FaultReport;
 pub use lumis_api::registrar::{Factory, PluginKind, PluginSpec, Registrar};
 
 use crate::bsdf::Bsdf;

@@ -6,8 +6,9 @@
 use embree4_sys as sys;
 
 use crate::packet::{Packets, MAX_PACKET};
+use crate::ray::Ray;
 use crate::record::{raw_ray, RayHit};
-use crate::scene::{Ray, Scene};
+use crate::scene::Scene;
 
 /// A recorded query: a closest-hit ray or a shadow ray.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,8 +6,10 @@
 //! and occlusion, for single rays (`intersect1`, `occluded1`) and for
 //! packets of 4, 8 or 16 (`intersect_packets`, `occluded_packets`).
 //!
-//! All `unsafe` code of lumis lives in this crate; each block says why it is
-//! sound.
+//! The workspace denies `unsafe` code except in the crates that call C or
+//! load libraries: this one (Embree), `lumis-denoise`'s `ffi` module
+//! (Open Image Denoise), `lumis-loader` (plugin libraries) and the plugin
+//! declaration of `lumis-api`. Each block says why it is sound.
 
 #![allow(unsafe_code)]
 
@@ -15,6 +17,7 @@ pub mod bare;
 mod buffer;
 mod device;
 mod packet;
+mod ray;
 mod record;
 mod scene;
 mod tape;
@@ -22,7 +25,8 @@ mod tape;
 pub use buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 pub use device::{Device, EmbreeError};
 pub use packet::{PacketWidth, Packets, MAX_PACKET};
-pub use scene::{BuildQuality, Hit, Ray, Scene, SceneBuilder, SceneOptions};
+pub use ray::{Hit, Ray};
+pub use scene::{BuildQuality, Scene, SceneBuilder, SceneOptions};
 
 /// The largest vertex coordinate Embree builds with: a triangle with a
 /// coordinate of this magnitude or more is invalid and left out of the BVH

@@ -10,8 +10,9 @@ use std::mem::MaybeUninit;
 
 use embree4_sys as sys;
 
+use crate::ray::{Hit, Ray};
 use crate::record::MAX_INSTANCE_LEVELS;
-use crate::scene::{Hit, Ray, Scene};
+use crate::scene::Scene;
 
 /// Rays per Embree packet query.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -315,6 +316,63 @@ packet!(
     rtcIntersect16,
     rtcOccluded16
 );
+
+/// The packet queries of a scene.
+impl Scene {
+    /// [`Scene::intersect1`] for each ray of `rays`, traced as Embree
+    /// packets (`rtcIntersect4/8/16`); a last packet that is not full has
+    /// its other lanes switched off. `out` has the length of `rays`. The
+    /// answers are those of single rays up to rounding. Recorded and
+    /// replayed lane by lane, in order, with the single-ray queries (feature
+    /// `replay`; see the `tape` module).
+    pub fn intersect_packets(&self, packets: Packets, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
+        self.tape.hits(out, |start, out| {
+            let rays = &rays[start..];
+            match packets.width {
+                PacketWidth::Four => self.trace_packets::<w4::Width>(packets, rays, out),
+                PacketWidth::Eight => self.trace_packets::<w8::Width>(packets, rays, out),
+                PacketWidth::Sixteen => self.trace_packets::<w16::Width>(packets, rays, out),
+            }
+        });
+    }
+
+    fn trace_packets<P: Packet>(&self, packets: Packets, rays: &[Ray], out: &mut [Option<Hit>]) {
+        let mut args = Args::new(packets.coherent);
+        for (rays, out) in rays.chunks(P::LANES).zip(out.chunks_mut(P::LANES)) {
+            let mut packet = P::ray_hit(rays);
+            P::intersect(self, &P::valid(rays.len()), &mut packet, &mut args);
+            for (lane, out) in out.iter_mut().enumerate() {
+                *out = P::hit(&packet, lane);
+            }
+        }
+    }
+
+    /// [`Scene::occluded1`] for each ray of `rays`, as
+    /// [`Scene::intersect_packets`] (`rtcOccluded4/8/16`).
+    pub fn occluded_packets(&self, packets: Packets, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one answer per ray");
+        self.tape.occlusions(out, |start, out| {
+            let rays = &rays[start..];
+            match packets.width {
+                PacketWidth::Four => self.trace_occluded::<w4::Width>(packets, rays, out),
+                PacketWidth::Eight => self.trace_occluded::<w8::Width>(packets, rays, out),
+                PacketWidth::Sixteen => self.trace_occluded::<w16::Width>(packets, rays, out),
+            }
+        });
+    }
+
+    fn trace_occluded<P: Packet>(&self, packets: Packets, rays: &[Ray], out: &mut [bool]) {
+        let mut args = Args::new(packets.coherent);
+        for (rays, out) in rays.chunks(P::LANES).zip(out.chunks_mut(P::LANES)) {
+            let mut packet = P::rays(rays);
+            P::occluded(self, &P::valid(rays.len()), &mut packet, &mut args);
+            for (lane, out) in out.iter_mut().enumerate() {
+                *out = P::is_occluded(&packet, lane);
+            }
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -22,7 +22,7 @@ use std::mem::MaybeUninit;
 
 use embree4_sys as sys;
 
-use crate::scene::Ray;
+use crate::ray::Ray;
 
 /// The deepest instance stack (`RTC_MAX_INSTANCE_LEVEL_COUNT`) of a runtime
 /// whose hits fit in a [`RayHit`]. Embree's default is 1; lumis instances

@@ -7,7 +7,7 @@ use embree4_sys as sys;
 
 use crate::buffer::{PaddedBuffer, SpherePoint, Triangle, Vertex};
 use crate::device::{Device, EmbreeError};
-use crate::packet::{w16, w4, w8, Args, Packet, PacketWidth, Packets};
+use crate::ray::{Hit, Ray};
 use crate::record::{raw_ray, RayHit};
 use crate::tape::Tape;
 
@@ -40,31 +40,6 @@ pub struct SceneOptions {
     pub compact: bool,
 }
 
-/// A ray segment `org + t dir`, `t` in `[tnear, tfar]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Ray {
-    pub org: [f32; 3],
-    pub dir: [f32; 3],
-    pub tnear: f32,
-    pub tfar: f32,
-}
-
-/// The closest hit along a ray, as Embree reports it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Hit {
-    pub t: f32,
-    /// Barycentric coordinates of the hit: weights of vertices 1 and 2.
-    pub u: f32,
-    pub v: f32,
-    /// Unnormalized geometric normal (for triangles `(v1 - v0) x (v2 - v0)`).
-    pub ng: [f32; 3],
-    /// The geometry within the instanced scene when `inst_id` is set.
-    pub geom_id: u32,
-    pub prim_id: u32,
-    /// The instance hit ([`crate::INVALID_ID`] for geometry of the top scene).
-    pub inst_id: u32,
-}
-
 /// What the scene keeps alive because Embree reads it in place.
 enum SharedStorage {
     Triangles {
@@ -93,7 +68,7 @@ pub struct Scene {
     raw: sys::RTCScene,
     _storage: Vec<SharedStorage>,
     /// Recorded answers to replay (feature `replay`), else nothing.
-    tape: Tape,
+    pub(crate) tape: Tape,
 }
 
 // SAFETY: a committed Embree scene is immutable and its queries
@@ -383,60 +358,6 @@ impl Scene {
         raw.tfar == f32::NEG_INFINITY
     }
 
-    /// [`Scene::intersect1`] for each ray of `rays`, traced as Embree
-    /// packets (`rtcIntersect4/8/16`); a last packet that is not full has
-    /// its other lanes switched off. `out` has the length of `rays`. The
-    /// answers are those of single rays up to rounding. Recorded and
-    /// replayed lane by lane, in order, with the single-ray queries (feature
-    /// `replay`; see the `tape` module).
-    pub fn intersect_packets(&self, packets: Packets, rays: &[Ray], out: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), out.len(), "one answer per ray");
-        self.tape.hits(out, |start, out| {
-            let rays = &rays[start..];
-            match packets.width {
-                PacketWidth::Four => self.trace_packets::<w4::Width>(packets, rays, out),
-                PacketWidth::Eight => self.trace_packets::<w8::Width>(packets, rays, out),
-                PacketWidth::Sixteen => self.trace_packets::<w16::Width>(packets, rays, out),
-            }
-        });
-    }
-
-    fn trace_packets<P: Packet>(&self, packets: Packets, rays: &[Ray], out: &mut [Option<Hit>]) {
-        let mut args = Args::new(packets.coherent);
-        for (rays, out) in rays.chunks(P::LANES).zip(out.chunks_mut(P::LANES)) {
-            let mut packet = P::ray_hit(rays);
-            P::intersect(self, &P::valid(rays.len()), &mut packet, &mut args);
-            for (lane, out) in out.iter_mut().enumerate() {
-                *out = P::hit(&packet, lane);
-            }
-        }
-    }
-
-    /// [`Scene::occluded1`] for each ray of `rays`, as
-    /// [`Scene::intersect_packets`] (`rtcOccluded4/8/16`).
-    pub fn occluded_packets(&self, packets: Packets, rays: &[Ray], out: &mut [bool]) {
-        assert_eq!(rays.len(), out.len(), "one answer per ray");
-        self.tape.occlusions(out, |start, out| {
-            let rays = &rays[start..];
-            match packets.width {
-                PacketWidth::Four => self.trace_occluded::<w4::Width>(packets, rays, out),
-                PacketWidth::Eight => self.trace_occluded::<w8::Width>(packets, rays, out),
-                PacketWidth::Sixteen => self.trace_occluded::<w16::Width>(packets, rays, out),
-            }
-        });
-    }
-
-    fn trace_occluded<P: Packet>(&self, packets: Packets, rays: &[Ray], out: &mut [bool]) {
-        let mut args = Args::new(packets.coherent);
-        for (rays, out) in rays.chunks(P::LANES).zip(out.chunks_mut(P::LANES)) {
-            let mut packet = P::rays(rays);
-            P::occluded(self, &P::valid(rays.len()), &mut packet, &mut args);
-            for (lane, out) in out.iter_mut().enumerate() {
-                *out = P::is_occluded(&packet, lane);
-            }
-        }
-    }
-
     /// Records the answers of the queries that follow (feature `replay`;
     /// see the `tape` module), forgetting earlier ones.
     #[cfg(feature = "replay")]
@@ -488,6 +409,7 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{PacketWidth, Packets};
 
     fn unit_quad(device: &Device) -> Scene {
         let mut builder = SceneBuilder::new(device, SceneOptions::default()).unwrap();

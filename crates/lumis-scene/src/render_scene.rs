@@ -249,7 +249,10 @@ impl RenderScene {
     #[inline]
     fn texture_query(&self, uv: Vec2, point: &SurfacePoint, dp_duv: (Vec3, Vec3)) -> TextureQuery {
         match &self.footprint {
-            Some(footprint) => footprint.query(uv, point.p, point.n, dp_duv.0, dp_duv.1),
+            Some(footprint) => {
+                let (duv_dx, duv_dy) = footprint.uv_footprint(point.p, point.n, dp_duv.0, dp_duv.1);
+                TextureQuery::new(uv, duv_dx, duv_dy)
+            }
             None => TextureQuery::at(uv),
         }
     }

@@ -15,13 +15,14 @@ use lumis_api::bsdf::{
 use lumis_api::lanes::{Floats, LaneMask, Vec2Lanes, Vec3Lanes, LANES};
 use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, Params, PluginKind, PluginParams, PluginSpec, Result,
-    Rgb, TextureQuery, TexturedRgb, Vec2, Vec3,
+    Rgb, TexturedRgb, Vec2, Vec3,
 };
 
 use lumis_sampling::real::{load, F32x8, Real, V3};
 
 use crate::fresnel;
 use crate::lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
+use crate::metal_fresnel::{ConductorFresnel, MetalFresnel};
 use crate::metal_params::MetalParams;
 use crate::microfacet::{
     half_vector, half_vector_lanes, Microfacet, MicrofacetParams, NormalSampling, Roughness,
@@ -64,78 +65,6 @@ pub struct ConductorParams {
     /// cosine/uniform hemisphere for comparison
     #[param(default = Visible)]
     pub sampling: MicrofacetLobeSampling,
-}
-
-/// The metal's reflectance at each angle.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum ConductorFresnel {
-    /// Reflects everything at every angle (Fresnel = 1).
-    Perfect,
-    Complex {
-        eta: Rgb,
-        k: Rgb,
-    },
-}
-
-impl ConductorFresnel {
-    #[inline]
-    pub fn eval(&self, cos_theta: f32) -> Rgb {
-        match *self {
-            Self::Perfect => Rgb::WHITE,
-            Self::Complex { eta, k } => fresnel::conductor(cos_theta, eta, k),
-        }
-    }
-
-    /// [`Self::eval`] of each lane of `cos_theta`, the same bits per lane.
-    #[inline]
-    fn eval_lanes<F: Real>(&self, cos_theta: F) -> [F; 3] {
-        match *self {
-            Self::Perfect => [F::splat(1.0); 3],
-            Self::Complex { eta, k } => [(eta.r, k.r), (eta.g, k.g), (eta.b, k.b)]
-                .map(|(eta, k)| fresnel::conductor_channel_lanes(cos_theta, eta, k)),
-        }
-    }
-}
-
-/// A metal's Fresnel term: the same everywhere, or from `eta` and `k`
-/// textures at each hit (pbrt-v4's `ConductorMaterial` reads its
-/// spectrum textures per hit the same way).
-#[derive(Debug, Clone)]
-pub enum MetalFresnel {
-    Fixed(ConductorFresnel),
-    Textured { eta: TexturedRgb, k: TexturedRgb },
-}
-
-impl From<ConductorFresnel> for MetalFresnel {
-    fn from(fresnel: ConductorFresnel) -> Self {
-        Self::Fixed(fresnel)
-    }
-}
-
-impl MetalFresnel {
-    /// The Fresnel term at the hit `query` looks up.
-    #[inline]
-    pub fn at(&self, query: &TextureQuery) -> ConductorFresnel {
-        match self {
-            Self::Fixed(fresnel) => *fresnel,
-            // A texel out of the physical range (eta <= 0, k < 0) is held
-            // at its edge, as the constants are checked to be.
-            Self::Textured { eta, k } => ConductorFresnel::Complex {
-                eta: eta.eval(query).map(|c| c.max(1e-3)),
-                k: k.eval(query).map(|c| c.max(0.0)),
-            },
-        }
-    }
-
-    /// The Fresnel term if it is the same everywhere: what the batched
-    /// methods work on lanes with.
-    #[inline]
-    pub fn fixed(&self) -> Option<ConductorFresnel> {
-        match self {
-            Self::Fixed(fresnel) => Some(*fresnel),
-            Self::Textured { .. } => None,
-        }
-    }
 }
 
 #[derive(Debug, Clone)]
@@ -568,6 +497,7 @@ impl Bsdf for Conductor {
 mod tests {
     use super::*;
     use crate::microfacet::Distribution;
+    use lumis_api::TextureQuery;
 
     /// A texture that is `c` times `(1 + u)`.
     struct UvRamp(Rgb);

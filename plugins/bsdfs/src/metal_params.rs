@@ -4,8 +4,8 @@
 use lumis_api::params::Textured;
 use lumis_api::{ParamChoice, Params, PluginParams, Result, Rgb, TexturedRgb};
 
-use crate::conductor::{ConductorFresnel, MetalFresnel};
 use crate::fresnel;
+use crate::metal_fresnel::{ConductorFresnel, MetalFresnel};
 
 /// The `material` choice: a metal of [`fresnel::METALS`], or none.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
