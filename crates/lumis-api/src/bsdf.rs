@@ -224,9 +224,7 @@ pub trait Bsdf: Send + Sync {
         u2: &[Vec2],
         out: &mut [Option<BsdfSample>],
     ) {
-        for (i, out) in out.iter_mut().enumerate() {
-            *out = self.sample_f(&ctx[i], wo[i], u1[i], u2[i]);
-        }
+        sample_f_each(self, ctx, wo, u1, u2, out)
     }
 
     /// [`Bsdf::eval`] for each lane of a batch: `out[i]` is
@@ -234,9 +232,7 @@ pub trait Bsdf: Send + Sync {
     /// [`Bsdf::sample_f_batch`].
     #[on_fault(out.fill((Rgb::BLACK, 0.0)))]
     fn eval_batch(&self, ctx: &[BsdfContext], wo: &[Vec3], wi: &[Vec3], out: &mut [(Rgb, f32)]) {
-        for (i, out) in out.iter_mut().enumerate() {
-            *out = self.eval(&ctx[i], wo[i], wi[i]);
-        }
+        eval_each(self, ctx, wo, wi, out)
     }
 
     /// [`Bsdf::sample_f`] for the lanes of `active` of a packet: lane `i`
@@ -274,6 +270,35 @@ pub trait Bsdf: Send + Sync {
         out: &mut BsdfEvalLanes,
     ) {
         eval_each_lane(self, ctx, wo, wi, active, out)
+    }
+}
+
+/// [`Bsdf::sample_f_batch`] lane by lane through `sample_f`: the trait's
+/// default, and an override's answer for the settings it has no SIMD
+/// code for.
+pub fn sample_f_each<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext],
+    wo: &[Vec3],
+    u1: &[f32],
+    u2: &[Vec2],
+    out: &mut [Option<BsdfSample>],
+) {
+    for (i, out) in out.iter_mut().enumerate() {
+        *out = bsdf.sample_f(&ctx[i], wo[i], u1[i], u2[i]);
+    }
+}
+
+/// [`Bsdf::eval_batch`] lane by lane through `eval`, as [`sample_f_each`].
+pub fn eval_each<B: Bsdf + ?Sized>(
+    bsdf: &B,
+    ctx: &[BsdfContext],
+    wo: &[Vec3],
+    wi: &[Vec3],
+    out: &mut [(Rgb, f32)],
+) {
+    for (i, out) in out.iter_mut().enumerate() {
+        *out = bsdf.eval(&ctx[i], wo[i], wi[i]);
     }
 }
 

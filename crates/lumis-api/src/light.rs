@@ -148,9 +148,7 @@ pub trait Light: Send + Sync {
         u: &[Vec2],
         out: &mut [Option<LightSample>],
     ) {
-        for (i, out) in out.iter_mut().enumerate() {
-            *out = self.sample_li(&ctx[i], u[i]);
-        }
+        sample_li_each(self, ctx, u, out)
     }
 
     /// [`Light::sample_li`] for the lanes of `active` of a packet: lane `i`
@@ -198,6 +196,20 @@ pub trait Light: Send + Sync {
 
     /// Lets infinite lights learn the scene's bounding sphere after loading.
     fn preprocess(&mut self, _scene_center: Vec3, _scene_radius: f32) {}
+}
+
+/// [`Light::sample_li_batch`] lane by lane through `sample_li`: the
+/// trait's default, and an override's answer for the settings it has no
+/// SIMD code for.
+pub fn sample_li_each<L: Light + ?Sized>(
+    light: &L,
+    ctx: &[LightSampleContext],
+    u: &[Vec2],
+    out: &mut [Option<LightSample>],
+) {
+    for (i, out) in out.iter_mut().enumerate() {
+        *out = light.sample_li(&ctx[i], u[i]);
+    }
 }
 
 /// [`Light::sample_li_lanes`] lane by lane through `sample_li`: the

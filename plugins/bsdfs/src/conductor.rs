@@ -10,7 +10,8 @@
 //! One-sided, like Mitsuba's: black from behind.
 
 use lumis_api::bsdf::{
-    eval_lanes_by_batch, sample_f_lanes_by_batch, BsdfEvalLanes, BsdfSampleLanes,
+    eval_each, eval_lanes_by_batch, sample_f_each, sample_f_lanes_by_batch, BsdfEvalLanes,
+    BsdfSampleLanes,
 };
 use lumis_api::lanes::{Floats, LaneMask, Vec2Lanes, Vec3Lanes, LANES};
 use lumis_api::{
@@ -382,10 +383,7 @@ impl Bsdf for Conductor {
         let (Some(mf), Some(fresnel), None) =
             (self.roughness.fixed(), self.fresnel.fixed(), &self.tint)
         else {
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = self.eval(&ctx[i], wo[i], wi[i]);
-            }
-            return;
+            return eval_each(self, ctx, wo, wi, out);
         };
         let width = Lanes::LANES;
         for ((wo, wi), out) in wo
@@ -446,12 +444,7 @@ impl Bsdf for Conductor {
             {
                 (mf, fresnel)
             }
-            _ => {
-                for (i, out) in out.iter_mut().enumerate() {
-                    *out = self.sample_f(&ctx[i], wo[i], u1[i], u2[i]);
-                }
-                return;
-            }
+            _ => return sample_f_each(self, ctx, wo, u1, u2, out),
         };
         let width = Lanes::LANES;
         for ((wo, u2), out) in wo

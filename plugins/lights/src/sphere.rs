@@ -7,7 +7,7 @@
 use std::f32::consts::PI;
 
 use lumis_api::lanes::{LaneMask, Vec2Lanes, LANES};
-use lumis_api::light::{sample_li_lanes_by_batch, LightSampleLanes};
+use lumis_api::light::{sample_li_each, sample_li_lanes_by_batch, LightSampleLanes};
 use lumis_api::math::gamma;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
@@ -283,10 +283,7 @@ impl Light for SphereLight {
         out: &mut [Option<LightSample>],
     ) {
         if self.sampling != Sampling::SolidAngle {
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = self.sample_li(&ctx[i], u[i]);
-            }
-            return;
+            return sample_li_each(self, ctx, u, out);
         }
         // Padding lanes look from a point outside.
         let pad = LightSampleContext::at(self.center + Vec3::X * (4.0 * self.radius));
@@ -301,9 +298,7 @@ impl Light for SphereLight {
                 cone |= (self.samples_cone_from(c.p()) as u32) << i;
             }
             if cone == 0 {
-                for (i, out) in out.iter_mut().enumerate() {
-                    *out = self.sample_li(&ctx[i], u[i]);
-                }
+                sample_li_each(self, ctx, u, out);
                 continue;
             }
             let p = V3::<Lanes>::new(
