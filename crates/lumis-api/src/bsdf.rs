@@ -138,6 +138,13 @@ impl BsdfSampleLanes {
         })
     }
 
+    /// No sample in the lanes of `lanes`: the answer of a call that
+    /// faulted, the other lanes left as they are.
+    #[inline]
+    pub fn set_neutral(&mut self, lanes: LaneMask) {
+        self.valid = self.valid & !lanes;
+    }
+
     /// Sets lane `i` to `sample`.
     #[inline]
     pub fn set(&mut self, i: usize, sample: Option<BsdfSample>) {
@@ -165,6 +172,15 @@ impl BsdfEvalLanes {
     #[inline]
     pub fn get(&self, i: usize) -> (Rgb, f32) {
         (self.f.get(i), self.pdf[i])
+    }
+
+    /// Zero value and density in the lanes of `lanes`: the answer of a
+    /// call that faulted, the other lanes left as they are.
+    #[inline]
+    pub fn set_neutral(&mut self, lanes: LaneMask) {
+        for i in lanes.iter() {
+            self.set(i, (Rgb::BLACK, 0.0));
+        }
     }
 
     #[inline]
@@ -244,7 +260,7 @@ pub trait Bsdf: Send + Sync {
     /// The default loops over `sample_f`; a plugin overrides it to compute
     /// the lanes with SIMD, giving `sample_f`'s answer (`lumis
     /// check-plugin` compares the two).
-    #[on_fault(*out = BsdfSampleLanes::default())]
+    #[on_fault(out.set_neutral(active))]
     fn sample_f_lanes(
         &self,
         ctx: &[BsdfContext; LANES],
@@ -260,7 +276,7 @@ pub trait Bsdf: Send + Sync {
     /// [`Bsdf::eval`] for the lanes of `active` of a packet, as
     /// [`Bsdf::sample_f_lanes`] is `sample_f`: it sets the bits of
     /// `active` in `out.valid`, and leaves the other lanes as they are.
-    #[on_fault(*out = BsdfEvalLanes::default())]
+    #[on_fault(out.set_neutral(active))]
     fn eval_lanes(
         &self,
         ctx: &[BsdfContext; LANES],

@@ -117,6 +117,13 @@ impl LightSampleLanes {
         })
     }
 
+    /// No sample in the lanes of `lanes`: the answer of a call that
+    /// faulted, the other lanes left as they are.
+    #[inline]
+    pub fn set_neutral(&mut self, lanes: LaneMask) {
+        self.valid = self.valid & !lanes;
+    }
+
     #[inline]
     pub fn set(&mut self, i: usize, sample: Option<LightSample>) {
         self.valid.set(i, sample.is_some());
@@ -157,7 +164,7 @@ pub trait Light: Send + Sync {
     /// `active` are left as they are. The default loops over
     /// `sample_li`; a plugin overrides it to compute the lanes with SIMD,
     /// giving `sample_li`'s answer.
-    #[on_fault(*out = LightSampleLanes::default())]
+    #[on_fault(out.set_neutral(active))]
     fn sample_li_lanes(
         &self,
         ctx: &[LightSampleContext; LANES],
