@@ -290,6 +290,31 @@ fn a_panicking_plugin_is_an_error_not_an_abort() {
         assert!(!output.with_extension("exr").exists(), "{panic_in}");
     }
 
+    // The packet integrator asks the BSDF for its lanes; the trait's
+    // default runs inside the library and calls `sample_f` there, so the
+    // panic is the lane method's, and the same error.
+    let scene = dir.path().join("packet.toml");
+    std::fs::write(&scene, scene_with_plugin(lib, "sample-f")).unwrap();
+    let output = dir.path().join("packet");
+    let (code, _, stderr) = run(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--set",
+            "integrator.type=\"packet\"",
+            "-q",
+            "-o",
+            output.to_str().unwrap(),
+        ],
+        false,
+    );
+    assert_eq!(code, Some(1), "packet: {stderr}");
+    assert!(
+        stderr.contains("panicked in Bsdf::sample_f_lanes: the fixture panics in"),
+        "packet: {stderr}"
+    );
+    assert!(!output.with_extension("exr").exists(), "packet");
+
     // `--out` names a directory that does not exist yet: check-plugin
     // makes it before the first case.
     let out_dir = dir.path().join("check").join("pictures");
