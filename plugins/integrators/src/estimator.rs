@@ -228,6 +228,30 @@ pub fn extra_sample_ray(
     ))
 }
 
+/// The end of next-event estimation for an integrator that batches it:
+/// traces the shadow rays `rays` in one batch (`blocked` holds the
+/// answers) and hands `add` each light sample `pending[i] = (vertex,
+/// unshadowed contribution)` whose ray `rays[i]` reaches its light.
+pub fn add_unshadowed<S: Scene + ?Sized>(
+    scene: &SceneView<S>,
+    rays: &[Ray],
+    pending: &[(usize, Rgb)],
+    blocked: &mut Vec<bool>,
+    stats: &mut RenderStats,
+    mut add: impl FnMut(usize, Rgb),
+) {
+    blocked.clear();
+    blocked.resize(rays.len(), false);
+    stats.shadow_rays += rays.len() as u64;
+    scene.scene.occluded_batch(rays, blocked);
+    for (&(vertex, unshadowed), &blocked) in pending.iter().zip(blocked.iter()) {
+        if !blocked {
+            stats.light_samples += 1;
+            add(vertex, unshadowed);
+        }
+    }
+}
+
 /// How a ray was sampled, which is what the MIS weight of emission found
 /// along it depends on. In the path loop it is the state carried from one
 /// vertex to the next.

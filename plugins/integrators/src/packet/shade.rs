@@ -10,7 +10,7 @@ use lumis_api::{
     SamplerLanes, Scene, SurfaceInteraction, Vec2,
 };
 
-use crate::estimator::{bsdf_context, Estimator, SceneView, Vertex, VertexPlan};
+use crate::estimator::{add_unshadowed, bsdf_context, Estimator, SceneView, Vertex, VertexPlan};
 use crate::packet::state::PathLanes;
 use crate::path::PathIntegrator;
 
@@ -37,6 +37,11 @@ pub struct Bounce<'a, 's> {
     u1: Floats,
     u2: Vec2Lanes,
     samples: BsdfSampleLanes,
+    /// A round of light samples: each taker's context, the samples, and
+    /// the BSDF at their directions (only the takers' lanes are read).
+    light_ctx: [LightSampleContext; LANES],
+    light_samples: LightSampleLanes,
+    evals: BsdfEvalLanes,
     light_sums: RgbLanes,
     shadow_rays: Vec<Ray>,
     shadow_lanes: Vec<(usize, Rgb)>,
@@ -63,6 +68,9 @@ impl<'a, 's> Bounce<'a, 's> {
             u1: [0.0; LANES],
             u2: Vec2Lanes::default(),
             samples: BsdfSampleLanes::default(),
+            light_ctx: [LightSampleContext::at(Default::default()); LANES],
+            light_samples: LightSampleLanes::default(),
+            evals: BsdfEvalLanes::default(),
             light_sums: RgbLanes::default(),
             shadow_rays: Vec::with_capacity(LANES),
             shadow_lanes: Vec::with_capacity(LANES),
@@ -247,45 +255,46 @@ impl<'a, 's> Bounce<'a, 's> {
             }
 
             // Choose a light per lane, then one call per light chosen.
-            let mut ctx = [LightSampleContext::at(Default::default()); LANES];
             let mut chosen = [None::<SampledLight>; LANES];
             let mut u = Vec2Lanes::default();
             for lane in takers.iter() {
-                ctx[lane] = self.hit(lane).light_context();
-                chosen[lane] = scene.light_sampler.sample(&ctx[lane], numbers[lane].0);
+                let ctx = self.hit(lane).light_context();
+                chosen[lane] = scene.light_sampler.sample(&ctx, numbers[lane].0);
+                self.light_ctx[lane] = ctx;
                 u.set(lane, numbers[lane].1);
             }
-            let mut light_samples = LightSampleLanes::default();
-            let mut rest = mask_where(takers, |lane| chosen[lane].is_some());
-            while let Some(first) = rest.iter().next() {
-                let index = chosen[first].map(|c| c.index);
-                let group = mask_where(rest, |lane| chosen[lane].map(|c| c.index) == index);
-                let light = &scene.lights[index.expect("a chosen light") as usize];
-                light.sample_li_lanes(&ctx, &u, group, &mut light_samples);
-                rest = rest & !group;
+            let light_samples = &mut self.light_samples;
+            light_samples.valid = LaneMask::NONE;
+            let choosers = mask_where(takers, |lane| chosen[lane].is_some());
+            for (first, group) in groups(choosers, |lane| chosen[lane].map(|c| c.index)) {
+                let index = chosen[first].expect("a lane that chose a light").index;
+                let light = &scene.lights[index as usize];
+                light.sample_li_lanes(&self.light_ctx, &u, group, light_samples);
             }
 
             // The BSDF at each sampled direction, one call per BSDF.
-            let sampled = light_samples.valid & takers;
+            let sampled = self.light_samples.valid & takers;
             let mut wi = Vec3Lanes::default();
             for lane in sampled.iter() {
                 wi.set(
                     lane,
-                    self.hit(lane).shading.to_local(light_samples.wi.get(lane)),
+                    self.hit(lane)
+                        .shading
+                        .to_local(self.light_samples.wi.get(lane)),
                 );
             }
-            let mut evals = BsdfEvalLanes::default();
+            self.evals.valid = LaneMask::NONE;
             for (bsdf, group) in by_bsdf(sampled, self.bsdf_of) {
-                bsdf.eval_lanes(&self.ctx, &self.wo, &wi, group, &mut evals);
+                bsdf.eval_lanes(&self.ctx, &self.wo, &wi, group, &mut self.evals);
             }
 
             self.shadow_rays.clear();
             self.shadow_lanes.clear();
             for lane in sampled.iter() {
                 let chosen = chosen[lane].expect("a sampled lane chose a light");
-                let ls = light_samples.get(lane).expect("a sampled lane");
+                let ls = self.light_samples.get(lane).expect("a sampled lane");
                 let delta = scene.lights[chosen.index as usize].kind() == LightKind::DeltaPosition;
-                let (f, p_bsdf) = evals.get(lane);
+                let (f, p_bsdf) = self.evals.get(lane);
                 let p_bsdf = if delta { 0.0 } else { p_bsdf };
                 let wi_z = wi.z[lane];
                 if let Some(unshadowed) =
@@ -296,19 +305,15 @@ impl<'a, 's> Bounce<'a, 's> {
                         .push(self.hit(lane).point.ray_origins().spawn_ray_to(&ls.p));
                 }
             }
-            self.blocked.clear();
-            self.blocked.resize(self.shadow_rays.len(), false);
-            stats.shadow_rays += self.shadow_rays.len() as u64;
-            scene
-                .scene
-                .occluded_batch(&self.shadow_rays, &mut self.blocked);
-            for (&(lane, unshadowed), &blocked) in self.shadow_lanes.iter().zip(&self.blocked) {
-                if !blocked {
-                    stats.light_samples += 1;
-                    self.light_sums
-                        .set(lane, self.light_sums.get(lane) + unshadowed);
-                }
-            }
+            let light_sums = &mut self.light_sums;
+            add_unshadowed(
+                scene,
+                &self.shadow_rays,
+                &self.shadow_lanes,
+                &mut self.blocked,
+                stats,
+                |lane, unshadowed| light_sums.set(lane, light_sums.get(lane) + unshadowed),
+            );
         }
     }
 }
@@ -322,19 +327,30 @@ fn mask_where(lanes: LaneMask, holds: impl Fn(usize) -> bool) -> LaneMask {
     mask
 }
 
+/// The lanes of `lanes` grouped by `key`, each group as its first lane and
+/// its mask, in the order of their first lanes.
+fn groups<K: PartialEq>(
+    lanes: LaneMask,
+    key: impl Fn(usize) -> K,
+) -> impl Iterator<Item = (usize, LaneMask)> {
+    let mut rest = lanes;
+    std::iter::from_fn(move || {
+        let first = rest.iter().next()?;
+        let first_key = key(first);
+        let group = mask_where(rest, |lane| key(lane) == first_key);
+        rest = rest & !group;
+        Some((first, group))
+    })
+}
+
 /// The lanes of `lanes` grouped by their BSDF (`bsdf_of`), each BSDF with
-/// the mask of its lanes, in the order of their first lanes.
+/// the mask of its lanes.
 fn by_bsdf(
     lanes: LaneMask,
     bsdf_of: [Option<&dyn Bsdf>; LANES],
 ) -> impl Iterator<Item = (&dyn Bsdf, LaneMask)> {
     let identity =
         move |lane: usize| bsdf_of[lane].map(|bsdf| (bsdf as *const dyn Bsdf).cast::<()>());
-    let mut rest = lanes;
-    std::iter::from_fn(move || {
-        let first = rest.iter().next()?;
-        let group = mask_where(rest, |lane| identity(lane) == identity(first));
-        rest = rest & !group;
-        Some((bsdf_of[first].expect("a shaded lane has a BSDF"), group))
-    })
+    groups(lanes, identity)
+        .map(move |(first, group)| (bsdf_of[first].expect("a shaded lane has a BSDF"), group))
 }

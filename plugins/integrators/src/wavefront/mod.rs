@@ -26,7 +26,9 @@ use lumis_api::{
     Scene, SurfaceInteraction, Vec2, Vec3,
 };
 
-use crate::estimator::{bsdf_context, extra_sample_ray, SceneView, Vertex, VertexPlan};
+use crate::estimator::{
+    add_unshadowed, bsdf_context, extra_sample_ray, SceneView, Vertex, VertexPlan,
+};
 use crate::path::{PathIntegrator, PathParams};
 use crate::path_state::PathState;
 use batched::{Batcher, BsdfLane};
@@ -110,13 +112,6 @@ fn hit_of<'a, 's>(
     found[v.found].as_ref().expect("a wave vertex is a hit")
 }
 
-/// A light sample of a wave vertex waiting for its shadow ray.
-#[derive(Clone, Copy)]
-struct PendingShadow {
-    vertex: usize,
-    unshadowed: Rgb,
-}
-
 /// Everything a wave keeps between stages and bounces, allocated once per
 /// wave: the paths, and the buffers each stage fills for the next.
 struct Wave<'s> {
@@ -154,7 +149,9 @@ struct LightStage {
     vertex_of: Vec<usize>,
     wi: Vec<Vec3>,
     evals: Vec<(Rgb, f32)>,
-    pending: Vec<PendingShadow>,
+    /// The light samples waiting for their shadow rays: (vertex,
+    /// unshadowed contribution).
+    pending: Vec<(usize, Rgb)>,
     shadow_rays: Vec<Ray>,
     blocked: Vec<bool>,
 }
@@ -410,10 +407,7 @@ impl WavefrontIntegrator {
                 if let Some(unshadowed) =
                     estimator.light_contribution(chosen.pmf, ls, delta, f, p_bsdf, wi.z)
                 {
-                    stage.pending.push(PendingShadow {
-                        vertex: k,
-                        unshadowed: unshadowed(),
-                    });
+                    stage.pending.push((k, unshadowed()));
                     stage.shadow_rays.push(
                         hit_of(&wave.found, &vertices[k])
                             .point
@@ -422,18 +416,15 @@ impl WavefrontIntegrator {
                     );
                 }
             }
-            stage.blocked.clear();
-            stage.blocked.resize(stage.shadow_rays.len(), false);
-            stats.shadow_rays += stage.shadow_rays.len() as u64;
-            scene
-                .scene
-                .occluded_batch(&stage.shadow_rays, &mut stage.blocked);
-            for (p, &blocked) in stage.pending.iter().zip(&stage.blocked) {
-                if !blocked {
-                    stats.light_samples += 1;
-                    wave.light_sums[p.vertex] += p.unshadowed;
-                }
-            }
+            let light_sums = &mut wave.light_sums;
+            add_unshadowed(
+                scene,
+                &stage.shadow_rays,
+                &stage.pending,
+                &mut stage.blocked,
+                stats,
+                |k, unshadowed| light_sums[k] += unshadowed,
+            );
         }
     }
 
