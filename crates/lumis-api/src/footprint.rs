@@ -71,7 +71,7 @@ impl PixelFootprint {
     }
 }
 
-/// The uv footprint as a [`TextureQuery`] carries it: `du/dx, dv/dx,
+/// The uv footprint as a [`TextureQuery`](crate::texture::TextureQuery) carries it: `du/dx, dv/dx,
 /// du/dy, dv/dy` in IEEE half precision. A hit is copied at every path
 /// vertex, and at 128 bytes or less the copy stays inline (see
 /// `interaction.rs`); four f32s would take it past that, and a footprint
