@@ -23,6 +23,7 @@ use lumis_cli::{
     INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
+use lumis_sampling::simd::{self, Isa};
 
 #[derive(Parser)]
 #[command(
@@ -165,15 +166,21 @@ enum SamplersCommand {
 }
 
 /// What `lumis --version` prints after the name: the versions a plugin
-/// library must match to load.
+/// library must match to load, and the instruction sets of the SIMD
+/// kernels with the one this CPU runs.
 fn version_text() -> String {
     use lumis_core::plugin::{
         API_VERSION, INTERFACE_FINGERPRINT, PLUGIN_ABI_VERSION, RUSTC_VERSION,
     };
+    let built: Vec<_> = Isa::BUILT.iter().map(|isa| isa.name()).collect();
     format!(
         "{}\nlumis-api {API_VERSION}, plugin ABI {PLUGIN_ABI_VERSION}, plugin interface \
-         {INTERFACE_FINGERPRINT}\nbuilt by {RUSTC_VERSION}",
-        env!("CARGO_PKG_VERSION")
+         {INTERFACE_FINGERPRINT}\nbuilt by {RUSTC_VERSION}\nSIMD kernels for {}; this CPU \
+         runs them with {} ({} chooses)",
+        env!("CARGO_PKG_VERSION"),
+        built.join(", "),
+        simd::chosen(),
+        simd::ENV,
     )
 }
 
@@ -182,6 +189,10 @@ fn main() -> ExitCode {
     let version: &'static str = Box::leak(version_text().into_boxed_str());
     let matches = Cli::command().version(version).get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    if let Err(why) = simd::choose_from_env() {
+        eprintln!("error: {why}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Render(args) => interruptible(|stop| {
             let registry = registry_with_search_path()?;

@@ -441,6 +441,7 @@ pub fn render_scene_file(
         for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
             eprintln!("{line}");
         }
+        eprintln!("SIMD kernels: {}", lumis_sampling::simd::chosen());
     }
     if args.verbose {
         eprintln!("{}", describe(&loaded));

@@ -8,8 +8,10 @@
 //!
 //! The workspace denies `unsafe` code except in the crates that call C or
 //! load libraries: this one (Embree), `lumis-denoise`'s `ffi` module
-//! (Open Image Denoise), `lumis-loader` (plugin libraries) and the plugin
-//! declaration of `lumis-api`. Each block says why it is sound.
+//! (Open Image Denoise), `lumis-loader` (plugin libraries), the plugin
+//! declaration of `lumis-api`, and the calls of `lumis-sampling::simd`
+//! into code compiled for a CPU feature it has checked. Each block says
+//! why it is sound.
 
 #![allow(unsafe_code)]
 

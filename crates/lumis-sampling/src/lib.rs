@@ -18,6 +18,7 @@ pub mod radical_inverse;
 pub mod real;
 pub mod rng;
 pub mod scramble;
+pub mod simd;
 pub mod sobol;
 pub mod special;
 pub mod spherical_rectangle;

@@ -20,6 +20,7 @@ use lumis_api::{
 };
 
 use lumis_sampling::real::{load, F32x8, Real, V3};
+use lumis_sampling::simd;
 
 use crate::fresnel;
 use crate::lobe_sampling::{LobeSampling, MicrofacetLobeSampling};
@@ -386,17 +387,19 @@ impl Bsdf for Conductor {
             return eval_each(self, ctx, wo, wi, out);
         };
         let width = Lanes::LANES;
-        for ((wo, wi), out) in wo
-            .chunks(width)
-            .zip(wi.chunks(width))
-            .zip(out.chunks_mut(width))
-        {
-            let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, wi);
-            let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = (Rgb::new(f[0][i], f[1][i], f[2][i]), pdf[i]);
+        simd::dispatch(|| {
+            for ((wo, wi), out) in wo
+                .chunks(width)
+                .zip(wi.chunks(width))
+                .zip(out.chunks_mut(width))
+            {
+                let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, wi);
+                let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
+                for (i, out) in out.iter_mut().enumerate() {
+                    *out = (Rgb::new(f[0][i], f[1][i], f[2][i]), pdf[i]);
+                }
             }
-        }
+        })
     }
 
     /// A packet's lanes through the SIMD [`Bsdf::eval_batch`].
@@ -447,42 +450,44 @@ impl Bsdf for Conductor {
             _ => return sample_f_each(self, ctx, wo, u1, u2, out),
         };
         let width = Lanes::LANES;
-        for ((wo, u2), out) in wo
-            .chunks(width)
-            .zip(u2.chunks(width))
-            .zip(out.chunks_mut(width))
-        {
-            let n = out.len();
-            // Lanes below the surface (no sample) draw for the normal.
-            let w = V3::<Lanes>::load(wo, Vec3::Z);
-            let w = V3::select(w.z.gt(Lanes::splat(0.0)), w, V3::splat(Vec3::Z));
-            let u = [
-                load(u2, Vec2::splat(0.5), |u| u.x),
-                load(u2, Vec2::splat(0.5), |u| u.y),
-            ];
-            let m = mf.sample_visible(w, u);
-            let above = |i: usize| wo[i].z > 0.0;
-            // A lane without a sample gets a direction below the surface,
-            // which has no lobe.
-            let mut wi = [-Vec3::Z; MAX_LANES];
-            for (i, wi) in wi[..n].iter_mut().enumerate() {
-                let m = m.lane(i);
-                // A facet facing away from wo would reflect into itself.
-                if above(i) && wo[i].dot(m) > 0.0 {
-                    *wi = fresnel::reflect(wo[i], m);
+        simd::dispatch(|| {
+            for ((wo, u2), out) in wo
+                .chunks(width)
+                .zip(u2.chunks(width))
+                .zip(out.chunks_mut(width))
+            {
+                let n = out.len();
+                // Lanes below the surface (no sample) draw for the normal.
+                let w = V3::<Lanes>::load(wo, Vec3::Z);
+                let w = V3::select(w.z.gt(Lanes::splat(0.0)), w, V3::splat(Vec3::Z));
+                let u = [
+                    load(u2, Vec2::splat(0.5), |u| u.x),
+                    load(u2, Vec2::splat(0.5), |u| u.y),
+                ];
+                let m = mf.sample_visible(w, u);
+                let above = |i: usize| wo[i].z > 0.0;
+                // A lane without a sample gets a direction below the surface,
+                // which has no lobe.
+                let mut wi = [-Vec3::Z; MAX_LANES];
+                for (i, wi) in wi[..n].iter_mut().enumerate() {
+                    let m = m.lane(i);
+                    // A facet facing away from wo would reflect into itself.
+                    if above(i) && wo[i].dot(m) > 0.0 {
+                        *wi = fresnel::reflect(wo[i], m);
+                    }
+                }
+                let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, &wi[..n]);
+                let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
+                for (i, out) in out.iter_mut().enumerate() {
+                    *out = BsdfSample::reflection(
+                        wi[i],
+                        BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
+                        |_| pdf[i],
+                        |_| Rgb::new(f[0][i], f[1][i], f[2][i]),
+                    );
                 }
             }
-            let (f, pdf) = self.eval_lanes::<Lanes>(mf, fresnel, wo, &wi[..n]);
-            let (f, pdf) = (f.map(Lanes::to_array), pdf.to_array());
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = BsdfSample::reflection(
-                    wi[i],
-                    BsdfFlags::GLOSSY | BsdfFlags::REFLECTION,
-                    |_| pdf[i],
-                    |_| Rgb::new(f[0][i], f[1][i], f[2][i]),
-                );
-            }
-        }
+        })
     }
 }
 

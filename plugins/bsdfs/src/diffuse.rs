@@ -9,7 +9,7 @@ use lumis_api::{
     PluginSpec, Result, Rgb, TexturedRgb, Vec2, Vec3,
 };
 use lumis_sampling::real::F32x8;
-use lumis_sampling::warp;
+use lumis_sampling::{simd, warp};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
@@ -165,8 +165,11 @@ impl Bsdf for Diffuse {
         if self.sampling != DiffuseSampling::Cosine {
             return sample_f_each_lane(self, ctx, wo, u1, u2, active, out);
         }
-        let local = warp::square_to_cosine_hemisphere_lanes([F32x8::from(u2.x), F32x8::from(u2.y)]);
-        let [x, y, z] = [local.x, local.y, local.z].map(F32x8::to_array);
+        let [x, y, z] = simd::dispatch(|| {
+            let local =
+                warp::square_to_cosine_hemisphere_lanes([F32x8::from(u2.x), F32x8::from(u2.y)]);
+            [local.x, local.y, local.z].map(F32x8::to_array)
+        });
         for i in active.iter() {
             let local = Vec3::new(x[i], y[i], z[i]);
             let sample = self

@@ -15,6 +15,7 @@ use lumis_api::{
     Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::real::{load, F32x8, Real, V3};
+use lumis_sampling::simd;
 use lumis_sampling::warp;
 
 use crate::area::{Emission, EmissionParams, Sampling};
@@ -288,35 +289,37 @@ impl Light for SphereLight {
         // Padding lanes look from a point outside.
         let pad = LightSampleContext::at(self.center + Vec3::X * (4.0 * self.radius));
         let width = Lanes::LANES;
-        for ((ctx, u), out) in ctx
-            .chunks(width)
-            .zip(u.chunks(width))
-            .zip(out.chunks_mut(width))
-        {
-            let mut cone = 0u32;
-            for (i, c) in ctx.iter().enumerate() {
-                cone |= (self.samples_cone_from(c.p()) as u32) << i;
+        simd::dispatch(|| {
+            for ((ctx, u), out) in ctx
+                .chunks(width)
+                .zip(u.chunks(width))
+                .zip(out.chunks_mut(width))
+            {
+                let mut cone = 0u32;
+                for (i, c) in ctx.iter().enumerate() {
+                    cone |= (self.samples_cone_from(c.p()) as u32) << i;
+                }
+                if cone == 0 {
+                    sample_li_each(self, ctx, u, out);
+                    continue;
+                }
+                let p = V3::<Lanes>::new(
+                    load(ctx, pad, |c| c.p().x),
+                    load(ctx, pad, |c| c.p().y),
+                    load(ctx, pad, |c| c.p().z),
+                );
+                let u_lanes = [load(u, Vec2::ZERO, |u| u.x), load(u, Vec2::ZERO, |u| u.y)];
+                let (wi, n_out, pdf) = self.sample_cone_lanes(p, u_lanes);
+                let pdf = pdf.to_array();
+                for (i, out) in out.iter_mut().enumerate() {
+                    *out = if cone >> i & 1 != 0 {
+                        self.cone_sample(wi.lane(i), n_out.lane(i), pdf[i])
+                    } else {
+                        self.sample_area(&ctx[i], u[i])
+                    };
+                }
             }
-            if cone == 0 {
-                sample_li_each(self, ctx, u, out);
-                continue;
-            }
-            let p = V3::<Lanes>::new(
-                load(ctx, pad, |c| c.p().x),
-                load(ctx, pad, |c| c.p().y),
-                load(ctx, pad, |c| c.p().z),
-            );
-            let u_lanes = [load(u, Vec2::ZERO, |u| u.x), load(u, Vec2::ZERO, |u| u.y)];
-            let (wi, n_out, pdf) = self.sample_cone_lanes(p, u_lanes);
-            let pdf = pdf.to_array();
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = if cone >> i & 1 != 0 {
-                    self.cone_sample(wi.lane(i), n_out.lane(i), pdf[i])
-                } else {
-                    self.sample_area(&ctx[i], u[i])
-                };
-            }
-        }
+        })
     }
 
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {

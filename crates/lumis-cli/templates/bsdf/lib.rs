@@ -16,7 +16,7 @@ use lumis_api::{
     Registrar, Result, Rgb, Vec2, Vec3,
 };
 use lumis_sampling::real::F32x8;
-use lumis_sampling::warp;
+use lumis_sampling::{simd, warp};
 
 /// The plugin as a scene names it (`type = "{{plugin}}"`) and as
 /// `lumis plugins` lists it.
@@ -122,8 +122,12 @@ impl Bsdf for Lambertian {
         active: LaneMask,
         out: &mut BsdfSampleLanes,
     ) {
-        let wi = warp::square_to_cosine_hemisphere_lanes([F32x8::from(u2.x), F32x8::from(u2.y)]);
-        let [x, y, z] = [wi.x, wi.y, wi.z].map(F32x8::to_array);
+        // Compiled for SSE2, AVX2 and AVX-512, run with what the CPU has.
+        let [x, y, z] = simd::dispatch(|| {
+            let wi =
+                warp::square_to_cosine_hemisphere_lanes([F32x8::from(u2.x), F32x8::from(u2.y)]);
+            [wi.x, wi.y, wi.z].map(F32x8::to_array)
+        });
         for i in active.iter() {
             out.set(i, self.sample_from(&ctx[i], wo.get(i), Vec3::new(x[i], y[i], z[i])));
         }
