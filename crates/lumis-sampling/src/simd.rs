@@ -50,12 +50,13 @@ impl Isa {
         }
     }
 
-    /// 32-bit floats per register.
-    pub fn f32_per_register(self) -> usize {
+    /// The CPU features the kernels are compiled with.
+    pub fn features(self) -> &'static str {
         match self {
-            Isa::Baseline => 4,
-            Isa::Avx2 => 8,
-            Isa::Avx512 => 16,
+            Isa::Baseline if cfg!(target_arch = "x86_64") => "the x86-64 baseline",
+            Isa::Baseline => "the target's baseline",
+            Isa::Avx2 => "AVX2 and FMA",
+            Isa::Avx512 => "AVX-512 F, BW, DQ and VL",
         }
     }
 
@@ -131,12 +132,7 @@ impl Isa {
 
 impl fmt::Display for Isa {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} ({} f32 per register)",
-            self.name(),
-            self.f32_per_register()
-        )
+        write!(f, "{} ({})", self.name(), self.features())
     }
 }
 
