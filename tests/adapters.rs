@@ -98,7 +98,7 @@ fn normal_mapped(normals: [f32; 3]) -> String {
 
 #[test]
 fn normalmap_leans_toward_u_and_the_images_up_in_a_scene_file() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let (s, c) = (0.5f32.sqrt() * 0.5, 0.5 + 0.5 * 0.5f32.sqrt());
     for (normals, lean) in [
         ([0.5 + s, 0.5, c], Vec3::X),

@@ -9,7 +9,7 @@ use lumis_tests::{assert_same_mean, bonferroni_z, read_scene, render_toml, scene
 
 /// Loads `scenes/<name>` with `overrides`.
 fn load(name: &str, overrides: &[String]) -> LoadedScene {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let path = scenes_dir().join(name);
     lumis_scene::load_file(&path, overrides, &registry)
         .unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
@@ -128,7 +128,7 @@ fn same_mean_as_path_on_every_bench_scene() {
     let integrators = ["wavefront", "packet"];
     let block = 8;
     let z = bonferroni_z(1e-3, scenes.len() * integrators.len() * 4 * 3 * 3);
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let common = ["film.resolution=[32, 24]", "sampler.spp=16"];
     for scene in &scenes {
         let name = scene.file_name().unwrap().to_string_lossy().into_owned();

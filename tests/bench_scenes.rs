@@ -13,7 +13,7 @@ use lumis_tests::{render_loaded, scenes_dir};
 #[test]
 fn every_bench_scene_renders() {
     let dir = scenes_dir().join("bench");
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let mut scenes: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())

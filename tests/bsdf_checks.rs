@@ -9,7 +9,7 @@ use lumis_core::PluginKind;
 
 #[test]
 fn every_builtin_bsdf_passes_the_check_suite() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let names: Vec<&str> = registry
         .names(PluginKind::Bsdf)
         .into_iter()

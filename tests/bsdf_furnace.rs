@@ -262,7 +262,7 @@ fn rendered_means(case: &Case, first_seed: u64) -> Vec<f64> {
 
 #[test]
 fn every_bsdf_in_the_white_furnace() {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let cases = cases();
     // Two-sided, family-wise false alarm rate 1e-3 over all cases.
     let tail = 1e-3 / (2.0 * cases.len() as f64);
@@ -320,7 +320,7 @@ fn every_bsdf_in_the_white_furnace() {
 /// where it is not (doubling the nodes changes nothing that matters).
 #[test]
 fn the_albedo_quadrature_is_converged() {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let bsdf = |name: &str, params: &str| {
         instantiate(&registry, name, &variant(name, params).unwrap()).unwrap()
     };

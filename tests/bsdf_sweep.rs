@@ -36,7 +36,7 @@ fn beyond_f32_at_grazing(r: &CaseResult) -> bool {
 /// in `beyond_f32` (and those of [`beyond_f32_at_grazing`]) left out;
 /// every other check still applies to them.
 fn run_except(name: &str, variants: Vec<Variant>, beyond_f32: &[(&str, f32)]) {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let results =
         check_bsdf_variants(&registry, name, &variants, &BsdfCheckConfig::default()).unwrap();
     let report = format_results(&results);

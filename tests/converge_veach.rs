@@ -9,7 +9,7 @@ use lumis_tests::scenes_dir;
 
 #[test]
 fn mis_is_more_efficient_than_either_single_strategy() {
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     example_bsdf::register(&mut registry).unwrap();
     let out = std::env::temp_dir().join(format!("lumis-converge-veach-{}", std::process::id()));
     let args = ConvergeArgs {

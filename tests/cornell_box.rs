@@ -99,7 +99,7 @@ fn bit_identical_for_any_thread_count() {
 /// image, bit for bit, for every integrator and strategy.
 #[test]
 fn concrete_and_dyn_scene_loops_agree() {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let path = read_scene("cornell-box.toml");
     let path_keys = "type = \"path\"\nmax_depth = 8\nrr_depth = 5\n";
     assert!(path.contains(path_keys));
@@ -163,7 +163,7 @@ fn concrete_and_dyn_scene_loops_agree() {
 /// middle of the box checks that the stored frames face the same way.
 #[test]
 fn stored_flat_frames_match_frames_computed_at_the_hit() {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     let scene = read_scene("cornell-box.toml")
         + "\n[[shape]]\ntype = \"quad\"\ncorner = [-0.3, -0.2, 0.2]\n\
            edge_u = [0.5, 0.1, 0.0]\nedge_v = [0.1, 0.4, 0.3]\n\

@@ -39,7 +39,7 @@ fn test_dir(name: &str) -> tempfile::TempDir {
 }
 
 fn try_load(dir: &Path, toml: &str) -> Result<LoadedScene, String> {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     lumis_scene::load_str(toml, &dir.join("test.toml"), &[], &registry).map_err(|e| e.to_string())
 }
 
@@ -411,7 +411,7 @@ fn plastic_params(rgb: [f32; 3], alpha: f32) -> String {
 fn dielectric(rgb: [f32; 3]) -> [f32; 3] {
     let text = format!("type = \"plastic\"\n{}", plastic_params(rgb, 1.0));
     let table = lumis_core::doc::parse(&text, "expected").unwrap();
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let entity = PluginEntity::from_table(
         PluginKind::Bsdf,
         "expected",
@@ -1293,7 +1293,7 @@ fn emissive_instances_get_their_own_world_space_lights() {
 
 #[test]
 fn the_example_scene_loads() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let scene = lumis_scene::load_file(
         &lumis_tests::scenes_dir().join("gltf-boxes.toml"),
         &[],

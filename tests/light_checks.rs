@@ -50,7 +50,7 @@ fn every_builtin_light_passes_the_full_check_suite() {
 }
 
 fn every_builtin_light_passes(cfg: &LightCheckConfig) {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let lights = names(&registry, PluginKind::Light);
     assert!(lights.len() >= 6, "{lights:?}");
     let mut failures = Vec::new();
@@ -86,7 +86,7 @@ fn every_builtin_light_passes(cfg: &LightCheckConfig) {
 /// Delta lights are reported as not testable, never as passed or failed.
 #[test]
 fn delta_lights_are_not_testable() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let cfg = fast();
     for name in ["point", "spot"] {
         let results = check_light_with(&registry, name, &[], &cfg).unwrap();
@@ -162,7 +162,7 @@ fn environment_only(params: &Params, shape: &LightShape) -> Result<()> {
 
 #[test]
 fn a_light_whose_pdf_is_three_percent_off_fails() {
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     registry
         .add_light(cosine_spec("cosine"), |p, shape| {
             environment_only(p, shape)?;
@@ -197,7 +197,7 @@ fn a_light_whose_pdf_is_three_percent_off_fails() {
 
 #[test]
 fn every_builtin_light_sampler_passes_the_check_suite() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let samplers = names(&registry, PluginKind::LightSampler);
     assert!(samplers.len() >= 2, "{samplers:?}");
     for name in samplers {
@@ -298,7 +298,7 @@ fn sampler_spec(name: &'static str) -> PluginSpec {
 
 #[test]
 fn a_light_sampler_whose_pmf_disagrees_with_its_draws_fails() {
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     registry
         .add_light_sampler(sampler_spec("lying"), |_, lights| {
             Ok(Box::new(Lying {

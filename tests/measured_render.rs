@@ -64,7 +64,7 @@ fn temp_dir(tag: &str) -> PathBuf {
 }
 
 fn bsdf(toml: &str) -> std::sync::Arc<dyn Bsdf> {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let table = lumis_core::doc::parse(toml, "<test>").unwrap();
     let entity = lumis_core::PluginEntity::from_table(
         lumis_core::PluginKind::Bsdf,
@@ -185,7 +185,7 @@ fn every_strategy_estimates_the_same_albedo() {
 #[test]
 fn tabulate_refuses_what_the_format_cannot_hold() {
     let dir = temp_dir("refuse");
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let try_tab = |plugin: &str, set: &[&str]| {
         tabulate_bsdf(
             &TabulateArgs {
@@ -259,7 +259,7 @@ fn scene_with(material_block: &str) -> String {
 
 #[test]
 fn scene_errors_name_the_file() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let text = read_scene("measured-sphere.toml");
     let load = |overrides: &[String]| {
         lumis_scene::load_str(&text, &scenes_dir().join("s.toml"), overrides, &registry)
@@ -316,7 +316,7 @@ const REFERENCE_SPP: u32 = 4096;
 #[test]
 fn measured_results_table() {
     let dir = temp_dir("table");
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let mut out = String::new();
     out.push_str(&format!(
         "scenes/measured-sphere.toml, {SPP} spp x {SEEDS} seeds, BSDF sampling only; reference {REFERENCE_SPP} spp (tabulated sampling for the tables, the model's own for the analytic BSDFs)\n"

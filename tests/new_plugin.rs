@@ -166,7 +166,7 @@ fn a_new_integrator_renders_the_mean_of_path() {
     let lumis = build_lumis();
     let parent = tempfile::tempdir().unwrap();
     let library = build(&new_plugin(&lumis, "integrator", parent.path()));
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     lumis_loader::load_library(&library, &mut registry).unwrap();
     let generated = render_toml_with(&registry, &scene("my-integrator", 1), &[], 0).image;
     let path = render_toml_with(&registry, &scene("path", 2), &[], 0).image;

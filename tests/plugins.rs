@@ -64,7 +64,7 @@ emission = {{ radiance = [18.387, 13.9873, 6.75357] }}
 #[test]
 fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     let library = build_example_plugin();
-    let builtin = lumis_cli::builtin_registry().unwrap();
+    let builtin = lumis_app::builtin_registry().unwrap();
 
     // Without the plugin, the type is unknown.
     let err = lumis_scene::load_str(
@@ -82,14 +82,14 @@ fn dynamically_loaded_bsdf_renders_like_the_linked_one() {
     let dynamic = render_toml_with(&builtin, &scene(&plugins, 1), &[], 0).image;
     assert!(dynamic.mean()[0] > 0.01, "the plugin's render is black");
 
-    let mut linked = lumis_cli::builtin_registry().unwrap();
+    let mut linked = lumis_app::builtin_registry().unwrap();
     example_bsdf::register(&mut linked).unwrap();
     let reference = render_toml_with(&linked, &scene("", 2), &[], 0).image;
     let z = bonferroni_z(1e-3, 4 * 4 * 3);
     assert_same_mean(&dynamic, &reference, 8, z, "dynamic vs linked phong");
 
     // The loaded BSDF passes the same statistical checks as the built-in ones.
-    let mut loaded = lumis_cli::builtin_registry().unwrap();
+    let mut loaded = lumis_app::builtin_registry().unwrap();
     lumis_loader::load_library(&library, &mut loaded).unwrap();
     let results = check_bsdf(&loaded, "phong", &BsdfCheckConfig::default()).unwrap();
     assert!(
@@ -124,7 +124,7 @@ fn plugin_search_path_is_loaded_at_start_up() {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::copy(&library, dir.join(library.file_name().unwrap())).unwrap();
     std::env::set_var(lumis_loader::PLUGIN_PATH_VAR, &dir);
-    let registry = lumis_cli::registry_with_search_path().unwrap();
+    let registry = lumis_app::registry_with_search_path().unwrap();
     std::env::remove_var(lumis_loader::PLUGIN_PATH_VAR);
     let phong = registry
         .find(lumis_core::PluginKind::Bsdf, "phong")
@@ -145,7 +145,7 @@ fn plugin_search_path_is_loaded_at_start_up() {
 #[test]
 fn library_from_another_lumis_core_is_refused_before_registering() {
     let library = build_plugin("foreign-plugin", "foreign_plugin");
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     // Its register function panics: reaching it would fail differently.
     let err = lumis_loader::load_library(&library, &mut registry)
         .unwrap_err()
@@ -164,7 +164,7 @@ fn library_from_another_lumis_core_is_refused_before_registering() {
 #[test]
 fn library_with_another_plugin_interface_is_refused_before_registering() {
     let library = build_plugin("altered-interface-plugin", "altered_interface_plugin");
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     // Its register function panics: reaching it would fail differently.
     let err = lumis_loader::load_library(&library, &mut registry)
         .unwrap_err()
@@ -193,7 +193,7 @@ fn plugin_copy(tag: &str) -> (PathBuf, PathBuf) {
 #[test]
 fn a_library_named_twice_loads_once() {
     let (dir, copy) = plugin_copy("plugin-twice");
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     lumis_loader::load_library(&copy, &mut registry).unwrap();
     let again = dir.join(".").join(copy.file_name().unwrap());
     lumis_loader::load_library(&again, &mut registry).unwrap();

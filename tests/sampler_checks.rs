@@ -22,7 +22,7 @@ fn fast() -> SamplerCheckConfig {
 
 #[test]
 fn every_builtin_sampler_passes_the_check_suite() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let names = registry.names(PluginKind::Sampler);
     assert!(names.len() >= 7, "{names:?}");
     let mut failures = Vec::new();
@@ -131,7 +131,7 @@ fn register<const DEFECT: u8>(registry: &mut Registry, name: &'static str) {
 
 #[test]
 fn samplers_with_planted_defects_fail() {
-    let mut registry = lumis_cli::builtin_registry().unwrap();
+    let mut registry = lumis_app::builtin_registry().unwrap();
     register::<0>(&mut registry, "gives-one");
     register::<1>(&mut registry, "order-dependent");
     register::<2>(&mut registry, "false-net");

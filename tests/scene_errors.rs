@@ -35,7 +35,7 @@ fn assert_contains(err: &str, parts: &[&str]) {
 
 #[test]
 fn base_scene_loads() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let toml = with(
         "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nbsdf = \"white\"\n",
     );
@@ -44,7 +44,7 @@ fn base_scene_loads() {
 
 #[test]
 fn missing_scene_file() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let err = lumis_scene::load_file(std::path::Path::new("no/such/scene.toml"), &[], &registry)
         .err()
         .unwrap()

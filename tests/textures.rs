@@ -156,7 +156,7 @@ fn bad_texture_references_are_located_errors() {
 
 #[test]
 fn the_example_scene_loads() {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let text = lumis_tests::read_scene("textured-quads.toml");
     let path = scenes_dir().join("textured-quads.toml");
     lumis_scene::load_str(&text, &path, &[], &registry).unwrap_or_else(|e| panic!("{e}"));

@@ -28,7 +28,7 @@ const PLATE_EXPONENTS: [f32; 4] = [8000.0, 2000.0, 400.0, 80.0];
 fn registry() -> &'static Registry {
     static REGISTRY: OnceLock<Registry> = OnceLock::new();
     REGISTRY.get_or_init(|| {
-        let mut r = lumis_cli::builtin_registry().expect("built-in plugins register");
+        let mut r = lumis_app::builtin_registry().expect("built-in plugins register");
         example_bsdf::register(&mut r).expect("phong registers");
         r
     })

@@ -1,10 +1,6 @@
-//! Puts the library directories found by lumis-embree (Embree) and
-//! lumis-denoise (Open Image Denoise) into the rpath of the `lumis` binary
-//! and this crate's tests.
+//! Puts the directories of the native libraries that lumis-embree (Embree)
+//! and lumis-denoise (Open Image Denoise) provisioned into the rpath of
+//! this crate's binaries and tests.
 fn main() {
-    for dir in ["DEP_LUMIS_EMBREE_LIBDIR", "DEP_LUMIS_OIDN_LIBDIR"] {
-        if let Ok(dir) = std::env::var(dir) {
-            println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
-        }
-    }
+    lumis_provision::rpath_of_dependencies();
 }

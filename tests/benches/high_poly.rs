@@ -149,7 +149,7 @@ fn hash2(i: u64) -> Vec2 {
 /// Child process: load the scene, report memory and times, then trace.
 fn child(scene_path: &Path) {
     let baseline_kb = status_kb("VmRSS:");
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let start = Instant::now();
     let loaded = lumis_scene::load_file(scene_path, &[], &registry).unwrap();
     let res = loaded.camera.resolution();

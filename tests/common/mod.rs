@@ -14,7 +14,7 @@ use lumis_scene::LoadedScene;
 /// Loads `toml` (relative paths resolve against `scenes/`) with overrides
 /// and renders it with the scene's own spp and seed.
 pub fn render_toml(toml: &str, overrides: &[&str], threads: usize) -> RenderOutput {
-    let registry = lumis_cli::builtin_registry().expect("built-in plugins register");
+    let registry = lumis_app::builtin_registry().expect("built-in plugins register");
     render_toml_with(&registry, toml, overrides, threads)
 }
 
@@ -167,7 +167,7 @@ pub fn scenes_dir() -> std::path::PathBuf {
 /// The error loading `toml` gives, located in a scene file `bad.toml` of
 /// the working directory (the scene names no files); panics if it loads.
 pub fn load_error(toml: &str) -> String {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     match lumis_scene::load_str(toml, Path::new("bad.toml"), &[], &registry) {
         Ok(_) => panic!("scene unexpectedly loaded:\n{toml}"),
         Err(e) => e.to_string(),
@@ -288,7 +288,7 @@ pub const MEASURED_MATERIALS: [(&str, &str, &[&str]); 3] = [
 pub fn assert_measured_variants_pass(variants: &[lumis_check::bsdf_suite::Variant], dir: &Path) {
     use lumis_check::bsdf_suite::{check_bsdf_variants, format_results, BsdfCheckConfig};
     use lumis_check::outcome::Outcome;
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let results =
         check_bsdf_variants(&registry, "measured", variants, &BsdfCheckConfig::default()).unwrap();
     let report = format_results(&results);
@@ -301,7 +301,7 @@ pub fn assert_measured_variants_pass(variants: &[lumis_check::bsdf_suite::Varian
 /// table `dir/name.binary`, as `lumis brdf tabulate` does.
 pub fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> std::path::PathBuf {
     let output = dir.join(format!("{name}.binary"));
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     lumis_cli::tabulate_bsdf(
         &lumis_cli::TabulateArgs {
             bsdf: bsdf.into(),

@@ -145,7 +145,7 @@ fn located(result: lumis_core::Result<lumis_scene::LoadedScene>, file: &str) -> 
 }
 
 fn load_scene(text: &str, dir: &Path) -> lumis_core::Result<lumis_scene::LoadedScene> {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     lumis_scene::load_str(text, &dir.join("fuzz.toml"), &[], &registry)
 }
 

@@ -90,7 +90,7 @@ fn main() {
     });
     let spp: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(64);
     let packets_only = args.get(2).is_some_and(|a| a == "packets");
-    let registry = lumis_cli::builtin_registry().expect("plugins register");
+    let registry = lumis_app::builtin_registry().expect("plugins register");
     if !packets_only {
         overhead(&scene_path, spp, &registry);
     }

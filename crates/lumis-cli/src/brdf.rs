@@ -20,7 +20,7 @@ use lumis_measured::reflectance::Reflectance;
 use lumis_measured::tabulate::tabulate;
 use lumis_measured::tensor::{compression_error, DIMS};
 
-use crate::assignments::parameter_table;
+use lumis_app::parameter_table;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct TabulateArgs {

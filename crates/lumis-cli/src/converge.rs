@@ -16,8 +16,7 @@ use lumis_core::{Error, Registry, Result};
 use lumis_files::{read_text_bounded, FileKind, MIB};
 use lumis_image::{read_exr, Image};
 
-use crate::metadata::ImageMetadata;
-use crate::render::{render_scene_file, RenderArgs};
+use lumis_app::{render, threads_capped, ImageMetadata, RenderArgs, Session};
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct ConvergeArgs {
@@ -266,7 +265,9 @@ pub fn converge(
     registry: &Registry,
     stop: &AtomicBool,
 ) -> Result<ConvergeReport> {
-    crate::warn_if_threads_capped(args.threads);
+    if let Some(warning) = threads_capped(args.threads) {
+        eprintln!("{warning}");
+    }
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
     let provenance = reference_provenance(args);
     let variants_path = args.variants.display().to_string();
@@ -287,6 +288,7 @@ pub fn converge(
     std::fs::create_dir_all(&renders)
         .map_err(|e| Error::msg(format!("{}: {e}", renders.display())))?;
     let never = AtomicBool::new(false);
+    let session = Session::silent(registry, &never);
     let render_once =
         |index: usize, variant: &Variant, spp: u32, seed: u64| -> Result<(Run, Image)> {
             let mut set = args.set.clone();
@@ -307,7 +309,7 @@ pub fn converge(
                 ..Default::default()
             };
             let context = |e: Error| Error::msg(format!("variant \"{}\": {e}", variant.name));
-            let report = render_scene_file(&render_args, registry, &never).map_err(context)?;
+            let report = render(&render_args, &session).map_err(context)?;
             // A loaded plugin that panicked answered with neutral values.
             registry.faults().check()?;
             let (image, seconds) = match (variant.image, report.denoised) {

@@ -13,7 +13,7 @@ use lumis_core::{Error, Result};
 use lumis_files::{read_text_bounded, FileKind, MIB};
 use lumis_image::{read_exr, Image, OutputLock};
 
-use crate::outputs::same_file;
+use lumis_app::same_file;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct DiffArgs {

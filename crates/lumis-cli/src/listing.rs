@@ -175,7 +175,7 @@ mod tests {
 
     #[test]
     fn lists_every_builtin_with_its_parameters() {
-        let text = plugin_listing(&crate::builtin_registry().unwrap());
+        let text = plugin_listing(&lumis_app::builtin_registry().unwrap());
         for needle in [
             "[sampler]",
             "type = \"independent\"  (built-in)",
@@ -191,7 +191,7 @@ mod tests {
 
     #[test]
     fn markdown_has_a_table_per_plugin() {
-        let text = plugin_markdown(&crate::builtin_registry().unwrap());
+        let text = plugin_markdown(&lumis_app::builtin_registry().unwrap());
         for needle in [
             "## Samplers (`[sampler]`)",
             "### `independent`",

@@ -4,6 +4,10 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use lumis_app::{
+    denoise_image, merge, registry_with_search_path, render, render_reference, DenoiseArgs,
+    MergeArgs, Progress, ReferenceArgs, RenderArgs, Session,
+};
 use lumis_check::bsdf_suite::{
     check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
 };
@@ -14,13 +18,11 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, check_integrator_with, compress_table, converge, denoise_image, diff_images,
-    format_integrator_results, lecture, merge, new_plugin, plugin_listing, plugin_markdown,
-    precompute_table, registry_with_search_path, render_reference, render_scene_file, slurm_status,
-    stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs,
-    DenoiseArgs, DiffArgs, IntegratorCheckConfig, LectureArgs, MergeArgs, NewPluginArgs,
-    PrecomputeArgs, ReferenceArgs, RenderArgs, SlurmArgs, SlurmCommand, TabulateArgs,
-    INTERRUPTED_EXIT_CODE,
+    analyze_samplers, check_integrator_with, compress_table, converge, diff_images,
+    format_integrator_results, lecture, new_plugin, plugin_listing, plugin_markdown,
+    precompute_table, slurm_status, stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs,
+    CompressArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig, LectureArgs, NewPluginArgs,
+    PrecomputeArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};
 use lumis_sampling::simd::{self, Isa};
@@ -196,7 +198,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => interruptible(|stop| {
             let registry = registry_with_search_path()?;
-            let report = render_scene_file(&args, &registry, stop)?;
+            let report = render(&args, &on_stderr(&registry, stop))?;
             println!("{}", report.summary());
             for line in report.profile.iter().flat_map(|p| p.lines()) {
                 println!("{line}");
@@ -233,7 +235,7 @@ fn main() -> ExitCode {
         }),
         Command::Reference(args) => interruptible(|stop| {
             let registry = registry_with_search_path()?;
-            let (path, meta) = render_reference(&args, &registry, stop)?;
+            let (path, meta) = render_reference(&args, &on_stderr(&registry, stop))?;
             println!(
                 "{}: {} spp in {:.1} s ({} passes; metadata in its header)",
                 path.display(),
@@ -369,6 +371,16 @@ fn main() -> ExitCode {
     }
 }
 
+/// A render session that prints its notes and its progress on stderr.
+fn on_stderr<'a>(registry: &'a Registry, stop: &'a std::sync::atomic::AtomicBool) -> Session<'a> {
+    Session {
+        registry,
+        stop,
+        notes: &|line| eprintln!("{line}"),
+        progress: Progress::Stderr,
+    }
+}
+
 /// How a command ended, for its exit status.
 enum Outcome {
     Done,
@@ -467,7 +479,7 @@ fn check_plugin(
     out: &std::path::Path,
     set: &[String],
 ) -> Result<bool> {
-    let fixed = lumis_cli::fixed_parameters(set)?;
+    let fixed = lumis_app::fixed_parameters(set)?;
     // Before any check runs: a failure picture has somewhere to go.
     std::fs::create_dir_all(out).map_err(|e| {
         Error::msg(format!(

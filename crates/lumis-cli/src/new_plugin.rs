@@ -148,7 +148,7 @@ pub fn check_name(name: &str, kind: NewPluginKind) -> Result<()> {
             "invalid plugin name \"{name}\": a Rust crate cannot be called that"
         )));
     }
-    let builtin = crate::builtin_registry()?;
+    let builtin = lumis_app::builtin_registry()?;
     if builtin.find(kind.plugin_kind(), name).is_some() {
         return Err(Error::msg(format!(
             "invalid plugin name \"{name}\": a built-in {} plugin has it already",

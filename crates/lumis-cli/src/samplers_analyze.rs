@@ -14,7 +14,7 @@ use lumis_analysis::{l2_star_discrepancy, sample_points, PointSet};
 use lumis_core::doc;
 use lumis_core::{Error, Location, PluginEntity, PluginKind, Registry, Result, Sampler, UVec2};
 
-use crate::assignments::parameter_text;
+use lumis_app::parameter_text;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct AnalyzeArgs {

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use lumis_cli::{builtin_registry, render_scene_file, RenderArgs, RenderReport};
+use lumis_app::{builtin_registry, RenderArgs, RenderReport, Session};
 use lumis_image::Image;
 use lumis_render::Aov;
 
@@ -71,7 +71,7 @@ fn render_on(dir: &Path, name: &str, seed: u64, set: &[&str], threads: usize) ->
         ..Default::default()
     };
     let registry = builtin_registry().unwrap();
-    render_scene_file(&args, &registry, &AtomicBool::new(false)).unwrap()
+    lumis_app::render(&args, &Session::silent(&registry, &AtomicBool::new(false))).unwrap()
 }
 
 fn aov(report: &RenderReport, aov: Aov) -> &Image {

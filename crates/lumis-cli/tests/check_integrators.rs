@@ -6,9 +6,10 @@ use lumis_check::outcome::Outcome;
 use lumis_check::sweep::parameter_sweep;
 use std::process::Command;
 
+use lumis_app::builtin_registry;
 use lumis_cli::{
-    builtin_registry, check_integrator_with, format_integrator_results, IntegratorCaseResult,
-    IntegratorCheckConfig, IntegratorTest,
+    check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,
+    IntegratorTest,
 };
 use lumis_core::{
     Integrator, PluginKind, PluginParams, PluginSpec, Ray, Registrar, Registry, RenderStats, Rgb,

@@ -4,7 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use lumis_cli::{builtin_registry, converge, render_scene_file, ConvergeArgs, RenderArgs};
+use lumis_app::{builtin_registry, render, render_reference, ReferenceArgs, RenderArgs, Session};
+use lumis_cli::{converge, ConvergeArgs};
 
 /// A fresh directory for one test's files, removed when the test ends.
 fn scratch(name: &str) -> tempfile::TempDir {
@@ -28,7 +29,7 @@ fn reference_render(
     spp: u32,
     out: &Path,
 ) {
-    render_scene_file(
+    render(
         &RenderArgs {
             scene: scene.to_path_buf(),
             spp: Some(spp),
@@ -38,8 +39,7 @@ fn reference_render(
             quiet: true,
             ..Default::default()
         },
-        registry,
-        &AtomicBool::new(false),
+        &Session::silent(registry, &AtomicBool::new(false)),
     )
     .unwrap();
 }
@@ -258,7 +258,6 @@ fn bad_variants_and_mismatched_reference_are_clear_errors() {
 /// instead of mixing images.
 #[test]
 fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
-    use lumis_cli::{render_reference, ReferenceArgs};
     let tmp = scratch("reference");
     let dir = tmp.path();
     let registry = builtin_registry().unwrap();
@@ -276,21 +275,40 @@ fn reference_resumes_to_the_same_image_and_restarts_when_the_scene_changes() {
         threads: 0,
         force: extra.contains(&"--force"),
     };
-    let (path, meta) = render_reference(&args(64, "resumed.exr", &[]), &registry, &stop).unwrap();
+    let (path, meta) = render_reference(
+        &args(64, "resumed.exr", &[]),
+        &Session::silent(&registry, &stop),
+    )
+    .unwrap();
     assert_eq!((meta.spp, meta.passes), (64, 2));
-    let (_, meta) = render_reference(&args(128, "resumed.exr", &[]), &registry, &stop).unwrap();
+    let (_, meta) = render_reference(
+        &args(128, "resumed.exr", &[]),
+        &Session::silent(&registry, &stop),
+    )
+    .unwrap();
     assert_eq!((meta.spp, meta.passes), (128, 4));
-    let (whole, _) = render_reference(&args(128, "whole.exr", &[]), &registry, &stop).unwrap();
+    let (whole, _) = render_reference(
+        &args(128, "whole.exr", &[]),
+        &Session::silent(&registry, &stop),
+    )
+    .unwrap();
     let read = |p: &Path| lumis_image::read_exr(p).unwrap();
     assert_eq!(read(&path), read(&whole));
     let changed = ["integrator.max_depth=2"];
-    let refused = render_reference(&args(128, "resumed.exr", &changed), &registry, &stop)
-        .err()
-        .unwrap()
-        .to_string();
+    let refused = render_reference(
+        &args(128, "resumed.exr", &changed),
+        &Session::silent(&registry, &stop),
+    )
+    .err()
+    .unwrap()
+    .to_string();
     assert!(refused.contains("different scene"), "{refused}");
     let forced = ["integrator.max_depth=2", "--force"];
-    let (_, meta) = render_reference(&args(128, "resumed.exr", &forced), &registry, &stop).unwrap();
+    let (_, meta) = render_reference(
+        &args(128, "resumed.exr", &forced),
+        &Session::silent(&registry, &stop),
+    )
+    .unwrap();
     assert_eq!((meta.spp, meta.passes), (128, 4), "restarted from zero");
     assert_ne!(read(&path), read(&whole));
 }

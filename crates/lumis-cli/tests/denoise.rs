@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use lumis_cli::{builtin_registry, denoise_image, DenoiseArgs};
+use lumis_app::{builtin_registry, denoise_image, DenoiseArgs};
 use lumis_core::{
     DenoiseInput, Denoiser, Error, Params, PluginKind, PluginSpec, Registrar, Result,
 };

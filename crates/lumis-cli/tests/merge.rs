@@ -63,7 +63,7 @@ fn merge_error(parts: &[&str], out: &str) -> String {
 
 /// The names of the built-in samplers.
 fn builtin_samplers() -> Vec<&'static str> {
-    let registry = lumis_cli::builtin_registry().unwrap();
+    let registry = lumis_app::builtin_registry().unwrap();
     let names = registry.names(PluginKind::Sampler);
     assert!(names.len() >= 7, "{names:?}");
     names

@@ -12,8 +12,9 @@
 //!    `~/.cache/lumis/NAME-VERSION`), libraries in its `lib/`.
 //!
 //! [`NativeLibrary::provision`] prints the link search path and the rpath of
-//! the crate's own test binaries, and `cargo:libdir` so that binary crates
-//! can read `DEP_<LINKS>_LIBDIR` for theirs (`crates/lumis-cli/build.rs`).
+//! the crate's own test binaries, and `cargo:libdir` so that the crates
+//! depending on it put the directory into their binaries' rpath
+//! ([`rpath_of_dependencies`]).
 
 mod wheel;
 
@@ -22,6 +23,18 @@ use std::path::PathBuf;
 use std::process::Command;
 
 pub use wheel::Wheel;
+
+/// For the build script of a crate with binaries or tests that load a
+/// provisioned library: puts the directory of each library its direct
+/// dependencies provisioned (the `DEP_<LINKS>_LIBDIR` cargo hands it) into
+/// their rpath, so they run without `LD_LIBRARY_PATH`.
+pub fn rpath_of_dependencies() {
+    for (var, dir) in env::vars() {
+        if var.starts_with("DEP_") && var.ends_with("_LIBDIR") {
+            println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
+        }
+    }
+}
 
 /// What a `-sys`-style crate links, and where it may be found.
 #[derive(Debug, Clone, Copy)]

@@ -19,4 +19,4 @@ pub use driver::{
 };
 pub use film::{AdaptiveState, Film, FirstHitSums};
 pub use first_hit::{first_hit, first_hit_rng, FirstHit, MAX_SPECULAR_BOUNCES};
-pub use progress::RenderProgress;
+pub use progress::{ProgressFn, RenderProgress};

@@ -1,10 +1,10 @@
 //! A render's progress, over all its passes: a bar on a terminal; a plain line every few
 //! seconds where stderr is a log, a pipe or a CI job, which a bar would
-//! leave silent; or nothing.
+//! leave silent; a caller's own function; or nothing.
 
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -17,8 +17,18 @@ const LINE_PERIOD: f64 = 5.0;
 pub enum RenderProgress {
     Bar(ProgressBar),
     Lines(Lines),
+    /// `report(done, total)` after each unit of work, from the thread
+    /// that did it.
+    Reported {
+        total: u64,
+        done: AtomicU64,
+        report: Arc<ProgressFn>,
+    },
     Hidden,
 }
+
+/// A caller's progress display: called with the units done and the total.
+pub type ProgressFn = dyn Fn(u64, u64) + Send + Sync;
 
 impl RenderProgress {
     /// Progress over `total` units, shown if `enabled`.
@@ -39,6 +49,15 @@ impl RenderProgress {
         Self::Bar(bar)
     }
 
+    /// Progress over `total` units, reported to `report`.
+    pub fn reported(total: u64, report: Arc<ProgressFn>) -> Self {
+        Self::Reported {
+            total,
+            done: AtomicU64::new(0),
+            report,
+        }
+    }
+
     /// Counts `units` more done.
     pub fn advance(&self, units: u64) {
         match self {
@@ -48,6 +67,11 @@ impl RenderProgress {
                     eprintln!("{line}");
                 }
             }
+            Self::Reported {
+                total,
+                done,
+                report,
+            } => report(done.fetch_add(units, Ordering::Relaxed) + units, *total),
             Self::Hidden => {}
         }
     }

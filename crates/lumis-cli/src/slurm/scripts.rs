@@ -19,7 +19,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::manifest::Manifest;
-use crate::denoise::denoised_paths;
+use lumis_app::denoised_paths;
 
 /// The job array's script, in the run directory.
 pub const RENDER_SCRIPT: &str = "render.sbatch";

@@ -4,7 +4,7 @@
 use lumis_core::{doc, Error, Result};
 
 /// The assignments as TOML lines, one per `key=value`.
-pub(crate) fn parameter_text(assignments: &[String]) -> Result<String> {
+pub fn parameter_text(assignments: &[String]) -> Result<String> {
     let mut text = String::new();
     for assignment in assignments {
         let (key, value) = assignment

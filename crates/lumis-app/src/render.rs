@@ -1,8 +1,8 @@
-//! `lumis render`: load, render in passes with checkpoints, write the PNG
-//! and the EXR (with its metadata in the header), report.
+//! A render: load, render in passes with checkpoints, write the PNG and
+//! the EXR (with its metadata in the header), report.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -10,9 +10,7 @@ use lumis_core::audit::Defects;
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_image::Image;
 use lumis_render::profile::{profiled_sampler, profiled_scene, Profile, ProfileReport};
-use lumis_render::{
-    progress_units, render_pass, Aov, Film, PassContext, RenderPool, RenderProgress,
-};
+use lumis_render::{progress_units, render_pass, Aov, Film, PassContext, RenderPool};
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
@@ -21,6 +19,7 @@ use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::{partial_path, remove_if_present, Outputs};
 use crate::partial::Partial;
+use crate::session::Session;
 use crate::slice::SampleSlice;
 
 /// What `lumis render` was asked to do; also its command-line flags.
@@ -47,7 +46,7 @@ pub struct RenderArgs {
     /// Arrays of tables are addressed by name or index (shape.0.file).
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     pub set: Vec<String>,
-    /// No progress bar.
+    /// No start-up report and no progress bar.
     #[arg(long, short)]
     pub quiet: bool,
     /// Print what the loader decided the scene needs.
@@ -307,6 +306,7 @@ impl CheckpointEvery {
 /// belong to this render), else an empty one.
 fn starting_state(
     args: &RenderArgs,
+    session: &Session,
     checkpoint: &Path,
     scene_hash: u64,
     loaded: &LoadedScene,
@@ -382,11 +382,11 @@ fn starting_state(
             saved.spp
         ));
     }
-    eprintln!(
+    session.note(&format!(
         "resuming '{}' at {} of {spp} spp",
         checkpoint.display(),
         saved.film.samples
-    );
+    ));
     Ok(saved)
 }
 
@@ -428,23 +428,20 @@ fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Resul
 /// saving a checkpoint as [`RenderArgs::checkpoint`] asks; with
 /// [`RenderArgs::part`] or [`RenderArgs::samples`], renders that slice of
 /// the sample indices to a partial EXR ([`Partial`](crate::Partial))
-/// instead. Once `stop` is set (by the first Ctrl-C) the pass in flight is
-/// abandoned and the passes done are written, with their true sample
-/// count (a part writes nothing).
-pub fn render_scene_file(
-    args: &RenderArgs,
-    registry: &lumis_core::Registry,
-    stop: &AtomicBool,
-) -> Result<RenderReport> {
+/// instead. Once the session's `stop` is set (by the first Ctrl-C) the
+/// pass in flight is abandoned and the passes done are written, with their
+/// true sample count (a part writes nothing).
+pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
+    let (registry, stop) = (session.registry, session.stop);
     let mut loaded = load(args, registry)?;
     if !args.quiet {
         for line in loaded.scene.load_report().lines(loaded.scene.counts()) {
-            eprintln!("{line}");
+            session.note(&line);
         }
-        eprintln!("SIMD kernels: {}", lumis_sampling::simd::chosen());
+        session.note(&format!("SIMD kernels: {}", lumis_sampling::simd::chosen()));
     }
     if args.verbose {
-        eprintln!("{}", describe(&loaded));
+        session.note(&describe(&loaded));
     }
     if args.pass_spp == Some(0) {
         return Err(Error::msg("--pass-spp must be at least 1"));
@@ -462,7 +459,7 @@ pub fn render_scene_file(
     );
     let budget = MemoryBudget::of(args.max_memory);
     if !args.quiet {
-        eprintln!("{}", memory.line(&budget));
+        session.note(&memory.line(&budget));
     }
     memory.check(&budget)?;
     if (slice.is_some() || args.parts.is_some()) && loaded.adaptive.is_some() {
@@ -509,7 +506,9 @@ pub fn render_scene_file(
         .filter(|_| slice.is_none())
         .map(|_| claim_denoised_outputs(&exr))
         .transpose()?;
-    crate::warn_if_threads_capped(args.threads);
+    if let Some(warning) = threads_capped(args.threads) {
+        session.note(&warning);
+    }
     let scene_hash = lumis_scene::scene_hash(&args.scene, &args.set)?;
     let checkpoint_file = checkpoint_path(&exr);
     let resolution = loaded.camera.resolution();
@@ -528,7 +527,7 @@ pub fn render_scene_file(
             scene_hash,
             seconds: 0.0,
         },
-        None => starting_state(args, &checkpoint_file, scene_hash, &loaded)?,
+        None => starting_state(args, session, &checkpoint_file, scene_hash, &loaded)?,
     };
     // The last sample index (exclusive) this run renders.
     let end = slice.map_or(spp, |s| s.end);
@@ -546,10 +545,11 @@ pub fn render_scene_file(
         None => (&loaded.scene, loaded.sampler.as_ref()),
     };
     let pool = RenderPool::new(args.threads)?;
-    let progress = RenderProgress::new(
-        !args.quiet,
-        progress_units(resolution, end - state.film.samples),
-    );
+    let units = progress_units(resolution, end - state.film.samples);
+    let progress = match args.quiet {
+        true => crate::Progress::Hidden.over(units),
+        false => session.progress.over(units),
+    };
     let ctx = PassContext {
         camera: &loaded.camera,
         scene,
@@ -664,11 +664,11 @@ pub fn render_scene_file(
         )));
     } else if interrupted && state.film.samples < spp {
         save(&state)?;
-        eprintln!(
+        session.note(&format!(
             "interrupted at {} of {spp} spp: {} holds the image so far; --resume continues it",
             state.film.samples,
             partial_path(&exr).display()
-        );
+        ));
     } else {
         write_film(&outputs, &state.film, &metadata(&state))?;
         // Last: a kill before this line leaves a checkpoint that resumes
@@ -703,6 +703,18 @@ pub fn render_scene_file(
         stats,
         profile,
         defects: registry.faults().defects(),
+    })
+}
+
+/// The warning where `--threads` asks for more workers than a render runs
+/// (`lumis_render::worker_threads`).
+pub fn threads_capped(requested: usize) -> Option<String> {
+    let used = lumis_render::worker_threads(requested);
+    (requested != 0 && used < requested).then(|| {
+        format!(
+            "warning: --threads {requested} capped at {used} ({} per core)",
+            lumis_render::MAX_THREADS_PER_CORE
+        )
     })
 }
 

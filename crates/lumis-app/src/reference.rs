@@ -4,15 +4,15 @@
 //! converged or a different reference.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
-use lumis_core::{Error, Registry, Result};
+use lumis_core::{Error, Result};
 use lumis_image::{read_exr, Image};
-use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool, RenderProgress};
+use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool};
 
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
-use crate::render::{load, output_paths, RenderArgs};
+use crate::render::{load, output_paths, threads_capped, RenderArgs};
+use crate::session::Session;
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct ReferenceArgs {
@@ -73,6 +73,7 @@ fn reason_to_keep(
 fn existing_reference(
     exr: &Path,
     args: &ReferenceArgs,
+    session: &Session,
     scene_hash: u64,
     seed: u64,
 ) -> Result<Option<(ImageMetadata, Image)>> {
@@ -86,7 +87,7 @@ fn existing_reference(
         )))
     };
     if args.force {
-        eprintln!("replacing {} (--force)", exr.display());
+        session.note(&format!("replacing {} (--force)", exr.display()));
         return Ok(None);
     }
     let meta = match ImageMetadata::read(exr) {
@@ -108,10 +109,12 @@ fn existing_reference(
 /// same atomic rename as the image, it always describes it.
 pub fn render_reference(
     args: &ReferenceArgs,
-    registry: &Registry,
-    stop: &AtomicBool,
+    session: &Session,
 ) -> Result<(PathBuf, ImageMetadata)> {
-    crate::warn_if_threads_capped(args.threads);
+    let (registry, stop) = (session.registry, session.stop);
+    if let Some(warning) = threads_capped(args.threads) {
+        session.note(&warning);
+    }
     if args.spp == 0 || args.pass_spp == 0 {
         return Err(Error::msg("--spp and --pass-spp must be at least 1"));
     }
@@ -135,14 +138,15 @@ pub fn render_reference(
         .unwrap_or_else(|| PathBuf::from(format!("{name}.exr")));
     let (exr, _) = output_paths(&output, &name);
     let outputs = Outputs::claim(&exr, None)?;
-    let (mut meta, mut mean) = match existing_reference(&exr, args, scene_hash, base_seed)? {
+    let (mut meta, mut mean) = match existing_reference(&exr, args, session, scene_hash, base_seed)?
+    {
         Some((meta, image)) => {
-            eprintln!(
+            session.note(&format!(
                 "resuming {} at {} of {} spp",
                 exr.display(),
                 meta.spp,
                 args.spp
-            );
+            ));
             (meta, Some(image))
         }
         None => (
@@ -176,7 +180,7 @@ pub fn render_reference(
             },
             registry,
         )?;
-        let progress = RenderProgress::new(true, progress_units(resolution, pass));
+        let progress = session.progress.over(progress_units(resolution, pass));
         let ctx = PassContext {
             camera: &loaded.camera,
             scene: &loaded.scene,

@@ -1,0 +1,119 @@
+//! The render session as a library caller drives it: its notes and
+//! progress reach the caller, a stop flag ends it with the passes done,
+//! and the image is the one the command line writes.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use lumis_app::{builtin_registry, render, Progress, RenderArgs, Session};
+
+fn scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+}
+
+/// A small Cornell box render of `spp` samples in passes of one, written
+/// under `dir`.
+fn small_box(dir: &Path, spp: u32) -> RenderArgs {
+    RenderArgs {
+        scene: scene("cornell-box.toml"),
+        spp: Some(spp),
+        threads: 2,
+        set: vec!["film.resolution=[32, 32]".into()],
+        output: Some(dir.join("box.exr")),
+        pass_spp: Some(1),
+        ..Default::default()
+    }
+}
+
+/// The start-up report arrives as notes, the progress counts up to its
+/// total, and the image is written where asked.
+#[test]
+fn notes_and_progress_reach_the_caller() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = builtin_registry().unwrap();
+    let stop = AtomicBool::new(false);
+    let notes = Mutex::new(Vec::<String>::new());
+    let last = Arc::new(Mutex::new((0u64, 0u64)));
+    let seen = last.clone();
+    let session = Session {
+        registry: &registry,
+        stop: &stop,
+        notes: &|line| notes.lock().unwrap().push(line.to_string()),
+        progress: Progress::Reported(Arc::new(move |done, total| {
+            let mut seen = seen.lock().unwrap();
+            *seen = (seen.0.max(done), total);
+        })),
+    };
+    let report = render(&small_box(dir.path(), 4), &session).unwrap();
+    assert_eq!(report.spp, 4);
+    assert!(report.exr.exists() && report.png.exists());
+    let notes = notes.into_inner().unwrap();
+    for expected in ["loaded", "memory:", "SIMD kernels:"] {
+        assert!(
+            notes.iter().any(|line| line.starts_with(expected)),
+            "no note starting {expected:?} in {notes:?}"
+        );
+    }
+    let (done, total) = *last.lock().unwrap();
+    assert!(total > 0 && done == total, "progress {done} of {total}");
+
+    // Quiet: no start-up report and no progress; the same image.
+    let quiet_notes = Mutex::new(Vec::<String>::new());
+    let calls = Arc::new(AtomicU64::new(0));
+    let counted = calls.clone();
+    let quiet = Session {
+        notes: &|line| quiet_notes.lock().unwrap().push(line.to_string()),
+        progress: Progress::Reported(Arc::new(move |_, _| {
+            counted.fetch_add(1, Ordering::Relaxed);
+        })),
+        ..Session::silent(&registry, &stop)
+    };
+    let args = RenderArgs {
+        quiet: true,
+        output: Some(dir.path().join("quiet.exr")),
+        ..small_box(dir.path(), 4)
+    };
+    let again = render(&args, &quiet).unwrap();
+    assert_eq!(quiet_notes.into_inner().unwrap(), Vec::<String>::new());
+    assert_eq!(calls.load(Ordering::Relaxed), 0);
+    assert_eq!(again.image.pixels, report.image.pixels);
+}
+
+/// A stop set while the render runs ends it after the pass in flight:
+/// the report says interrupted, holds fewer samples than asked, and the
+/// image so far is on disk beside the outputs with a note saying where.
+#[test]
+fn a_stop_ends_the_render_with_the_passes_done() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = builtin_registry().unwrap();
+    let stop = Arc::new(AtomicBool::new(false));
+    let notes = Mutex::new(Vec::<String>::new());
+    let spp = 16;
+    let stopper = stop.clone();
+    // Stopped once a quarter of the units are done: after some passes.
+    let session = Session {
+        registry: &registry,
+        stop: &stop,
+        notes: &|line| notes.lock().unwrap().push(line.to_string()),
+        progress: Progress::Reported(Arc::new(move |done, total| {
+            if done * 4 >= total {
+                stopper.store(true, Ordering::Relaxed);
+            }
+        })),
+    };
+    let report = render(&small_box(dir.path(), spp), &session).unwrap();
+    assert!(report.interrupted);
+    assert!(report.spp >= 1 && report.spp < spp, "{} spp", report.spp);
+    let notes = notes.into_inner().unwrap();
+    assert!(
+        notes.iter().any(|line| line.starts_with("interrupted at")),
+        "{notes:?}"
+    );
+    assert!(
+        !report.exr.exists(),
+        "an unfinished render is not the image"
+    );
+}
