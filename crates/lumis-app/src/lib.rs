@@ -29,6 +29,8 @@ mod partial;
 mod reference;
 mod registry;
 mod render;
+mod render_args;
+mod render_report;
 mod session;
 mod slice;
 
@@ -43,9 +45,8 @@ pub use outputs::same_file;
 pub use partial::Partial;
 pub use reference::{render_reference, ReferenceArgs};
 pub use registry::{builtin_registry, registry_with_search_path};
-pub use render::{
-    output_paths, render, threads_capped, DenoisedReport, RenderArgs, RenderReport,
-    DEFAULT_CHECKPOINT_SECONDS,
-};
+pub use render::{output_paths, render, threads_capped};
+pub use render_args::{RenderArgs, DEFAULT_CHECKPOINT_SECONDS};
+pub use render_report::{DenoisedReport, RenderReport};
 pub use session::{Progress, Session};
 pub use slice::SampleSlice;

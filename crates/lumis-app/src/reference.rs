@@ -11,7 +11,8 @@ use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool};
 
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
-use crate::render::{load, output_paths, threads_capped, RenderArgs};
+use crate::render::{load, output_paths, threads_capped};
+use crate::render_args::RenderArgs;
 use crate::session::Session;
 
 #[derive(clap::Args, Debug, Clone)]
@@ -156,7 +157,7 @@ pub fn render_reference(
                 passes: 0,
                 seed: base_seed,
                 scene_hash,
-                scene_file_hash: lumis_scene::scene_hash(&args.scene, &[])?,
+                scene_file_hash: lumis_scene::scene_file_hash(&args.scene)?,
                 seconds: 0.0,
                 version: lumis_version(),
                 slice: None,

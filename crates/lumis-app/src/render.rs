@@ -3,13 +3,10 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
-use std::sync::Arc;
 use std::time::Instant;
 
-use lumis_core::audit::Defects;
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
-use lumis_image::Image;
-use lumis_render::profile::{profiled_sampler, profiled_scene, Profile, ProfileReport};
+use lumis_render::profile::{profiled_sampler, profiled_scene, Profile};
 use lumis_render::{progress_units, render_pass, Aov, Film, PassContext, RenderPool};
 use lumis_scene::LoadedScene;
 
@@ -19,200 +16,14 @@ use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::{partial_path, remove_if_present, Outputs};
 use crate::partial::Partial;
+use crate::render_args::{CheckpointEvery, RenderArgs};
+use crate::render_report::{DenoisedReport, RenderReport};
 use crate::session::Session;
 use crate::slice::SampleSlice;
-
-/// What `lumis render` was asked to do; also its command-line flags.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct RenderArgs {
-    /// The scene file.
-    pub scene: PathBuf,
-    /// Samples per pixel (overrides sampler.spp).
-    #[arg(long)]
-    pub spp: Option<u32>,
-    /// Random seed (overrides the scene's top-level seed), at most
-    /// 2^63 - 1 as a scene's is.
-    #[arg(long, value_parser = clap::value_parser!(u64).range(..=i64::MAX as u64))]
-    pub seed: Option<u64>,
-    /// Worker threads; 0 or absent means one per core.
-    #[arg(long, default_value_t = 0)]
-    pub threads: usize,
-    /// Output path: writes PATH.exr and PATH.png [default: the scene's
-    /// film.output, else SCENE-NAME.exr in the current directory].
-    #[arg(long, short)]
-    pub output: Option<PathBuf>,
-    /// Override any scene value, e.g. --set integrator.max_depth=3,
-    /// --set bsdf.white.reflectance=[0.5,0.5,0.5], --set sampler.type=independent.
-    /// Arrays of tables are addressed by name or index (shape.0.file).
-    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
-    pub set: Vec<String>,
-    /// No start-up report and no progress bar.
-    #[arg(long, short)]
-    pub quiet: bool,
-    /// Print what the loader decided the scene needs.
-    #[arg(long, short)]
-    pub verbose: bool,
-    /// Report where the render's time went: traversal, shading, sampling,
-    /// light sampling (statistical profile; the render runs a few percent
-    /// slower).
-    #[arg(long)]
-    pub stats: bool,
-    /// Fail (exit 1, after the image is written) where a loaded plugin
-    /// answered with NaN or infinite values, negative ones, or BSDF samples
-    /// that create energy; without it, each is a warning.
-    #[arg(long)]
-    pub strict: bool,
-    /// Save the render's state (NAME.checkpoint beside the EXR, and the
-    /// image so far) every SECONDS, or after every pass without a value.
-    /// Without this flag a render checkpoints every 60 s.
-    #[arg(long, value_name = "SECONDS", num_args = 0..=1, conflicts_with = "no_checkpoint")]
-    pub checkpoint: Option<Option<f64>>,
-    /// Never write a checkpoint while rendering (Ctrl-C still saves the
-    /// passes done).
-    #[arg(long)]
-    pub no_checkpoint: bool,
-    /// Continue the render its checkpoint saved (same scene, overrides and
-    /// seed); the image is the one an uninterrupted render makes.
-    #[arg(long)]
-    pub resume: bool,
-    /// The memory the render may use, scene included (8G, 512M) [default:
-    /// the film must fit in what the system has available].
-    #[arg(long, value_name = "SIZE", value_parser = crate::memory::parse_bytes)]
-    pub max_memory: Option<u64>,
-    /// Replace an image of this scene with more samples than this render
-    /// makes, instead of refusing.
-    #[arg(long)]
-    pub force: bool,
-    /// Samples per pixel per pass [default: passes of about two seconds].
-    /// The image does not depend on it.
-    #[arg(long, value_name = "N")]
-    pub pass_spp: Option<u32>,
-    /// Render part K (0-based) of N of the scene's samples per pixel: the
-    /// sample indices [K spp / N, (K + 1) spp / N), written as a partial
-    /// EXR that `lumis merge` adds to the other parts.
-    #[arg(long, value_name = "K/N", conflicts_with_all = ["samples", "resume", "checkpoint"])]
-    pub part: Option<String>,
-    /// Render sample indices A..B (half-open, B <= spp) of the scene's
-    /// samples per pixel, written as a partial EXR for `lumis merge`.
-    #[arg(long, value_name = "A..B", conflicts_with_all = ["resume", "checkpoint"])]
-    pub samples: Option<String>,
-    /// Render the whole image in this process, summed as N parts: each
-    /// slice `--part K/N` renders is summed on its own and added to the
-    /// slices before it, so the image is, bit for bit, what `lumis merge`
-    /// makes of the N parts (one plain run sums every sample in turn,
-    /// which rounds the sums differently in their last bits). It
-    /// checkpoints and resumes like any render; a part interrupted midway
-    /// is then summed in two pieces, equal to `merge`'s to rounding.
-    #[arg(
-        long,
-        value_name = "N",
-        value_parser = clap::value_parser!(u32).range(1..),
-        conflicts_with_all = ["part", "samples"]
-    )]
-    pub parts: Option<u32>,
-}
-
-/// Seconds between checkpoints when `--checkpoint` does not say.
-pub const DEFAULT_CHECKPOINT_SECONDS: f64 = 60.0;
 
 /// How long a pass should take when `--pass-spp` does not say: short enough
 /// that the first Ctrl-C, which abandons the pass in flight, loses little.
 const PASS_SECONDS: f64 = 2.0;
-
-/// The outcome of a render, for the summary line and for tests.
-pub struct RenderReport {
-    pub image: Image,
-    /// The outputs `[film] aovs` asked for, as the EXR holds them.
-    pub aovs: Vec<(Aov, Image)>,
-    pub exr: PathBuf,
-    pub png: PathBuf,
-    /// The denoised image, when the scene has a `[denoiser]`.
-    pub denoised: Option<DenoisedReport>,
-    pub spp: u32,
-    /// Stopped by a signal: the image holds the passes finished before it.
-    pub interrupted: bool,
-    /// `--resume` found the render finished: nothing was rendered, and the
-    /// image is the one on disk.
-    pub finished_before: bool,
-    pub seconds: f64,
-    pub stats: RenderStats,
-    /// Time by stage, with `--stats`.
-    pub profile: Option<ProfileReport>,
-    /// The loaded plugins whose answers held defects, each named with its
-    /// library ([`lumis_core::audit`]).
-    pub defects: Vec<(Arc<str>, Defects)>,
-}
-
-impl RenderReport {
-    /// One warning line per loaded plugin whose answers held defects.
-    pub fn defect_warnings(&self) -> Vec<String> {
-        self.defects
-            .iter()
-            .map(|(plugin, defects)| {
-                format!("warning: {plugin}: {}", defects.describe().join("; "))
-            })
-            .collect()
-    }
-
-    /// With `--strict`, the error that defects are.
-    pub fn strict_check(&self, args: &RenderArgs) -> Result<()> {
-        if args.strict && !self.defects.is_empty() {
-            return Err(Error::msg(format!(
-                "--strict: {} loaded plugin(s) answered with defects (warned above); the image was written to {}",
-                self.defects.len(),
-                self.exr.display()
-            )));
-        }
-        Ok(())
-    }
-    /// The one-line summary printed at the end of a render.
-    pub fn summary(&self) -> String {
-        if self.finished_before {
-            return format!(
-                "{} is finished ({} spp of this scene and seed): nothing to resume",
-                self.exr.display(),
-                self.spp
-            );
-        }
-        let secs = self.seconds.max(1e-9);
-        let interrupted = if self.interrupted {
-            "interrupted, "
-        } else {
-            ""
-        };
-        format!(
-            "{interrupted}{}x{}, {} spp, {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s ({} closest-hit and {} shadow rays), {} NaN/Inf samples, emission found by {} BSDF samples and {} light samples -> {}",
-            self.image.width,
-            self.image.height,
-            self.spp,
-            self.seconds,
-            self.stats.samples as f64 / secs * 1e-6,
-            self.stats.total_rays() as f64 / secs * 1e-6,
-            self.stats.rays,
-            self.stats.shadow_rays,
-            self.stats.nonfinite,
-            self.stats.bsdf_light_hits,
-            self.stats.light_samples,
-            self.exr.display(),
-        ) + &match &self.denoised {
-            Some(denoised) => format!(
-                ", denoised in {:.2} s -> {}",
-                denoised.seconds,
-                denoised.exr.display()
-            ),
-            None => String::new(),
-        }
-    }
-}
-
-/// The denoised image of a render and what making it cost.
-pub struct DenoisedReport {
-    pub image: Image,
-    pub exr: PathBuf,
-    /// Wall time of the denoiser and of writing its image, which a
-    /// comparison at equal time adds to the render's.
-    pub seconds: f64,
-}
 
 /// `PATH.exr` and `PATH.png` for an output argument given with `.exr`,
 /// `.png` or neither; for a directory (one that exists, or a path ending
@@ -278,28 +89,6 @@ fn describe(loaded: &LoadedScene) -> String {
             "cannot matter (only delta lights: light sampling gets weight 1)"
         },
     )
-}
-
-/// When a render saves its state.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum CheckpointEvery {
-    Pass,
-    Seconds(f64),
-    Never,
-}
-
-impl CheckpointEvery {
-    fn of(args: &RenderArgs) -> Result<Self> {
-        match args.checkpoint {
-            _ if args.no_checkpoint => Ok(Self::Never),
-            None => Ok(Self::Seconds(DEFAULT_CHECKPOINT_SECONDS)),
-            Some(None) => Ok(Self::Pass),
-            Some(Some(s)) if s.is_finite() && s >= 0.0 => Ok(Self::Seconds(s)),
-            Some(Some(s)) => Err(Error::msg(format!(
-                "--checkpoint {s}: expected a number of seconds, 0 or more"
-            ))),
-        }
-    }
 }
 
 /// The film to render into: the checkpoint's with `--resume` (checked to
@@ -405,20 +194,6 @@ fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) ->
     spp.clamp(1, remaining)
 }
 
-/// The slice of sample indices `--part` or `--samples` asks for, of a
-/// render of `spp` samples per pixel; `None` for a whole render.
-fn sample_slice(args: &RenderArgs, spp: u32) -> Result<Option<SampleSlice>> {
-    let slice = match (&args.part, &args.samples) {
-        (Some(part), _) => {
-            SampleSlice::parse_part(part, spp).map_err(|why| Error::msg(format!("--part {why}")))?
-        }
-        (None, Some(range)) => SampleSlice::parse_range(range, spp)
-            .map_err(|why| Error::msg(format!("--samples {why}")))?,
-        (None, None) => return Ok(None),
-    };
-    Ok(Some(slice))
-}
-
 /// Writes the film's colour and outputs.
 fn write_film(outputs: &Outputs, film: &Film, metadata: &ImageMetadata) -> Result<()> {
     outputs.write(&film.image(), &film.aov_images(), metadata)
@@ -450,7 +225,7 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
     if spp == 0 {
         return Err(Error::msg("spp must be at least 1"));
     }
-    let slice = sample_slice(args, spp)?;
+    let slice = args.sample_slice(spp)?;
     let memory = MemoryEstimate::of(
         loaded.scene.load_report(),
         loaded.camera.resolution(),
@@ -561,7 +336,7 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
         progress: &progress,
         stop,
     };
-    let scene_file_hash = lumis_scene::scene_hash(&args.scene, &[])?;
+    let scene_file_hash = lumis_scene::scene_file_hash(&args.scene)?;
     let metadata = |state: &Checkpoint| ImageMetadata {
         command: "render".into(),
         spp: state.film.samples - state.film.start,

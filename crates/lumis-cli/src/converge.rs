@@ -454,7 +454,7 @@ fn reference_provenance(args: &ConvergeArgs) -> String {
         meta.spp, meta.passes, meta.seed, meta.seconds, meta.version
     );
     let same_scene =
-        lumis_scene::scene_hash(&args.scene, &[]).is_ok_and(|hash| hash == meta.scene_file_hash);
+        lumis_scene::scene_file_hash(&args.scene).is_ok_and(|hash| hash == meta.scene_file_hash);
     if !same_scene {
         out += "warning: the reference was rendered from a different version of the scene file\n";
     }

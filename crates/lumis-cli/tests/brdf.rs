@@ -49,6 +49,30 @@ fn tabulate_precompute_and_check_a_measured_table() {
     assert!(text(&run).contains("34992012 bytes"), "{}", text(&run));
     assert_eq!(std::fs::metadata(&table).unwrap().len(), 34_992_012);
 
+    // The measured scene renders the table given with --set, though the
+    // table it names itself is absent (the copy's directory has none).
+    let scene = dir.join("measured-sphere.toml");
+    let source = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/measured-sphere.toml"
+    );
+    std::fs::copy(source, &scene).unwrap();
+    let image = dir.join("sphere.exr").display().to_string();
+    let run = lumis(&[
+        "render",
+        &scene.display().to_string(),
+        "--set",
+        &format!("bsdf.sample.file={table_arg}"),
+        "--set",
+        "film.resolution=[8, 8]",
+        "--spp",
+        "1",
+        "-q",
+        "-o",
+        &image,
+    ]);
+    assert!(run.status.success(), "{}", text(&run));
+
     let run = lumis(&[
         "brdf",
         "precompute",

@@ -74,15 +74,36 @@ impl Fnv1a {
 }
 
 /// The hash of the scene file at `path` with `overrides` applied, as the
-/// module documentation describes.
+/// module documentation describes. A file the scene names that cannot be
+/// read is an error: the render would fail on it too.
 pub fn scene_hash(path: &Path, overrides: &[String]) -> Result<u64> {
+    hash_scene(path, overrides, Unreadable::Fails)
+}
+
+/// The hash of the scene file at `path` as written, without the render's
+/// overrides: which file a render came from, whatever was set on top.
+/// A file it names that cannot be read counts by its name, since an
+/// override may have put another in its place (`--set
+/// bsdf.sample.file=...` where the scene's own table is absent).
+pub fn scene_file_hash(path: &Path) -> Result<u64> {
+    hash_scene(path, &[], Unreadable::CountsByName)
+}
+
+/// What a named file that cannot be read does to a hash.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Unreadable {
+    Fails,
+    CountsByName,
+}
+
+fn hash_scene(path: &Path, overrides: &[String], unreadable: Unreadable) -> Result<u64> {
     let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
     let mut root = doc::parse(&text, &path.display().to_string())?;
     for assignment in overrides {
         doc::apply_override(&mut root, assignment)?;
     }
     let mut hash = Fnv1a::default();
-    hash_table(&mut hash, &root, &[])?;
+    hash_table(&mut hash, &root, &[], unreadable)?;
     Ok(hash.finish())
 }
 
@@ -92,7 +113,7 @@ const HASHED_FILE: FileKind = FileKind::new("scene file's asset", 16 * GIB);
 /// Keys left out of the hash, by their path from the root.
 const NOT_HASHED: &[&[&str]] = &[&["seed"], &["sampler", "spp"], &["film", "output"]];
 
-fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str]) -> Result<()> {
+fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str], unreadable: Unreadable) -> Result<()> {
     let mut entries: Vec<_> = table.entries.iter().collect();
     entries.sort_by(|a, b| a.key.cmp(&b.key));
     let mut path = at.to_vec();
@@ -101,7 +122,7 @@ fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str]) -> Result<()> {
         if !NOT_HASHED.contains(&path.as_slice()) {
             hash.write(b"k");
             hash.write_field(entry.key.as_bytes());
-            hash_value(hash, &entry.node, &path)?;
+            hash_value(hash, &entry.node, &path, unreadable)?;
         }
         path.pop();
     }
@@ -109,7 +130,7 @@ fn hash_table(hash: &mut Fnv1a, table: &Table, at: &[&str]) -> Result<()> {
     Ok(())
 }
 
-fn hash_value(hash: &mut Fnv1a, node: &Node, at: &[&str]) -> Result<()> {
+fn hash_value(hash: &mut Fnv1a, node: &Node, at: &[&str], unreadable: Unreadable) -> Result<()> {
     match &node.value {
         Value::Bool(b) => hash.write(&[b'b', *b as u8]),
         Value::Int(i) => {
@@ -124,24 +145,29 @@ fn hash_value(hash: &mut Fnv1a, node: &Node, at: &[&str]) -> Result<()> {
             hash.write(b"s");
             hash.write_field(s.as_bytes());
             if names_a_file(at) {
-                hash.write_file(&node.location.resolve(s)).map_err(|e| {
-                    Error::msg(format!(
-                        "{e} (named by {} in the scene, to hash it)",
-                        at.join(".")
-                    ))
-                })?;
+                let mut bytes = *hash;
+                match bytes.write_file(&node.location.resolve(s)) {
+                    Ok(()) => *hash = bytes,
+                    Err(_) if unreadable == Unreadable::CountsByName => hash.write(b"?"),
+                    Err(e) => {
+                        return Err(Error::msg(format!(
+                            "{e} (named by {} in the scene, to hash it)",
+                            at.join(".")
+                        )))
+                    }
+                }
             }
         }
         Value::Array(items) => {
             hash.write(b"a");
             hash.write(&(items.len() as u64).to_le_bytes());
             for item in items {
-                hash_value(hash, item, at)?;
+                hash_value(hash, item, at, unreadable)?;
             }
         }
         Value::Table(table) => {
             hash.write(b"{");
-            hash_table(hash, table, at)?;
+            hash_table(hash, table, at, unreadable)?;
         }
         Value::Datetime(d) => {
             hash.write(b"d");
@@ -233,6 +259,26 @@ mod tests {
         let before = scene_hash(&path, &[]).unwrap();
         std::fs::write(dir.path().join("sky.exr"), b"another sky").unwrap();
         assert_ne!(before, scene_hash(&path, &[]).unwrap());
+    }
+
+    /// The scene file's own hash counts a file it cannot read by its name,
+    /// where the render's hash refuses: an override may replace it.
+    #[test]
+    fn the_file_hash_counts_an_unreadable_file_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("scene.toml");
+        let scene = |file: &str| format!("[[shape]]\ntype = \"obj\"\nfile = \"{file}\"\n");
+        std::fs::write(&path, scene("absent.obj")).unwrap();
+        assert!(scene_hash(&path, &[]).is_err());
+        let absent = scene_file_hash(&path).unwrap();
+        assert_eq!(absent, scene_file_hash(&path).unwrap());
+        std::fs::write(&path, scene("other.obj")).unwrap();
+        assert_ne!(absent, scene_file_hash(&path).unwrap());
+        std::fs::write(dir.path().join("other.obj"), b"v 0 0 0\n").unwrap();
+        assert_eq!(
+            scene_file_hash(&path).unwrap(),
+            scene_hash(&path, &[]).unwrap()
+        );
     }
 
     /// A path given with `--set` is hashed where the loader reads it: from
