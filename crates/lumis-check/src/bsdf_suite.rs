@@ -905,6 +905,7 @@ mod tests {
         let spec = lumis_core::PluginSpec {
             kind: PluginKind::Bsdf,
             name: "wrong-lambert",
+            file: file!(),
             doc: "",
             params: &[],
         };

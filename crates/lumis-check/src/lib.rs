@@ -10,6 +10,8 @@
 pub mod adapters;
 pub mod bsdf_suite;
 pub mod chi_square;
+#[cfg(feature = "integrators")]
+pub mod integrator_suite;
 pub mod light_sampler_suite;
 pub mod light_suite;
 pub mod lobe_zoom;

@@ -295,6 +295,7 @@ mod tests {
     const SPEC: PluginSpec = PluginSpec {
         kind: PluginKind::Bsdf,
         name: "t",
+        file: file!(),
         doc: "",
         params: TestParams::SPECS,
     };

@@ -1,6 +1,6 @@
 //! The `lumis` command line's own commands: the studies (`converge`,
-//! `lecture`, `samplers analyze`), the BRDF tools, the Slurm driver, the
-//! integrator check, `diff`, the plugin listing and `new-plugin`. The
+//! `lecture`, `samplers analyze`), the BRDF tools, the Slurm driver,
+//! `diff`, the plugin listing and `new-plugin`. The
 //! render session they build on (render, merge, denoise, references) is
 //! the `lumis-app` library; this crate is a library too, so that end-to-end
 //! tests and benchmarks drive exactly what users run.
@@ -8,7 +8,6 @@
 mod brdf;
 mod converge;
 mod diff;
-mod integrator_check;
 mod interrupt;
 mod lecture;
 mod listing;
@@ -23,10 +22,6 @@ pub use converge::{
     converge, parse_variants, ConvergeArgs, ConvergeReport, MeasuredImage, Point, Run, Variant,
 };
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
-pub use integrator_check::{
-    check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,
-    IntegratorTest, KNOWN_DEPTHS,
-};
 pub use interrupt::{stop_on_interrupt, INTERRUPTED_EXIT_CODE};
 pub use lecture::{lecture, LectureArgs};
 pub use listing::{plugin_listing, plugin_markdown, PLUGIN_MARKDOWN_COMMAND};

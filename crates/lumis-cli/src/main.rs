@@ -11,6 +11,9 @@ use lumis_app::{
 use lumis_check::bsdf_suite::{
     check_bsdf_with, format_results, write_histogram_png, BsdfCheckConfig,
 };
+use lumis_check::integrator_suite::{
+    check_integrator_with, format_integrator_results, IntegratorCheckConfig,
+};
 use lumis_check::light_sampler_suite::{
     check_light_sampler_with, format_light_sampler_results, LightSamplerCheckConfig,
 };
@@ -18,10 +21,9 @@ use lumis_check::light_suite::{check_light_with, format_light_results, LightChec
 use lumis_check::outcome::Outcome as _;
 use lumis_check::sampler_suite::{check_sampler_with, format_sampler_results, SamplerCheckConfig};
 use lumis_cli::{
-    analyze_samplers, check_integrator_with, compress_table, converge, diff_images,
-    format_integrator_results, lecture, new_plugin, plugin_listing, plugin_markdown,
-    precompute_table, slurm_status, stop_on_interrupt, submit_slurm, tabulate_bsdf, AnalyzeArgs,
-    CompressArgs, ConvergeArgs, DiffArgs, IntegratorCheckConfig, LectureArgs, NewPluginArgs,
+    analyze_samplers, compress_table, converge, diff_images, lecture, new_plugin, plugin_listing,
+    plugin_markdown, precompute_table, slurm_status, stop_on_interrupt, submit_slurm,
+    tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs, DiffArgs, LectureArgs, NewPluginArgs,
     PrecomputeArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, PluginKind, Registry, Result};

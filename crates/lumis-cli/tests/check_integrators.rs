@@ -7,7 +7,7 @@ use lumis_check::sweep::parameter_sweep;
 use std::process::Command;
 
 use lumis_app::builtin_registry;
-use lumis_cli::{
+use lumis_check::integrator_suite::{
     check_integrator_with, format_integrator_results, IntegratorCaseResult, IntegratorCheckConfig,
     IntegratorTest,
 };
@@ -72,6 +72,7 @@ impl Integrator for Scaled {
 const SCALED: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "scaled-path",
+    file: file!(),
     doc: "path, radiance times 0.95 (a planted defect)",
     params: PathParams::SPECS,
 };
@@ -79,6 +80,7 @@ const SCALED: PluginSpec = PluginSpec {
 const SHORT: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "short-path",
+    file: file!(),
     doc: "path that stops one segment short of its max_depth (a planted defect)",
     params: PathParams::SPECS,
 };
@@ -86,6 +88,7 @@ const SHORT: PluginSpec = PluginSpec {
 const DEPTHLESS: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "depthless",
+    file: file!(),
     doc: "direct lighting under a name the kit does not know, without max_depth",
     params: EstimatorParams::SPECS,
 };

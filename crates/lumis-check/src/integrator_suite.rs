@@ -15,17 +15,17 @@
 //!
 //! The exact values need the number of path segments the integrator takes:
 //! its `max_depth` parameter, or [`KNOWN_DEPTHS`]. An integrator with
-//! neither is "not testable". The suite renders scenes, so it lives with
-//! the renderer rather than in the dependency-light lumis-check.
+//! neither is "not testable". The suite renders scenes, so it needs the
+//! scene loader and Embree: the `integrators` feature of this crate.
 
-use lumis_check::outcome::{self, add_faults, summary, unmade, verdict, write_notes, Outcome as _};
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-use lumis_check::corrected_significance;
-use lumis_check::sweep::{declared, parameter_sweep_with, Variant};
+use crate::corrected_significance;
+use crate::outcome::{self, add_faults, summary, unmade, verdict, write_notes, Outcome as _};
+use crate::sweep::{declared, parameter_sweep_with, Variant};
 use lumis_core::params::{ParamDefault, ParamValue};
 use lumis_core::{
     doc::Value, Error, Integrator, Location, PluginEntity, PluginKind, PluginSpec, Registry, Result,
