@@ -6,16 +6,16 @@
 //! between the strategies.
 
 use lumis_api::{
-    Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
-    Sampler, Scene,
+    Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene,
 };
 
 use crate::estimator::{BsdfRay, Estimator, EstimatorParams, SceneView, Vertex, VertexPlan};
-use crate::specialize::Trace;
+use crate::specialize::{integrator_by_trace, Trace};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "direct",
+    file: file!(),
     doc: "direct lighting at the first hit: n_f BSDF and n_g light samples combined by MIS (or one strategy alone); specular surfaces pass one BSDF sample on to the emitter it hits",
     params: EstimatorParams::SPECS,
 };
@@ -35,17 +35,7 @@ impl DirectIntegrator {
     }
 }
 
-impl Integrator for DirectIntegrator {
-    fn li(
-        &self,
-        camera_ray: &Ray,
-        scene: &dyn Scene,
-        sampler: &mut dyn Sampler,
-        stats: &mut RenderStats,
-    ) -> Rgb {
-        self.trace(camera_ray, &SceneView::new(scene), sampler, stats)
-    }
-}
+integrator_by_trace!(DirectIntegrator);
 
 impl Trace for DirectIntegrator {
     fn trace<S: Scene + ?Sized>(

@@ -14,19 +14,19 @@
 //! worked out once per vertex.
 
 use lumis_api::{
-    Integrator, Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb,
-    Sampler, Scene,
+    Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene,
 };
 
 use crate::estimator::{
     bsdf_context, Estimator, EstimatorParams, Heuristic, SceneView, Strategy, Vertex, VertexPlan,
 };
 use crate::path_state::PathState;
-use crate::specialize::Trace;
+use crate::specialize::{integrator_by_trace, Trace};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "path",
+    file: file!(),
     doc: "unidirectional path tracer: BSDF sampling, light sampling, or both combined with MIS",
     params: PathParams::SPECS,
 };
@@ -86,17 +86,7 @@ impl PathIntegrator {
     }
 }
 
-impl Integrator for PathIntegrator {
-    fn li(
-        &self,
-        camera_ray: &Ray,
-        scene: &dyn Scene,
-        sampler: &mut dyn Sampler,
-        stats: &mut RenderStats,
-    ) -> Rgb {
-        self.trace(camera_ray, &SceneView::new(scene), sampler, stats)
-    }
-}
+integrator_by_trace!(PathIntegrator);
 
 impl Trace for PathIntegrator {
     fn trace<S: Scene + ?Sized>(

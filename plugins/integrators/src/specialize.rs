@@ -25,6 +25,30 @@ pub trait Trace: Send + Sync {
     ) -> Rgb;
 }
 
+/// `Integrator` for a [`Trace`] type: `li` traces through `dyn Scene`.
+macro_rules! integrator_by_trace {
+    ($integrator:ty) => {
+        impl lumis_api::Integrator for $integrator {
+            fn li(
+                &self,
+                camera_ray: &lumis_api::Ray,
+                scene: &dyn lumis_api::Scene,
+                sampler: &mut dyn lumis_api::Sampler,
+                stats: &mut lumis_api::RenderStats,
+            ) -> lumis_api::Rgb {
+                $crate::specialize::Trace::trace(
+                    self,
+                    camera_ray,
+                    &$crate::estimator::SceneView::new(scene),
+                    sampler,
+                    stats,
+                )
+            }
+        }
+    };
+}
+pub(crate) use integrator_by_trace;
+
 /// `I` with its loop compiled for scenes of type `S` (found through
 /// [`Scene::as_any`]) and for `dyn Scene` (any other scene, such as a
 /// wrapper that records queries). Both loops give the same result, bit for

@@ -9,11 +9,13 @@ use lumis_sampling::{
     hash_u64, hash_with, inverse_radical_inverse, scrambled_radical_inverse, DigitScramble,
 };
 
+use crate::dimensions::DimensionCursor;
 use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "halton",
+    file: file!(),
     doc: "one Halton sequence over the image (dimension d in base prime(d)); each pixel gets its own sub-sequence; digits scrambled",
     params: HaltonParams::SPECS,
 };
@@ -73,7 +75,7 @@ pub struct HaltonSampler {
     mult_inverse: [u64; 2],
     seed_key: u64,
     halton_index: u64,
-    dimension: u32,
+    dimension: DimensionCursor,
 }
 
 /// `a^-1 mod n` by the extended Euclidean algorithm (`a`, `n` coprime).
@@ -99,7 +101,7 @@ impl HaltonSampler {
             ],
             seed_key: 0,
             halton_index: 0,
-            dimension: 0,
+            dimension: DimensionCursor::default(),
         }
     }
 
@@ -131,18 +133,16 @@ impl Sampler for HaltonSampler {
         }
         self.halton_index = offset % STRIDE + index as u64 * STRIDE;
         self.seed_key = hash_u64(seed);
-        self.dimension = 2;
+        self.dimension = DimensionCursor::START;
     }
 
     fn get_1d(&mut self) -> f32 {
-        let d = self.dimension;
-        self.dimension += 1;
+        let d = self.dimension.take(1);
         self.sample_dimension(d)
     }
 
     fn get_2d(&mut self) -> Vec2 {
-        let d = self.dimension;
-        self.dimension += 2;
+        let d = self.dimension.take(2);
         Vec2::new(self.sample_dimension(d), self.sample_dimension(d + 1))
     }
 

@@ -11,11 +11,13 @@ use lumis_sampling::{
     scrambled_radical_inverse, DigitScramble,
 };
 
+use crate::dimensions::{net_at_powers_of_two, DimensionCursor};
 use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "hammersley",
+    file: file!(),
     doc: "the Hammersley set (i/spp, radical inverses in 2, 3, 5, ...) of each pixel, Owen-scrambled per pixel; a (0,m,2)-net in the pixel when spp = 2^m",
     params: SppParams::SPECS,
 };
@@ -34,7 +36,7 @@ pub struct HammersleySampler {
     spp: u32,
     key: u64,
     index: u32,
-    dimension: u32,
+    dimension: DimensionCursor,
 }
 
 impl HammersleySampler {
@@ -43,7 +45,7 @@ impl HammersleySampler {
             spp,
             key: 0,
             index: 0,
-            dimension: 0,
+            dimension: DimensionCursor::default(),
         }
     }
 
@@ -83,18 +85,16 @@ impl Sampler for HammersleySampler {
     fn start_pixel_sample(&mut self, pixel: UVec2, index: u32, seed: u64) {
         self.key = pixel_key(pixel.x, pixel.y, seed);
         self.index = index % self.spp;
-        self.dimension = 2;
+        self.dimension = DimensionCursor::START;
     }
 
     fn get_1d(&mut self) -> f32 {
-        let d = self.dimension;
-        self.dimension += 1;
+        let d = self.dimension.take(1);
         self.sample_dimension(d)
     }
 
     fn get_2d(&mut self) -> Vec2 {
-        let d = self.dimension;
-        self.dimension += 2;
+        let d = self.dimension.take(2);
         Vec2::new(self.sample_dimension(d), self.sample_dimension(d + 1))
     }
 
@@ -108,11 +108,7 @@ impl Sampler for HammersleySampler {
 
     /// The scrambled Hammersley set of a power-of-two count is a net.
     fn pixel_pattern(&self) -> PixelPattern {
-        if self.spp.is_power_of_two() {
-            PixelPattern::Net02
-        } else {
-            PixelPattern::Random
-        }
+        net_at_powers_of_two(self.spp)
     }
 
     fn lanes(&self, n: usize) -> Box<dyn SamplerLanes> {

@@ -11,6 +11,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "independent",
+    file: file!(),
     doc: "uniform random samples (PCG32, one stream per pixel); the baseline every other sampler is measured against",
     params: SppParams::SPECS,
 };

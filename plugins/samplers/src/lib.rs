@@ -1,5 +1,6 @@
 //! Standard sample generators.
 
+mod dimensions;
 mod halton;
 mod hammersley;
 mod independent;

@@ -12,6 +12,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "poisson-disk",
+    file: file!(),
     doc: "film-plane positions from toroidal Poisson disk patterns (dart throwing), randomly chosen and shifted per pixel; other dimensions independent",
     params: PoissonDiskParams::SPECS,
 };

@@ -12,11 +12,13 @@ use lumis_sampling::{
     sobol_reversed_run, sobol_reversed_tabulated, xor_scramble, SOBOL_DIMENSIONS,
 };
 
+use crate::dimensions::{net_at_powers_of_two, DimensionCursor};
 use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "sobol",
+    file: file!(),
     doc: "Sobol' points per pixel (the (0,2)-sequence in the film plane, Joe-Kuo dimensions beyond), Owen-scrambled per pixel; progressive: every power-of-two prefix is a (0,m,2)-net",
     params: SobolParams::SPECS,
 };
@@ -192,7 +194,7 @@ pub struct SobolSampler<R = Owen, D = SobolOrder> {
     seed_hashes: [u64; SEED_CACHE],
     cached: u64,
     index: u32,
-    dimension: u32,
+    dimension: DimensionCursor,
     strategy: PhantomData<(R, D)>,
 }
 
@@ -205,7 +207,7 @@ impl<R: Randomization, D: DimensionMapping> SobolSampler<R, D> {
             seed_hashes: [0; SEED_CACHE],
             cached: 0,
             index: 0,
-            dimension: 0,
+            dimension: DimensionCursor::default(),
             strategy: PhantomData,
         }
     }
@@ -384,24 +386,21 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
             self.cached = 0;
         }
         self.index = index;
-        self.dimension = 2;
+        self.dimension = DimensionCursor::START;
     }
 
     fn get_1d(&mut self) -> f32 {
-        let d = self.dimension;
-        self.dimension = d.wrapping_add(1);
+        let d = self.dimension.take(1);
         self.sample_1d(d)
     }
 
     fn get_2d(&mut self) -> Vec2 {
-        let d = self.dimension;
-        self.dimension = d.wrapping_add(2);
+        let d = self.dimension.take(2);
         self.sample_2d(d)
     }
 
     fn get_1d_2d(&mut self) -> (f32, Vec2) {
-        let d = self.dimension;
-        self.dimension = d.wrapping_add(3);
+        let d = self.dimension.take(3);
         match self.tabulated_1d_2d(d) {
             Some(request) => request,
             None => self.general_1d_2d(d),
@@ -418,11 +417,7 @@ impl<R: Randomization, D: DimensionMapping> Sampler for SobolSampler<R, D> {
 
     /// A pixel's first power-of-two points of a (0, 2)-sequence are a net.
     fn pixel_pattern(&self) -> PixelPattern {
-        if self.spp.is_power_of_two() {
-            PixelPattern::Net02
-        } else {
-            PixelPattern::Random
-        }
+        net_at_powers_of_two(self.spp)
     }
 
     fn randomized(&self) -> bool {

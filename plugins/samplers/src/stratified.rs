@@ -14,6 +14,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "stratified",
+    file: file!(),
     doc: "jittered stratification: spp strata in 1D, an nx x ny grid (nx the largest divisor of spp <= sqrt(spp)) in 2D; dimensions padded by per-pixel permutations",
     params: StratifiedParams::SPECS,
 };

@@ -9,11 +9,13 @@ use lumis_sampling::{
     hash_u64, hash_with, laine_karras_permutation, reversed_to_unit_f32, sobol_reversed_u32,
 };
 
+use crate::dimensions::{net_at_powers_of_two, DimensionCursor};
 use crate::spp::SppParams;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "zsobol",
+    file: file!(),
     doc: "Ahmed and Wonka's screen-space blue noise: pixels take consecutive blocks of one Sobol' sequence in Morton order, with randomly permuted base-4 digits; error is anti-correlated between neighbouring pixels (pbrt-v4's default)",
     params: ZSobolParams::SPECS,
 };
@@ -98,7 +100,7 @@ pub struct ZSobolSampler {
     owen: bool,
     seed_key: u64,
     morton_index: u64,
-    dimension: u32,
+    dimension: DimensionCursor,
     /// Per dimension, the permuted index bits above the sample bits: they
     /// depend only on the pixel, so each pixel hashes them once.
     pixel_bits: Vec<u64>,
@@ -113,7 +115,7 @@ impl ZSobolSampler {
             owen,
             seed_key: 0,
             morton_index: 0,
-            dimension: 0,
+            dimension: DimensionCursor::default(),
             pixel_bits: Vec::new(),
             pixel_key: None,
         }
@@ -213,18 +215,16 @@ impl Sampler for ZSobolSampler {
         self.seed_key = hash_u64(seed);
         self.morton_index = (morton_2d(pixel.x & mask, pixel.y & mask) << self.log2_block)
             | (index as u64 & ((1 << self.log2_block) - 1));
-        self.dimension = 2;
+        self.dimension = DimensionCursor::START;
     }
 
     fn get_1d(&mut self) -> f32 {
-        let d = self.dimension;
-        self.dimension += 1;
+        let d = self.dimension.take(1);
         self.sample_2d(d).x
     }
 
     fn get_2d(&mut self) -> Vec2 {
-        let d = self.dimension;
-        self.dimension += 2;
+        let d = self.dimension.take(2);
         self.sample_2d(d)
     }
 
@@ -238,11 +238,7 @@ impl Sampler for ZSobolSampler {
 
     /// Each pixel's power-of-two block of the sequence is a net.
     fn pixel_pattern(&self) -> PixelPattern {
-        if self.spp.is_power_of_two() {
-            PixelPattern::Net02
-        } else {
-            PixelPattern::Random
-        }
+        net_at_powers_of_two(self.spp)
     }
 
     fn randomized(&self) -> bool {
