@@ -144,6 +144,7 @@ fn cosine_spec(name: &'static str) -> PluginSpec {
     PluginSpec {
         kind: PluginKind::Light,
         name,
+        file: file!(),
         doc: "test light",
         params: &[],
     }
@@ -291,6 +292,7 @@ fn sampler_spec(name: &'static str) -> PluginSpec {
     PluginSpec {
         kind: PluginKind::LightSampler,
         name,
+        file: file!(),
         doc: "test light sampler",
         params: &[],
     }

@@ -123,6 +123,7 @@ fn register<const DEFECT: u8>(registry: &mut Registry, name: &'static str) {
     let spec = PluginSpec {
         kind: PluginKind::Sampler,
         name,
+        file: file!(),
         doc: "a sampler with a planted defect",
         params: &[],
     };

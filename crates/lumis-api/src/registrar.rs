@@ -68,6 +68,9 @@ impl fmt::Display for PluginKind {
 pub struct PluginSpec {
     pub kind: PluginKind,
     pub name: &'static str,
+    /// The source file that declares the plugin, `file!()` where its spec
+    /// is written: the plugin reference links to it.
+    pub file: &'static str,
     pub doc: &'static str,
     /// `SPECS` of the plugin's struct deriving
     /// [`PluginParams`](crate::params::PluginParams), which its factory reads.

@@ -67,6 +67,10 @@ pub fn plugin_markdown(registry: &Registry) -> String {
             let _ = write!(out, "\n### `{}`\n\n", p.spec.name);
             if &*p.source != "built-in" {
                 let _ = writeln!(out, "From `{}`.\n", p.source);
+            } else if !std::path::Path::new(p.spec.file).is_absolute() {
+                // The book is docs/src/: its links climb to the repository.
+                let file = p.spec.file;
+                let _ = writeln!(out, "Source: [`{file}`](../../{file}).\n");
             }
             let _ = writeln!(out, "{}", cell(&sentence(p.spec.doc)));
             if p.spec.params.is_empty() {
@@ -207,5 +211,18 @@ mod tests {
             !text.contains("From `"),
             "built-ins name no library:\n{text}"
         );
+        assert!(text.contains(
+            "Source: [`plugins/bsdfs/src/conductor.rs`](../../plugins/bsdfs/src/conductor.rs)."
+        ));
+    }
+
+    /// Every built-in's declaration names a file of the repository.
+    #[test]
+    fn every_builtin_links_to_its_source_file() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        for plugin in lumis_app::builtin_registry().unwrap().plugins() {
+            let file = plugin.spec.file;
+            assert!(root.join(file).is_file(), "{}: {file}", plugin.spec.name);
+        }
     }
 }

@@ -26,6 +26,7 @@ use crate::microfacet::{half_vector, NormalSampling};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "blinn",
+    file: file!(),
     doc: "normalised Blinn-Phong microfacet BRDF with V-cavity masking; half-vector sampling; one-sided",
     params: BlinnParams::SPECS,
 };

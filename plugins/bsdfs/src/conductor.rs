@@ -46,6 +46,7 @@ const _: () = assert!(Lanes::LANES <= MAX_LANES);
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "conductor",
+    file: file!(),
     doc: "rough metal: Cook-Torrance with GGX or Beckmann normals, Smith masking, complex Fresnel; one-sided",
     params: ConductorParams::SPECS,
 };
@@ -53,6 +54,7 @@ pub const SPEC: PluginSpec = PluginSpec {
 pub const MIRROR_SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "mirror",
+    file: file!(),
     doc: "smooth metal: delta reflection with the Fresnel term of the metal (conductor with roughness 0)",
     params: MetalParams::SPECS,
 };

@@ -29,6 +29,7 @@ pub const INDEX_MATCHED: f32 = 1e-3;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "dielectric",
+    file: file!(),
     doc: "glass: Fresnel reflection and refraction, smooth (delta) or rough (Walter et al. 2007)",
     params: DielectricParams::SPECS,
 };

@@ -14,6 +14,7 @@ use lumis_sampling::{simd, warp};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "diffuse",
+    file: file!(),
     doc: "Lambertian reflection f = R/pi, one-sided unless two_sided",
     params: DiffuseParams::SPECS,
 };

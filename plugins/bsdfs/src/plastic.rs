@@ -36,6 +36,7 @@ use crate::microfacet::{half_vector, Microfacet, MicrofacetParams, Roughness};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "plastic",
+    file: file!(),
     doc: "diffuse base under a smooth or rough dielectric coat; lobe choice by albedo; one-sided",
     params: PlasticParams::SPECS,
 };

@@ -14,6 +14,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "twosided",
+    file: file!(),
     doc: "a reflecting BSDF on both sides of the surface (Mitsuba's twosided)",
     params: TwoSidedParams::SPECS,
 };

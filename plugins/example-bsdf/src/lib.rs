@@ -25,6 +25,7 @@ use lumis_sampling::warp;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "phong",
+    file: file!(),
     doc: "modified Phong (Lafortune-Willems 1994): diffuse + normalized cos^n lobe, lobe-mixture sampling; one-sided",
     params: PhongParams::SPECS,
 };

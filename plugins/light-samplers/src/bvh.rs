@@ -18,6 +18,7 @@ use rayon::join;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "bvh",
+    file: file!(),
     doc: "descends a light BVH built by SAH over position and emission cones, at each node choosing a child by its importance from the shading point (Conty Estevez and Kulla 2018, pbrt-v4); lights without bounds (environments) picked alongside",
     params: &[],
 };

@@ -9,6 +9,7 @@ use lumis_api::{Light, LightSampleContext, LightSampler, PluginKind, PluginSpec,
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "power",
+    file: file!(),
     doc: "picks each light with probability proportional to the luminance of its emitted power (uniform if all are zero)",
     params: &[],
 };

@@ -27,6 +27,7 @@ pub use equirect::Equirect;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "envmap",
+    file: file!(),
     doc: "environment radiance from an equirectangular EXR or Radiance .hdr image (Mitsuba's convention: +y up, the image centre along +z), looked up bilinearly and importance-sampled by luminance",
     params: EnvMapParams::SPECS,
 };

@@ -10,6 +10,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "point",
+    file: file!(),
     doc: "isotropic point light: never hit by rays, sampled with probability 1 (MIS weight 1)",
     params: PointLightParams::SPECS,
 };

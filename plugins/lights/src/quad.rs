@@ -17,6 +17,7 @@ use crate::textured::boxed;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "quad",
+    file: file!(),
     doc: "emission of a quad shape: uniform area sampling converted to solid angle, or spherical-rectangle sampling (Urena et al. 2013) for rectangles subtending at least 3e-4 sr",
     params: EmissionParams::SPECS,
 };

@@ -23,6 +23,7 @@ use crate::area::{Emission, EmissionParams, Sampling};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "sphere",
+    file: file!(),
     doc: "emission of a sphere shape: uniform cone sampling from outside, uniform area sampling from inside or on it",
     params: SphereLightParams::SPECS,
 };

@@ -11,6 +11,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "spot",
+    file: file!(),
     doc: "point light emitting into a cone, full intensity inside falloff_start, smoothstep to zero at cutoff; never hit by rays (MIS weight 1)",
     params: SpotLightParams::SPECS,
 };

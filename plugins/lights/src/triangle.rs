@@ -17,6 +17,7 @@ use crate::textured::boxed;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "triangle",
+    file: file!(),
     doc: "emission of one mesh triangle: uniform area sampling converted to solid angle, or spherical-triangle sampling (Arvo 1995) where it subtends 3e-4 to 6.22 sr",
     params: EmissionParams::SPECS,
 };

@@ -20,6 +20,7 @@ use crate::reflectance::Reflectance;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
+    file: file!(),
     doc: "isotropic BRDF tabulated in the MERL format (trilinear f, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
     params: MeasuredParams::SPECS,
 };

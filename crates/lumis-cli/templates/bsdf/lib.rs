@@ -23,6 +23,7 @@ use lumis_sampling::{simd, warp};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "{{plugin}}",
+    file: file!(),
     doc: "Lambertian reflection f = R/pi, cosine-weighted sampling; one-sided",
     params: LambertianParams::SPECS,
 };

@@ -17,6 +17,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "{{plugin}}",
+    file: file!(),
     doc: "path tracer with BSDF sampling only: emission found by the rays the BSDFs sample",
     params: BsdfPathParams::SPECS,
 };

@@ -14,6 +14,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "{{plugin}}",
+    file: file!(),
     doc: "picks each light with probability proportional to the luminance of its power",
     params: &[],
 };

@@ -24,6 +24,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "{{plugin}}",
+    file: file!(),
     doc: "one-sided emission of a quad shape, sampled uniformly by area (density converted to solid angle)",
     params: QuadEmitterParams::SPECS,
 };

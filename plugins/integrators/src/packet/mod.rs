@@ -42,6 +42,7 @@ use state::PathLanes;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "packet",
+    file: file!(),
     doc: "the path tracer run on a packet of 8 paths, one per lane: rays traced as packets, each BSDF and light called once per packet with the lanes that need it (SIMD where the plugin overrides the lane methods); same estimate as path",
     params: PacketParams::SPECS,
 };

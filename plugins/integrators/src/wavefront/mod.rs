@@ -36,6 +36,7 @@ use batched::{Batcher, BsdfLane};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "wavefront",
+    file: file!(),
     doc: "the path tracer run a wave of paths at a time: each bounce traces all rays as packets and calls every BSDF and light once per wave, so plugins may compute lanes with SIMD; same estimate as path",
     params: WavefrontParams::SPECS,
 };

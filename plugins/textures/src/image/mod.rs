@@ -18,6 +18,7 @@ pub use texels::{Texels, Wrap};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Texture,
     name: "image",
+    file: file!(),
     doc: "an image file (PNG, JPEG or EXR); uv (0, 0) is its top-left corner",
     params: ImageParams::SPECS,
 };
