@@ -24,7 +24,7 @@ mod report;
 mod scene_hash;
 mod triangle_mesh;
 
-pub use description::{Compaction, AUTO_COMPACT_TRIANGLES};
+pub use description::{scene_tables, Compaction, SceneTable, AUTO_COMPACT_TRIANGLES};
 pub use load::{load_file, load_str, LoadedScene, SceneDenoiser};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
 pub use scene_hash::{scene_file_hash, scene_hash, Fnv1a};

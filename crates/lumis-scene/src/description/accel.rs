@@ -59,7 +59,7 @@ impl FromParam for Compaction {
     }
 }
 
-const ACCEL_PARAMS: &[ParamSpec] = &[
+pub(crate) const ACCEL_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
         "quality",
         ParamType::String,

@@ -7,7 +7,7 @@ use lumis_core::{Error, Location, ParamSpec, ParamType, Params, Result};
 
 const ADAPTIVE_KEY: &str = "adaptive";
 
-const ADAPTIVE_PARAMS: &[ParamSpec] = &[
+pub(crate) const ADAPTIVE_PARAMS: &[ParamSpec] = &[
     ParamSpec::required(
         "min_spp",
         ParamType::Int,

@@ -11,7 +11,7 @@ use super::document::{type_of, Located};
 use super::transform::parse_transform;
 use crate::gltf::camera::{find_camera, CameraChoice};
 
-const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
+pub(crate) const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     ParamSpec::required("origin", ParamType::Vec3, "eye position"),
     ParamSpec::required("target", ParamType::Vec3, "point looked at"),
     ParamSpec::with_default(
@@ -31,7 +31,7 @@ const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
     ),
 ];
 
-const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
+pub(crate) const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
     ParamSpec::required(
         "file",
         ParamType::Path,

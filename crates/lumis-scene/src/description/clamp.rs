@@ -3,11 +3,17 @@
 //! (`lumis_render::clamp_radiance`), so no integrator declares it.
 
 use lumis_core::doc::{Table, Value};
-use lumis_core::{Error, Result};
+use lumis_core::{Error, ParamSpec, ParamType, Result};
 
 /// The key, taken out of the `[integrator]` table before the integrator
 /// plugin checks its own parameters.
 pub(crate) const CLAMP_KEY: &str = "clamp";
+
+pub(crate) const CLAMP_PARAMS: &[ParamSpec] = &[ParamSpec::optional(
+    CLAMP_KEY,
+    ParamType::Float,
+    "the largest component a camera sample's radiance may have, a positive number",
+)];
 
 /// Takes `clamp` out of the integrator's table: a positive, finite
 /// number, or absent (no clamping).

@@ -9,7 +9,7 @@ use lumis_render::Aov;
 
 use super::document::{type_of, Located};
 
-const FILM_PARAMS: &[ParamSpec] = &[
+pub(crate) const FILM_PARAMS: &[ParamSpec] = &[
     ParamSpec::with_default(
         "resolution",
         ParamType::UIntPair,

@@ -18,11 +18,14 @@ mod gltf_shape;
 mod named;
 mod plugin_libraries;
 mod shapes;
+mod tables;
 mod transform;
 
 use lumis_core::doc::{Table, Value};
 use lumis_core::entity::TYPE_KEY;
-use lumis_core::{Error, Location, PluginEntity, PluginKind, Result};
+use lumis_core::{
+    Error, Location, ParamSpec, ParamType, ParamValue, PluginEntity, PluginKind, Result,
+};
 use lumis_render::PerspectiveCamera;
 
 pub(crate) use accel::AccelOptions;
@@ -32,6 +35,7 @@ pub(crate) use film::FilmDescription;
 pub(crate) use named::NamedPlugin;
 pub(crate) use plugin_libraries::PluginLibraries;
 pub(crate) use shapes::{ShapeEntity, ShapeSource, Surface, SurfaceGeometry};
+pub use tables::{scene_tables, SceneTable};
 
 use document::{take_required_table, take_table, take_tables};
 
@@ -204,6 +208,14 @@ fn check_top_level_keys(root: &Table) -> Result<()> {
         None => Ok(()),
     }
 }
+
+/// The top level's own key (the others name tables).
+pub(crate) const TOP_LEVEL_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
+    "seed",
+    ParamType::Int,
+    ParamValue::Int(0),
+    "the render's random seed, a non-negative integer (--seed overrides it)",
+)];
 
 fn seed_of(root: &Table) -> Result<u64> {
     match root.get("seed") {

@@ -7,7 +7,7 @@ use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Resu
 
 use super::document::Located;
 
-const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
+pub(crate) const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
     "load",
     ParamType::StringArray,
     ParamValue::Array(&[]),

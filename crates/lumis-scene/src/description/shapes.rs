@@ -127,12 +127,17 @@ const SPHERE_PARAMS: &[ParamSpec] = shape_params![
     ParamSpec::required("radius", ParamType::Float, "radius > 0"),
 ];
 
-const SHAPE_TYPES: &[(&str, &[ParamSpec])] = &[
-    ("quad", QUAD_PARAMS),
-    ("mesh", MESH_PARAMS),
-    ("obj", OBJ_PARAMS),
-    ("sphere", SPHERE_PARAMS),
-    ("gltf", GLTF_PARAMS),
+/// Each shape type: its name, what it is, its keys.
+pub(crate) const SHAPE_TYPES: &[(&str, &str, &[ParamSpec])] = &[
+    ("quad", "a parallelogram", QUAD_PARAMS),
+    ("mesh", "triangles written in the scene file", MESH_PARAMS),
+    ("obj", "a Wavefront OBJ mesh", OBJ_PARAMS),
+    ("sphere", "an analytic sphere", SPHERE_PARAMS),
+    (
+        "gltf",
+        "a glTF 2.0 asset: its meshes, materials, emissive surfaces and instances",
+        GLTF_PARAMS,
+    ),
 ];
 
 /// Describes the `index`-th (from 0) `[[shape]]`.
@@ -142,8 +147,8 @@ pub(crate) fn shape(index: usize, (table, location): Located<Table>) -> Result<S
     let (kind, kind_location) = type_of(&table, &location, &owner)?;
     let spec = SHAPE_TYPES
         .iter()
-        .find(|(n, _)| *n == kind)
-        .map(|(_, s)| *s)
+        .find(|(n, ..)| *n == kind)
+        .map(|(.., s)| *s)
         .ok_or_else(|| unknown_shape_type(kind, &kind_location))?;
     let owner = format!("{owner} (type = \"{kind}\")");
     let params = Params::new(owner.clone(), &table, location.clone(), spec, &["type"])?;
@@ -270,7 +275,7 @@ fn obj(params: &Params, table: &Table) -> Result<SurfaceGeometry> {
 
 /// Errors for a shape `type` that is not one of [`SHAPE_TYPES`].
 fn unknown_shape_type(kind: &str, location: &Location) -> Error {
-    let names: Vec<&str> = SHAPE_TYPES.iter().map(|(n, _)| *n).collect();
+    let names: Vec<&str> = SHAPE_TYPES.iter().map(|(n, ..)| *n).collect();
     Error::at(
         location,
         format!(
