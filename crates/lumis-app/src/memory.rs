@@ -89,7 +89,7 @@ impl MemoryEstimate {
         }
         Err(Error::msg(format!(
             "film resolution {}x{}: {what} ({}), more than {}: lower [film] resolution, drop \
-             [film] aovs or sampler.adaptive, or give --max-memory a larger budget if the \
+             [film] aovs or [adaptive], or give --max-memory a larger budget if the \
              machine has it",
             self.resolution.x,
             self.resolution.y,

@@ -239,9 +239,9 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
     memory.check(&budget)?;
     if (slice.is_some() || args.parts.is_some()) && loaded.adaptive.is_some() {
         return Err(Error::msg(
-            "--part, --samples and --parts cannot split a render with [sampler] adaptive: \
+            "--part, --samples and --parts cannot split a render with [adaptive] sampling: \
              which pixels still sample depends on all their earlier samples; remove the \
-             scene's sampler.adaptive to render it in parts",
+             scene's [adaptive] table to render it in parts",
         ));
     }
     // With --parts, where each part's slice ends.

@@ -223,7 +223,7 @@ mod tests {
             PLUGIN_MARKDOWN_COMMAND,
             "### `[film]`",
             "### `[[shape]] type = \"gltf\"`",
-            "### `[integrator] clamp`",
+            "### `[adaptive]`",
             "| `min_spp` | int | required |",
         ] {
             assert!(text.contains(needle), "markdown lacks '{needle}':\n{text}");

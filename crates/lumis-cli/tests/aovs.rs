@@ -1,4 +1,4 @@
-//! `[film] aovs`, `[integrator] clamp` and `[sampler] adaptive` through
+//! `[film] aovs`, `[film] clamp` and `[adaptive]` through
 //! `lumis render`: the outputs of an analytic scene, the variance output
 //! against the spread of independent renders, what the clamp leaves alone,
 //! and where adaptive sampling spends its samples.
@@ -178,12 +178,7 @@ fn the_variance_output_matches_the_spread_of_independent_renders() {
 fn clamp_caps_each_sample_and_leaves_a_scene_below_it_alone() {
     let tmp = tempfile::tempdir().unwrap();
     let plain = render(tmp.path(), "plain", 3, &["film.aovs=[]"]);
-    let high = render(
-        tmp.path(),
-        "high",
-        3,
-        &["film.aovs=[]", "integrator.clamp=1e30"],
-    );
+    let high = render(tmp.path(), "high", 3, &["film.aovs=[]", "film.clamp=1e30"]);
     assert_eq!(
         high.image, plain.image,
         "a cap above every sample changed the image"
@@ -197,7 +192,7 @@ fn clamp_caps_each_sample_and_leaves_a_scene_below_it_alone() {
         tmp.path(),
         "clamped",
         3,
-        &["film.aovs=[]", &format!("integrator.clamp={cap}")],
+        &["film.aovs=[]", &format!("film.clamp={cap}")],
     );
     // A mean of samples that are each at most the cap.
     for p in &clamped.image.pixels {
@@ -212,7 +207,7 @@ const ADAPTIVE: [&str; 5] = [
     "shape.0.corner=[0.0, -10.0, 0.0]",
     "film.resolution=[16, 8]",
     "sampler.spp=64",
-    "sampler.adaptive={ min_spp = 8, threshold = 0.02 }",
+    "adaptive={ min_spp = 8, threshold = 0.02 }",
 ];
 
 #[test]

@@ -285,9 +285,9 @@ fn render_refuses_slices_it_cannot_render() {
         "--part",
         "0/2",
         "--set",
-        "sampler.adaptive={min_spp = 2, threshold = 0.1}",
+        "adaptive={min_spp = 2, threshold = 0.1}",
     ]);
-    assert!(err.contains("sampler.adaptive"), "{err}");
+    assert!(err.contains("[adaptive]"), "{err}");
     assert!(refusal(&["--part", "2/2"]).contains("expected K/N"));
     assert!(refusal(&["--part", "0/7"]).contains("at most 6 parts"));
     assert!(refusal(&["--samples", "4..7"]).contains("expected A..B"));

@@ -94,7 +94,7 @@ fn an_adaptive_render_killed_at_random_moments_resumes_bit_for_bit() {
     killed_and_resumed_equals_uninterrupted(
         "kill-adaptive",
         2,
-        &["sampler.adaptive={ min_spp = 8, threshold = 0.05 }"],
+        &["adaptive={ min_spp = 8, threshold = 0.05 }"],
     );
 }
 

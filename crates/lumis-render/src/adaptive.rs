@@ -10,7 +10,7 @@
 
 use lumis_core::{Error, Result};
 
-/// `[sampler] adaptive = { min_spp, max_spp, threshold }`.
+/// A scene's `[adaptive]` table: `min_spp`, `max_spp`, `threshold`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AdaptiveSampling {
     /// Samples every pixel takes before any may stop; also the interval

@@ -33,9 +33,9 @@ pub struct LoadedScene {
     /// `film.aovs`, and the albedo and normal a denoiser reads: the outputs
     /// written beside the colour.
     pub aovs: Vec<lumis_render::Aov>,
-    /// `integrator.clamp`: the cap on each sample's largest component.
+    /// `[film] clamp`: the cap on each sample's largest component.
     pub clamp: Option<f32>,
-    /// `sampler.adaptive`, its `max_spp` the sampler's spp.
+    /// `[adaptive]`, its `max_spp` the sampler's spp.
     pub adaptive: Option<lumis_render::AdaptiveSampling>,
 }
 
@@ -115,6 +115,7 @@ pub fn load_str(
                 .iter()
                 .map(|l| l.memory_bytes())
                 .sum::<usize>(),
+        warnings: description.warnings,
         ..LoadReport::default()
     };
 
@@ -156,7 +157,7 @@ pub fn load_str(
         .map(|a| {
             let spp = plugins.sampler.samples_per_pixel();
             lumis_render::AdaptiveSampling::new(a.min_spp, a.max_spp.unwrap_or(spp), a.threshold)
-                .map_err(|e| Error::at(&a.location, format!("[sampler] {}", e.message)))
+                .map_err(|e| Error::at(&a.location, format!("[adaptive] {}", e.message)))
         })
         .transpose()?;
     // A denoiser is guided by the first hit's albedo and normal (Open Image

@@ -1,11 +1,15 @@
-//! `[sampler] adaptive = { min_spp, max_spp, threshold }`: adaptive
-//! sampling, which the render driver does for every sampler alike
-//! (`lumis_render::AdaptiveSampling`), so no sampler declares it.
+//! `[adaptive]`: adaptive sampling, which the render driver does for every
+//! sampler alike (`lumis_render::AdaptiveSampling`), so no sampler
+//! declares it. lumis 0.1.0 read it inside the sampler's table,
+//! `[sampler] adaptive = { ... }`, which still reads, with a warning.
 
 use lumis_core::doc::{Node, Table, Value};
 use lumis_core::{Error, Location, ParamSpec, ParamType, Params, Result};
 
-const ADAPTIVE_KEY: &str = "adaptive";
+use super::document::Located;
+
+/// The table's name, and the key of its deprecated place in `[sampler]`.
+pub(crate) const ADAPTIVE_KEY: &str = "adaptive";
 
 pub(crate) const ADAPTIVE_PARAMS: &[ParamSpec] = &[
     ParamSpec::required(
@@ -35,30 +39,44 @@ pub(crate) struct AdaptiveDescription {
     pub location: Location,
 }
 
-/// Takes `adaptive` out of the sampler's table, and gives the sampler
-/// `spp = max_spp` where the table sets no `spp` (one that sets another is
-/// an error).
-pub(crate) fn take_adaptive(sampler: &mut Table) -> Result<Option<AdaptiveDescription>> {
-    let Some(entry) = sampler.remove(ADAPTIVE_KEY) else {
-        return Ok(None);
+/// Reads `[adaptive]`, or the deprecated `[sampler] adaptive` (with a
+/// warning in `warnings`; both is an error), and gives the sampler `spp =
+/// max_spp` where its table sets no `spp` (one that sets another is an
+/// error).
+pub(crate) fn take_adaptive(
+    adaptive: Option<Located<Table>>,
+    sampler: &mut Table,
+    warnings: &mut Vec<String>,
+) -> Result<Option<AdaptiveDescription>> {
+    let deprecated = sampler.remove(ADAPTIVE_KEY);
+    let (table, location) = match (adaptive, deprecated) {
+        (None, None) => return Ok(None),
+        (Some(located), None) => located,
+        (Some(_), Some(entry)) => {
+            return Err(Error::at(
+                &entry.key_location,
+                "[sampler] adaptive and an [adaptive] table both given; keep the [adaptive] table",
+            ))
+        }
+        (None, Some(entry)) => {
+            let location = entry.node.location.clone();
+            let Value::Table(table) = entry.node.value else {
+                return Err(Error::at(
+                    &location,
+                    format!(
+                        "[sampler] adaptive: expected a table {{ min_spp = N, max_spp = M, threshold = T }}, found {}",
+                        entry.node.value.type_name()
+                    ),
+                ));
+            };
+            warnings.push(format!(
+                "{location}: [sampler] adaptive is deprecated; write its keys as an [adaptive] table (--set adaptive.min_spp=...)"
+            ));
+            (table, location)
+        }
     };
-    let location = entry.node.location.clone();
-    let Value::Table(table) = &entry.node.value else {
-        return Err(Error::at(
-            &location,
-            format!(
-                "[sampler] adaptive: expected a table {{ min_spp = N, max_spp = M, threshold = T }}, found {}",
-                entry.node.value.type_name()
-            ),
-        ));
-    };
-    let params = Params::new(
-        "[sampler] adaptive",
-        table,
-        location.clone(),
-        ADAPTIVE_PARAMS,
-        &[],
-    )?;
+    let table = &table;
+    let params = Params::new("[adaptive]", table, location.clone(), ADAPTIVE_PARAMS, &[])?;
     let min_spp: u32 = params.get("min_spp")?;
     let max_spp: Option<u32> = params.get_opt("max_spp")?;
     let threshold: f32 = params.get("threshold")?;
@@ -80,7 +98,7 @@ pub(crate) fn take_adaptive(sampler: &mut Table) -> Result<Option<AdaptiveDescri
                 return Err(Error::at(
                     &node.location,
                     format!(
-                        "[sampler] spp and adaptive.max_spp = {max_spp} disagree: give one of them (--spp sets spp)"
+                        "[sampler] spp and [adaptive] max_spp = {max_spp} disagree: give one of them (--spp sets spp)"
                     ),
                 ))
             }

@@ -1,32 +1,48 @@
-//! `[integrator] clamp`: the cap on each camera sample's radiance, which
-//! the render driver applies to every integrator's samples alike
-//! (`lumis_render::clamp_radiance`), so no integrator declares it.
+//! The clamp on each camera sample's radiance, which the render driver
+//! applies to every integrator's samples alike
+//! (`lumis_render::clamp_radiance`): `[film] clamp`. lumis 0.1.0 read it
+//! in the integrator's table, `[integrator] clamp`, which still reads,
+//! with a warning.
 
 use lumis_core::doc::{Table, Value};
-use lumis_core::{Error, ParamSpec, ParamType, Result};
+use lumis_core::{Error, Result};
 
-/// The key, taken out of the `[integrator]` table before the integrator
-/// plugin checks its own parameters.
+/// The key, in `[film]` and in its deprecated place in `[integrator]`.
 pub(crate) const CLAMP_KEY: &str = "clamp";
 
-pub(crate) const CLAMP_PARAMS: &[ParamSpec] = &[ParamSpec::optional(
-    CLAMP_KEY,
-    ParamType::Float,
-    "the largest component a camera sample's radiance may have, a positive number",
-)];
+/// `value` as a clamp: positive and finite in `f32`.
+pub(crate) fn checked(value: f32) -> std::result::Result<f32, String> {
+    if value > 0.0 && value.is_finite() {
+        Ok(value)
+    } else {
+        Err(format!("expected a positive, finite number, found {value}"))
+    }
+}
 
-/// Takes `clamp` out of the integrator's table: a positive, finite
-/// number, or absent (no clamping).
-pub(crate) fn take_clamp(integrator: &mut Table) -> Result<Option<f32>> {
+/// Takes the deprecated `clamp` out of the integrator's table, before the
+/// integrator plugin checks its own parameters: the clamp, with a warning
+/// in `warnings`; an error where `[film] clamp` is given too.
+pub(crate) fn take_deprecated_clamp(
+    integrator: &mut Table,
+    film_clamp: Option<f32>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<f32>> {
     let Some(entry) = integrator.remove(CLAMP_KEY) else {
-        return Ok(None);
+        return Ok(film_clamp);
     };
+    let location = &entry.node.location;
+    if film_clamp.is_some() {
+        return Err(Error::at(
+            &entry.key_location,
+            "[integrator] clamp and [film] clamp both given; keep [film] clamp",
+        ));
+    }
     let value = match entry.node.value {
-        Value::Float(v) => v,
-        Value::Int(v) => v as f64,
+        Value::Float(v) => v as f32,
+        Value::Int(v) => v as f32,
         ref other => {
             return Err(Error::at(
-                &entry.node.location,
+                location,
                 format!(
                     "[integrator] clamp: expected a positive number (the largest component a sample's radiance may have), found {}",
                     other.type_name()
@@ -34,11 +50,10 @@ pub(crate) fn take_clamp(integrator: &mut Table) -> Result<Option<f32>> {
             ))
         }
     };
-    if !(value > 0.0 && (value as f32).is_finite()) {
-        return Err(Error::at(
-            &entry.node.location,
-            format!("[integrator] clamp = {value}: expected a positive, finite number"),
-        ));
-    }
-    Ok(Some(value as f32))
+    let value =
+        checked(value).map_err(|why| Error::at(location, format!("[integrator] clamp: {why}")))?;
+    warnings.push(format!(
+        "{location}: [integrator] clamp is deprecated; write it as [film] clamp (--set film.clamp=...)"
+    ));
+    Ok(Some(value))
 }

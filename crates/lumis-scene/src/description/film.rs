@@ -1,5 +1,5 @@
-//! `[film]`: the image's size, where it goes, its pixel filter, and the
-//! outputs written beside the colour.
+//! `[film]`: the image's size, where it goes, its pixel filter, the
+//! outputs written beside the colour, and the clamp on the samples it adds.
 
 use std::path::PathBuf;
 
@@ -7,6 +7,7 @@ use lumis_core::doc::Table;
 use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2};
 use lumis_render::Aov;
 
+use super::clamp;
 use super::document::{type_of, Located};
 
 pub(crate) const FILM_PARAMS: &[ParamSpec] = &[
@@ -31,6 +32,11 @@ pub(crate) const FILM_PARAMS: &[ParamSpec] = &[
         ParamType::StringArray,
         "outputs written as layers of the EXR beside the colour: albedo, normal, depth, variance, spp",
     ),
+    ParamSpec::optional(
+        "clamp",
+        ParamType::Float,
+        "the largest component a camera sample's radiance may have (as pbrt-v4's maxcomponentvalue): biased, it trades rare bright samples for less variance; absent, nothing is clamped",
+    ),
 ];
 
 /// What `[film]` asks for.
@@ -41,6 +47,8 @@ pub(crate) struct FilmDescription {
     pub output: Option<PathBuf>,
     /// `aovs`, in the order written, each once.
     pub aovs: Vec<Aov>,
+    /// `clamp`, checked positive and finite.
+    pub clamp: Option<f32>,
 }
 
 /// Reads `[film]` (all defaults when absent; `file` locates its absence).
@@ -83,10 +91,15 @@ pub(crate) fn film(table: Option<Located<Table>>, file: &Location) -> Result<Fil
         }
         aovs.push(aov);
     }
+    let clamp = film
+        .get_opt::<f32>("clamp")?
+        .map(|value| clamp::checked(value).map_err(|why| film.error("clamp", why)))
+        .transpose()?;
     film.finish()?;
     Ok(FilmDescription {
         resolution,
         output,
         aovs,
+        clamp,
     })
 }

@@ -53,6 +53,7 @@ const TOP_LEVEL_KEYS: &[&str] = &[
     "plugins",
     "accel",
     "denoiser",
+    "adaptive",
 ];
 
 /// A scene as its file describes it, checked and typed.
@@ -63,11 +64,13 @@ pub(crate) struct SceneDescription {
     pub plugin_libraries: PluginLibraries,
     pub accel: AccelOptions,
     pub sampler: PluginEntity,
-    /// `[sampler] adaptive`.
+    /// `[adaptive]`.
     pub adaptive: Option<AdaptiveDescription>,
     pub integrator: PluginEntity,
-    /// `[integrator] clamp`: the cap on each sample's largest component.
+    /// `[film] clamp`: the cap on each sample's largest component.
     pub clamp: Option<f32>,
+    /// What the scene writes in a deprecated way, for the load report.
+    pub warnings: Vec<String>,
     /// `[denoiser]`: a post-process on the finished film, if the scene asks
     /// for one.
     pub denoiser: Option<PluginEntity>,
@@ -128,7 +131,12 @@ impl SceneDescription {
         };
         let (mut sampler_table, sampler_location) =
             take_required_table(&mut root, PluginKind::Sampler.table_name(), file)?;
-        let adaptive = adaptive::take_adaptive(&mut sampler_table)?;
+        let mut warnings = Vec::new();
+        let adaptive = adaptive::take_adaptive(
+            take_table(&mut root, adaptive::ADAPTIVE_KEY)?,
+            &mut sampler_table,
+            &mut warnings,
+        )?;
         let sampler = PluginEntity::from_table(
             PluginKind::Sampler,
             PluginKind::Sampler.table_name(),
@@ -138,7 +146,7 @@ impl SceneDescription {
         )?;
         let (mut integrator_table, integrator_location) =
             take_required_table(&mut root, PluginKind::Integrator.table_name(), file)?;
-        let clamp = clamp::take_clamp(&mut integrator_table)?;
+        let clamp = clamp::take_deprecated_clamp(&mut integrator_table, film.clamp, &mut warnings)?;
         let integrator = PluginEntity::from_table(
             PluginKind::Integrator,
             PluginKind::Integrator.table_name(),
@@ -167,6 +175,7 @@ impl SceneDescription {
             adaptive,
             integrator,
             clamp,
+            warnings,
             denoiser,
             light_sampler,
             textures,

@@ -5,7 +5,7 @@
 
 use lumis_core::ParamSpec;
 
-use super::{accel, adaptive, camera, clamp, film, plugin_libraries, shapes, transform};
+use super::{accel, adaptive, camera, film, plugin_libraries, shapes, transform};
 
 /// A table of the scene file: how a scene writes it, what it is for, and
 /// its keys.
@@ -58,14 +58,9 @@ pub fn scene_tables() -> Vec<SceneTable> {
             params: transform::TRANSFORM_PARAMS,
         },
         SceneTable {
-            heading: "[sampler] adaptive = { ... }".into(),
-            doc: "adaptive sampling, which the renderer does for every sampler alike: pixels stop once their estimated relative error is below the threshold",
+            heading: "[adaptive]".into(),
+            doc: "adaptive sampling, which the renderer does for every sampler alike: pixels stop once their estimated relative error is below the threshold (lumis 0.1.0 read it as [sampler] adaptive = { ... }, which still works, with a warning)",
             params: adaptive::ADAPTIVE_PARAMS,
-        },
-        SceneTable {
-            heading: "[integrator] clamp".into(),
-            doc: "the renderer's cap on each camera sample's radiance, for every integrator alike (biased; absent: no clamping)",
-            params: clamp::CLAMP_PARAMS,
         },
         SceneTable {
             heading: "[accel]".into(),

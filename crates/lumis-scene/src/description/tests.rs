@@ -147,17 +147,12 @@ fn film_aovs_are_typed_and_unknown_names_refused() {
 }
 
 #[test]
-fn integrator_clamp_is_read_by_the_scene_not_the_plugin() {
+fn film_clamp_is_read_by_the_scene_not_the_plugin() {
     assert_eq!(describe("").clamp, None);
-    let with = |clamp: &str| {
-        try_describe(&BASE.replace(
-            "type = \"path\"\n",
-            &format!("type = \"path\"\nclamp = {clamp}\n"),
-        ))
-    };
+    let with = |clamp: &str| try_describe(&format!("{BASE}[film]\nclamp = {clamp}\n"));
     let scene = with("10").unwrap();
     assert_eq!(scene.clamp, Some(10.0));
-    assert!(scene.integrator.table.get("clamp").is_none());
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     assert_eq!(with("0.5").unwrap().clamp, Some(0.5));
     for bad in ["0", "-1.0", "\"high\"", "1e300"] {
         let err = with(bad).err().unwrap().to_string();
@@ -165,19 +160,51 @@ fn integrator_clamp_is_read_by_the_scene_not_the_plugin() {
     }
 }
 
+/// lumis 0.1.0's `[integrator] clamp` still reads, taken out of the
+/// plugin's table, with a warning; given with `[film] clamp` it is an
+/// error.
 #[test]
-fn sampler_adaptive_is_read_by_the_scene_and_sets_the_spp() {
+fn integrator_clamp_reads_with_a_deprecation_warning() {
+    let in_integrator = |clamp: &str| {
+        BASE.replace(
+            "type = \"path\"\n",
+            &format!("type = \"path\"\nclamp = {clamp}\n"),
+        )
+    };
+    let scene = try_describe(&in_integrator("10")).unwrap();
+    assert_eq!(scene.clamp, Some(10.0));
+    assert!(scene.integrator.table.get("clamp").is_none());
+    assert!(
+        scene.warnings.len() == 1
+            && scene.warnings[0].contains("deprecated")
+            && scene.warnings[0].contains("[film] clamp"),
+        "{:?}",
+        scene.warnings
+    );
+    for bad in ["0", "\"high\""] {
+        let err = try_describe(&in_integrator(bad)).err().unwrap().to_string();
+        assert!(err.contains("[integrator] clamp"), "{bad}: {err}");
+    }
+    let both = try_describe(&format!("{}[film]\nclamp = 5\n", in_integrator("10")));
+    let err = both.err().unwrap().to_string();
+    assert!(err.contains("both given"), "{err}");
+}
+
+#[test]
+fn adaptive_is_read_by_the_scene_and_sets_the_spp() {
+    // A top-level key, written before the first table.
     let with = |adaptive: &str, spp: &str| {
-        try_describe(&BASE.replace(
+        let base = BASE.replace(
             "type = \"independent\"\n",
-            &format!("type = \"independent\"\n{spp}adaptive = {adaptive}\n"),
-        ))
+            &format!("type = \"independent\"\n{spp}"),
+        );
+        try_describe(&format!("adaptive = {adaptive}\n{base}"))
     };
     let scene = with("{ min_spp = 4, max_spp = 64, threshold = 0.01 }", "").unwrap();
     let adaptive = scene.adaptive.unwrap();
     assert_eq!((adaptive.min_spp, adaptive.max_spp), (4, Some(64)));
     assert_eq!(adaptive.threshold, 0.01);
-    assert!(scene.sampler.table.get("adaptive").is_none());
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
     assert_eq!(
         scene.sampler.table.get("spp").map(|n| n.value.clone()),
         Some(lumis_core::doc::Value::Int(64))
@@ -199,9 +226,36 @@ fn sampler_adaptive_is_read_by_the_scene_and_sets_the_spp() {
             "spread",
         ),
         ("{ max_spp = 4, threshold = 0.01 }", "", "min_spp"),
-        ("4", "", "expected a table"),
+        ("4", "", "table"),
     ] {
         let err = with(adaptive, spp).err().unwrap().to_string();
         assert!(err.contains(expected), "{adaptive}: {err}");
     }
+}
+
+/// lumis 0.1.0's `[sampler] adaptive = { ... }` still reads, taken out of
+/// the plugin's table, with a warning; given with `[adaptive]` it is an
+/// error.
+#[test]
+fn sampler_adaptive_reads_with_a_deprecation_warning() {
+    let in_sampler = BASE.replace(
+        "type = \"independent\"\n",
+        "type = \"independent\"\nadaptive = { min_spp = 4, max_spp = 64, threshold = 0.01 }\n",
+    );
+    let scene = try_describe(&in_sampler).unwrap();
+    let adaptive = scene.adaptive.unwrap();
+    assert_eq!((adaptive.min_spp, adaptive.max_spp), (4, Some(64)));
+    assert!(scene.sampler.table.get("adaptive").is_none());
+    assert!(
+        scene.warnings.len() == 1
+            && scene.warnings[0].contains("deprecated")
+            && scene.warnings[0].contains("[adaptive]"),
+        "{:?}",
+        scene.warnings
+    );
+    let both = try_describe(&format!(
+        "{in_sampler}[adaptive]\nmin_spp = 4\nthreshold = 0.1\n"
+    ));
+    let err = both.err().unwrap().to_string();
+    assert!(err.contains("both given"), "{err}");
 }
