@@ -9,7 +9,7 @@ use lumis_render::{ProgressFn, RenderProgress};
 
 /// The caller's side of a render. The library prints nothing itself: the
 /// command line passes `eprintln!` as [`Session::notes`] and
-/// [`Progress::Stderr`]; the Python module its own.
+/// [`Progress::Stderr`]; another caller passes its own.
 pub struct Session<'a> {
     pub registry: &'a Registry,
     /// Once set (by Ctrl-C, a signal, a notebook's interrupt), the pass in

@@ -95,19 +95,10 @@ pub struct CaseResult {
 }
 
 impl Outcome for CaseResult {
-    fn passed(&self) -> bool {
-        self.refused.is_some()
-            || (self.chi_square.passed || self.not_testable.is_some()) && self.problems.is_empty()
+    fn test_passed(&self) -> bool {
+        self.chi_square.passed
     }
-    fn refused(&self) -> Option<&str> {
-        self.refused.as_deref()
-    }
-    fn not_testable(&self) -> Option<&str> {
-        self.not_testable.as_deref()
-    }
-    fn problems(&self) -> &[String] {
-        &self.problems
-    }
+    crate::outcome::case_fields!();
 }
 
 /// [`STAND_IN_BSDFS`], made by `registry`.

@@ -123,20 +123,10 @@ pub struct IntegratorCaseResult {
 }
 
 impl outcome::Outcome for IntegratorCaseResult {
-    fn passed(&self) -> bool {
-        self.refused.is_some()
-            || self.problems.is_empty()
-                && (self.not_testable.is_some() || self.p_value >= self.significance)
+    fn test_passed(&self) -> bool {
+        self.p_value >= self.significance
     }
-    fn refused(&self) -> Option<&str> {
-        self.refused.as_deref()
-    }
-    fn not_testable(&self) -> Option<&str> {
-        self.not_testable.as_deref()
-    }
-    fn problems(&self) -> &[String] {
-        &self.problems
-    }
+    outcome::case_fields!();
 }
 
 fn owner(name: &str, variant: &Variant) -> String {

@@ -176,21 +176,10 @@ pub struct LightCaseResult {
 }
 
 impl Outcome for LightCaseResult {
-    fn passed(&self) -> bool {
-        self.refused.is_some()
-            || self.problems.is_empty()
-                && (self.not_testable.is_some()
-                    || self.chi_square.as_ref().is_some_and(|c| c.passed))
+    fn test_passed(&self) -> bool {
+        self.chi_square.as_ref().is_some_and(|c| c.passed)
     }
-    fn refused(&self) -> Option<&str> {
-        self.refused.as_deref()
-    }
-    fn not_testable(&self) -> Option<&str> {
-        self.not_testable.as_deref()
-    }
-    fn problems(&self) -> &[String] {
-        &self.problems
-    }
+    crate::outcome::case_fields!();
 }
 
 /// How the light made for `variant` on `shape` is named, in messages and

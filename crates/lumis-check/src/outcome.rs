@@ -8,15 +8,40 @@ use lumis_core::{Error, Registry};
 
 /// How a case ended.
 pub trait Outcome {
-    /// Whether nothing failed (a refused case passes: it was not tested).
-    fn passed(&self) -> bool;
+    /// Whether the suite's statistical test passed (read only for a case
+    /// that was made and could be decided).
+    fn test_passed(&self) -> bool;
     /// Why the plugin refused the case's parameters (its factory's error).
     fn refused(&self) -> Option<&str>;
     /// Why a test could not decide, as the kit established it.
     fn not_testable(&self) -> Option<&str>;
     /// Everything that failed besides the suite's statistical test.
     fn problems(&self) -> &[String];
+
+    /// Whether nothing failed: a refused case passes (it was not tested);
+    /// otherwise no problem, and the test passed or could not decide.
+    fn passed(&self) -> bool {
+        self.refused().is_some()
+            || self.problems().is_empty() && (self.not_testable().is_some() || self.test_passed())
+    }
 }
+
+/// [`Outcome`]'s accessors for a case result whose fields `refused`,
+/// `not_testable` and `problems` hold what the names say.
+macro_rules! case_fields {
+    () => {
+        fn refused(&self) -> Option<&str> {
+            self.refused.as_deref()
+        }
+        fn not_testable(&self) -> Option<&str> {
+            self.not_testable.as_deref()
+        }
+        fn problems(&self) -> &[String] {
+            &self.problems
+        }
+    };
+}
+pub(crate) use case_fields;
 
 /// The result column of a case's row.
 pub fn verdict(case: &impl Outcome) -> &'static str {
