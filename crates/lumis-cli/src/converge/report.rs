@@ -23,7 +23,8 @@ pub struct Run {
     pub rays_per_second: f64,
     pub mse: f64,
     pub rel_mse: f64,
-    /// PSNR of the sRGB-encoded image ([`error_metrics`]).
+    /// PSNR of the sRGB-encoded image
+    /// ([`lumis_analysis::image_error::error_metrics`]).
     pub psnr_db: f64,
 }
 
