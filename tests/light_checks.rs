@@ -144,7 +144,7 @@ fn cosine_spec(name: &'static str) -> PluginSpec {
     PluginSpec {
         kind: PluginKind::Light,
         name,
-        file: file!(),
+        source: lumis_api::source_file!(),
         doc: "test light",
         params: &[],
     }
@@ -292,7 +292,7 @@ fn sampler_spec(name: &'static str) -> PluginSpec {
     PluginSpec {
         kind: PluginKind::LightSampler,
         name,
-        file: file!(),
+        source: lumis_api::source_file!(),
         doc: "test light sampler",
         params: &[],
     }

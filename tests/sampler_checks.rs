@@ -123,7 +123,7 @@ fn register<const DEFECT: u8>(registry: &mut Registry, name: &'static str) {
     let spec = PluginSpec {
         kind: PluginKind::Sampler,
         name,
-        file: file!(),
+        source: lumis_api::source_file!(),
         doc: "a sampler with a planted defect",
         params: &[],
     };

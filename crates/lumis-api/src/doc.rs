@@ -4,7 +4,10 @@
 //! its cause. A plugin reads them through [`Params`](crate::Params); the
 //! host parses and edits the document they come from.
 
+use std::sync::Arc;
+
 use crate::error::Location;
+use crate::image::DecodedImage;
 
 /// A value with its origin.
 #[derive(Debug, Clone, PartialEq)]
@@ -24,6 +27,9 @@ pub enum Value {
     /// Dates are valid TOML but mean nothing in a scene; kept to be rejected
     /// with a located error.
     Datetime(String),
+    /// Decoded texels a host passes to a plugin (an image embedded in an
+    /// asset); no scene file can write one.
+    Image(Arc<DecodedImage>),
 }
 
 impl Value {
@@ -37,6 +43,7 @@ impl Value {
             Value::Array(_) => "an array",
             Value::Table(_) => "a table",
             Value::Datetime(_) => "a date",
+            Value::Image(_) => "an image",
         }
     }
 }
@@ -58,6 +65,7 @@ impl std::fmt::Display for Value {
                 f.write_str("]")
             }
             Value::Table(table) => write!(f, "{{ {table} }}"),
+            Value::Image(image) => write!(f, "{image:?}"),
         }
     }
 }
@@ -169,6 +177,20 @@ impl From<&str> for Value {
 impl From<[f32; 3]> for Value {
     /// An array of three numbers (located by [`Table::built`]).
     fn from(v: [f32; 3]) -> Self {
+        Value::Array(
+            v.into_iter()
+                .map(|c| Node {
+                    value: c.into(),
+                    location: Location::Builtin,
+                })
+                .collect(),
+        )
+    }
+}
+
+impl From<[f32; 2]> for Value {
+    /// An array of two numbers (located by [`Table::built`]).
+    fn from(v: [f32; 2]) -> Self {
         Value::Array(
             v.into_iter()
                 .map(|c| Node {

@@ -24,6 +24,7 @@ pub mod doc;
 pub mod error;
 pub mod footprint;
 pub mod guard;
+pub mod image;
 pub mod integrator;
 pub mod interaction;
 pub mod lanes;
@@ -46,6 +47,7 @@ pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
 pub use denoiser::{DenoiseInput, Denoiser};
 pub use error::{Error, Location, Result};
 pub use footprint::{PackedFootprint, PixelFootprint};
+pub use image::{DecodedImage, ImageValues};
 pub use integrator::Integrator;
 pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use lanes::{LaneMask, LANES};
@@ -57,7 +59,7 @@ pub use params::{
     ParamChoice, ParamSpec, ParamType, ParamValue, Params, PluginParams, TexturedFloat, TexturedRgb,
 };
 pub use ray::Ray;
-pub use registrar::{PluginKind, PluginSpec, Registrar};
+pub use registrar::{PluginKind, PluginSpec, Registrar, SourceFile};
 pub use sampler::{ConcreteLanes, PixelPattern, Sampler, SamplerLanes};
 pub use scene::Scene;
 pub use spectrum::Rgb;
@@ -67,6 +69,9 @@ pub use texture::{BsdfScope, Texture, TextureQuery, Textures, UvTransform};
 /// `#[plugin_interface]`: a plugin trait and its wrappers, declared once
 /// (see [`wrap`]).
 pub use lumis_derive::plugin_interface;
+/// `source_file!()`: the [`SourceFile`] of the file it is written in, for
+/// [`PluginSpec::source`].
+pub use lumis_derive::source_file;
 /// `#[derive(PluginParams)]` and `#[derive(ParamChoice)]`: a plugin's
 /// parameters declared once, as a struct (see [`PluginParams`](trait@PluginParams)).
 pub use lumis_derive::{ParamChoice, PluginParams};

@@ -68,13 +68,26 @@ impl fmt::Display for PluginKind {
 pub struct PluginSpec {
     pub kind: PluginKind,
     pub name: &'static str,
-    /// The source file that declares the plugin, `file!()` where its spec
-    /// is written: the plugin reference links to it.
-    pub file: &'static str,
+    /// Where the plugin is written: `lumis_api::source_file!()` in the
+    /// file that declares it. The plugin reference links to the file and
+    /// renders its module documentation.
+    pub source: SourceFile,
+    /// One line: what the plugin is.
     pub doc: &'static str,
     /// `SPECS` of the plugin's struct deriving
     /// [`PluginParams`](crate::params::PluginParams), which its factory reads.
     pub params: &'static [ParamSpec],
+}
+
+/// A plugin's source file and its module documentation, written
+/// `lumis_api::source_file!()`.
+#[derive(Debug, Clone, Copy)]
+pub struct SourceFile {
+    /// The path as `file!()` gives it: from the workspace root for a
+    /// workspace member.
+    pub path: &'static str,
+    /// The file's leading `//!` lines: how the plugin works, in Markdown.
+    pub notes: &'static str,
 }
 
 pub type SamplerFactory = fn(&Params) -> Result<Box<dyn Sampler>>;

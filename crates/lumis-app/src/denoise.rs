@@ -141,6 +141,7 @@ fn toml_value(value: &Value) -> Result<toml::Value> {
             text.parse()
                 .map_err(|e| Error::msg(format!("the date {text}: {e}")))?,
         ),
+        Value::Image(image) => return Err(Error::msg(format!("{image:?} has no TOML spelling"))),
     })
 }
 

@@ -896,7 +896,7 @@ mod tests {
         let spec = lumis_core::PluginSpec {
             kind: PluginKind::Bsdf,
             name: "wrong-lambert",
-            file: file!(),
+            source: lumis_api::source_file!(),
             doc: "",
             params: &[],
         };

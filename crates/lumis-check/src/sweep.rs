@@ -295,7 +295,7 @@ mod tests {
     const SPEC: PluginSpec = PluginSpec {
         kind: PluginKind::Bsdf,
         name: "t",
-        file: file!(),
+        source: lumis_api::source_file!(),
         doc: "",
         params: TestParams::SPECS,
     };

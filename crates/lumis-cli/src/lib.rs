@@ -12,6 +12,7 @@ mod interrupt;
 mod lecture;
 mod listing;
 mod new_plugin;
+mod plugin_notes;
 mod samplers_analyze;
 mod slurm;
 

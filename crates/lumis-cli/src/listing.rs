@@ -2,10 +2,13 @@
 //! own declarations, as plain text or as the book's Markdown reference
 //! (`lumis plugins --markdown`, committed as `docs/src/plugins.md`).
 
+use std::collections::HashMap;
 use std::fmt::Write;
 
 use lumis_core::params::{ParamDefault, ParamSpec};
 use lumis_core::{PluginKind, Registry};
+
+use crate::plugin_notes::book_notes;
 
 /// Every registered plugin by kind, with its parameters.
 pub fn plugin_listing(registry: &Registry) -> String {
@@ -58,9 +61,9 @@ pub fn plugin_markdown(registry: &Registry) -> String {
          the same declarations (`PluginSpec`, `ParamSpec`) that check scene \
          files, and a test fails when it differs from the code. A parameter \
          without a default is either required or optional (its absence has a \
-         meaning of its own, given in its description). \
-         [How the built-in plugins work](plugin-notes.md) has the algorithms \
-         behind them.\n",
+         meaning of its own, given in its description). Each built-in \
+         plugin's section ends with how it works, taken from its source \
+         file's module documentation.\n",
     );
     out.push_str(
         "\n## The scene's own tables\n\nThe tables the loader reads itself, \
@@ -73,19 +76,35 @@ pub fn plugin_markdown(registry: &Registry) -> String {
         write_params(&mut out, table.params);
     }
     let plugins = registry.plugins();
+    // The plugin that rendered a file's notes, for the others it declares.
+    let mut notes_of_file: HashMap<&str, &str> = HashMap::new();
     for kind in PluginKind::ALL {
         let _ = write!(out, "\n## {}\n", kind_heading(kind));
         for p in plugins.iter().filter(|p| p.spec.kind == kind) {
-            let _ = write!(out, "\n### `{}`\n\n", p.spec.name);
+            let (name, source) = (p.spec.name, p.spec.source);
+            let _ = write!(out, "\n### `{name}`\n\n");
             if &*p.source != "built-in" {
                 let _ = writeln!(out, "From `{}`.\n", p.source);
-            } else if !std::path::Path::new(p.spec.file).is_absolute() {
+            } else if !std::path::Path::new(source.path).is_absolute() {
                 // The book is docs/src/: its links climb to the repository.
-                let file = p.spec.file;
+                let file = source.path;
                 let _ = writeln!(out, "Source: [`{file}`](../../{file}).\n");
             }
             let _ = writeln!(out, "{}", cell(&sentence(p.spec.doc)));
             write_params(&mut out, p.spec.params);
+            let notes = book_notes(source.notes);
+            if notes.is_empty() {
+                continue;
+            }
+            match notes_of_file.get(source.path) {
+                Some(first) => {
+                    let _ = writeln!(out, "\nHow it works: as [`{first}`](#{first}).");
+                }
+                None => {
+                    notes_of_file.insert(source.path, name);
+                    let _ = write!(out, "\n{notes}");
+                }
+            }
         }
     }
     out
@@ -242,7 +261,7 @@ mod tests {
     fn every_builtin_links_to_its_source_file() {
         let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         for plugin in lumis_app::builtin_registry().unwrap().plugins() {
-            let file = plugin.spec.file;
+            let file = plugin.spec.source.path;
             assert!(root.join(file).is_file(), "{}: {file}", plugin.spec.name);
         }
     }

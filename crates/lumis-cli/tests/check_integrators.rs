@@ -72,7 +72,7 @@ impl Integrator for Scaled {
 const SCALED: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "scaled-path",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "path, radiance times 0.95 (a planted defect)",
     params: PathParams::SPECS,
 };
@@ -80,7 +80,7 @@ const SCALED: PluginSpec = PluginSpec {
 const SHORT: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "short-path",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "path that stops one segment short of its max_depth (a planted defect)",
     params: PathParams::SPECS,
 };
@@ -88,7 +88,7 @@ const SHORT: PluginSpec = PluginSpec {
 const DEPTHLESS: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "depthless",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "direct lighting under a name the kit does not know, without max_depth",
     params: EstimatorParams::SPECS,
 };

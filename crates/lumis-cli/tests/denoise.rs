@@ -127,7 +127,7 @@ impl Denoiser for GuidedOnly {
 const GUIDED_ONLY: PluginSpec = PluginSpec {
     kind: PluginKind::Denoiser,
     name: "guided-only",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "returns the colour, but only when given an albedo",
     params: &[],
 };

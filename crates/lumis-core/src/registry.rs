@@ -371,7 +371,7 @@ mod tests {
     const GREY: PluginSpec = PluginSpec {
         kind: PluginKind::Bsdf,
         name: "grey",
-        file: file!(),
+        source: lumis_api::source_file!(),
         doc: "test",
         params: &[ParamSpec::required("albedo", ParamType::Rgb, "albedo")],
     };

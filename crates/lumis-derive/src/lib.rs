@@ -27,6 +27,7 @@ mod attrs;
 mod param_choice;
 mod plugin_interface;
 mod plugin_params;
+mod source_file;
 mod value;
 
 use proc_macro::TokenStream;
@@ -91,6 +92,25 @@ pub fn plugin_interface(args: TokenStream, item: TokenStream) -> TokenStream {
     let args = parse_macro_input!(args as plugin_interface::Args);
     let item = parse_macro_input!(item as syn::ItemTrait);
     plugin_interface::expand(args, item)
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// `lumis_api::SourceFile` of the file it is written in: its path
+/// (`file!()`) and its module documentation (the leading `//!` lines), for
+/// `PluginSpec::source`. The plugin reference links to the file and
+/// renders the documentation below the plugin's parameters.
+#[proc_macro]
+pub fn source_file(input: TokenStream) -> TokenStream {
+    if !input.is_empty() {
+        return syn::Error::new(
+            proc_macro2::Span::call_site(),
+            "source_file!() takes no arguments",
+        )
+        .into_compile_error()
+        .into();
+    }
+    source_file::expand()
         .unwrap_or_else(syn::Error::into_compile_error)
         .into()
 }

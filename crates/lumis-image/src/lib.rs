@@ -1,5 +1,6 @@
 //! Images: a linear RGB float buffer, EXR and PNG files with metadata in
-//! the EXR header, Radiance `.hdr` files read, writes that never leave a
+//! the EXR header, Radiance `.hdr` files read, texture images (PNG, JPEG,
+//! EXR) decoded with their memory bounded, writes that never leave a
 //! half-written file behind, and a lock that keeps two processes from
 //! writing one output.
 
@@ -10,6 +11,7 @@ pub mod limits;
 mod output_lock;
 mod png_io;
 mod process;
+pub mod texture_decode;
 
 pub use atomic::{remove_stale_temporaries, stage, write_atomically, StagedFile};
 pub use exr_io::{

@@ -173,6 +173,18 @@ fn hash_value(hash: &mut Fnv1a, node: &Node, at: &[&str], unreadable: Unreadable
             hash.write(b"d");
             hash.write_field(d.as_bytes());
         }
+        // Texels decoded by the importer: a scene file holds none, but a
+        // table built in code may.
+        Value::Image(image) => {
+            hash.write(b"m");
+            hash.write(&(image.width as u64).to_le_bytes());
+            hash.write(&(image.height as u64).to_le_bytes());
+            for texel in image.floats() {
+                for c in texel.to_array() {
+                    hash.write(&c.to_bits().to_le_bytes());
+                }
+            }
+        }
     }
     Ok(())
 }

@@ -7,10 +7,10 @@
 //! V-cavity masking of Torrance and Sparrow 1967, `G = min(1, 2 cos theta_h
 //! cos theta_o / <wo, h>, 2 cos theta_h cos theta_i / <wo, h>)`, which
 //! satisfies the projected-area constraint (Heitz 2014, section 5.2), so
-//! the albedo never exceeds `R`. Sampling draws the half vector with
-//! `cos theta_h = u^(1/(n+1))`, density `(n + 1)/(2 pi) cos^n theta_h`, and
-//! maps it to `wi` with the reflection Jacobian `1 / (4 <wo, h>)`.
-//! One-sided.
+//! the albedo never exceeds `R`. Its own sampling, `sampling = "blinn"`,
+//! draws the half vector with `cos theta_h = u^(1/(n+1))`, density
+//! `(n + 1)/(2 pi) cos^n theta_h`, and maps it to `wi` with the reflection
+//! Jacobian `1 / (4 <wo, h>)`. One-sided.
 
 use std::f32::consts::PI;
 
@@ -26,7 +26,7 @@ use crate::microfacet::{half_vector, NormalSampling};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "blinn",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "normalised Blinn-Phong microfacet BRDF with V-cavity masking; half-vector sampling; one-sided",
     params: BlinnParams::SPECS,
 };

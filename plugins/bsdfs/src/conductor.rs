@@ -5,9 +5,19 @@
 //!
 //! (Walter et al. 2007, "Microfacet Models for Refraction through Rough
 //! Surfaces", eq. 20) with Beckmann or GGX normals, height-correlated Smith
-//! masking and the complex Fresnel term of the metal. `mirror` is its
-//! delta limit, which `conductor` also becomes below a roughness of 1e-3.
-//! One-sided, like Mitsuba's: black from behind.
+//! masking and the complex Fresnel term of the metal, from a named
+//! `material` or from `eta` and `k`. `mirror` is its delta limit, with the
+//! same Fresnel term (`material`, `eta`, `k` and `specular_reflectance`);
+//! `conductor` also becomes it below a roughness of 1e-3. One-sided, like
+//! Mitsuba's: black from behind.
+//!
+//! `roughness_v` makes the lobe anisotropic. `sampling = "visible"` draws
+//! visible normals (Heitz 2018 for GGX, Heitz and d'Eon 2014 for Beckmann);
+//! `"full"` draws from `D cos theta_m`. A textured `specular_reflectance`
+//! multiplies the whole value, which is exact since `f` is linear in it and
+//! sampling ignores it. [BSDF sampling](studies/bsdfs.md) has the microfacet
+//! code shared with `dielectric` and `plastic`, and the choices made at the
+//! extremes.
 
 use lumis_api::bsdf::{
     eval_each, eval_lanes_by_batch, sample_f_each, sample_f_lanes_by_batch, BsdfEvalLanes,
@@ -46,7 +56,7 @@ const _: () = assert!(Lanes::LANES <= MAX_LANES);
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "conductor",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "rough metal: Cook-Torrance with GGX or Beckmann normals, Smith masking, complex Fresnel; one-sided",
     params: ConductorParams::SPECS,
 };
@@ -54,7 +64,7 @@ pub const SPEC: PluginSpec = PluginSpec {
 pub const MIRROR_SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "mirror",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "smooth metal: delta reflection with the Fresnel term of the metal (conductor with roughness 0)",
     params: MetalParams::SPECS,
 };

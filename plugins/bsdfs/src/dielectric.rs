@@ -1,11 +1,13 @@
 //! `dielectric`: glass, smooth or rough.
 //!
-//! Smooth: Fresnel-weighted delta reflection and refraction, each picked
-//! with its Fresnel probability. Rough: the microfacet BTDF of Walter et
-//! al. 2007 ("Microfacet Models for Refraction through Rough Surfaces",
-//! eqs. 20-21) with the generalized half vector `m = normalize(wo + eta'
-//! wi)` and the refraction Jacobian `d(omega_m)/d(omega_i) = |<wi, m>| /
-//! (<wi, m> + <wo, m>/eta')^2` (eq. 17, as in pbrt-v4 `DielectricBxDF`).
+//! Smooth (`roughness` below 1e-3): Fresnel-weighted delta reflection and
+//! refraction, each picked with its Fresnel probability. Rough: the
+//! microfacet BTDF of Walter et al. 2007 ("Microfacet Models for Refraction
+//! through Rough Surfaces", eqs. 20-21) with the generalized half vector
+//! `m = normalize(wo + eta' wi)` and the refraction Jacobian
+//! `d(omega_m)/d(omega_i) = |<wi, m>| / (<wi, m> + <wo, m>/eta')^2` (eq. 17,
+//! as in pbrt-v4 `DielectricBxDF`). Relative indices within 1e-3 of 1 are
+//! index-matched and rendered smooth.
 //!
 //! Radiance crossing into a denser medium is compressed into a smaller
 //! solid angle: in radiance transport the transmitted term is divided by
@@ -29,7 +31,7 @@ pub const INDEX_MATCHED: f32 = 1e-3;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "dielectric",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "glass: Fresnel reflection and refraction, smooth (delta) or rough (Walter et al. 2007)",
     params: DielectricParams::SPECS,
 };

@@ -1,4 +1,8 @@
 //! `diffuse`: the Lambertian BRDF `f = R / pi`.
+//!
+//! One-sided unless `two_sided`: as in Mitsuba, a one-sided surface is black
+//! from behind. `sampling = "cosine"` is Malley's method (a uniform point on
+//! the disk, lifted to the hemisphere).
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -14,7 +18,7 @@ use lumis_sampling::{simd, warp};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "diffuse",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "Lambertian reflection f = R/pi, one-sided unless two_sided",
     params: DiffuseParams::SPECS,
 };

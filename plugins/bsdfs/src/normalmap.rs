@@ -44,7 +44,7 @@ use lumis_sampling::rng::{hash_with, Pcg32};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "normalmap",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "a tangent-space normal map on a reflecting BSDF, as a two-facet microsurface: reciprocal, never gains energy (Schüssler et al. 2017)",
     params: NormalMapParams::SPECS,
 };

@@ -2,25 +2,28 @@
 //! (Weidlich and Wilkie 2007's layering, in the closed form of Mitsuba's
 //! `plastic` / `roughplastic`).
 //!
-//! f = F(<wo, m>) D G / (4 cos theta_o cos theta_i)                 (rough coat)
-//!   + (1 - F(theta_i)) (1 - F(theta_o)) rho' / (pi eta^2)        (base)
+//! ```text
+//! f = F(<wo, m>) D G / (4 cos theta_o cos theta_i)          (rough coat)
+//!   + (1 - F(theta_i)) (1 - F(theta_o)) rho' / (pi eta^2)   (base)
+//! ```
 //!
 //! The base term transmits through the coat twice; light reflected back
 //! down by the coat's underside returns to the base, a geometric series
-//! with the coat's internal diffuse reflectance `F_dr,int`: `rho' = rho /
-//! (1 - rho F_dr,int)` (`nonlinear = true`, the physical one; colours get
-//! more saturated) or `rho / (1 - F_dr,int)` (default: `diffuse_reflectance`
-//! is then the base's albedo seen through the coat at normal incidence,
-//! `rho (1 - F(theta_o))`). A smooth coat's reflection is a delta.
+//! with the coat's internal diffuse reflectance `F_dr,int`:
+//! `rho' = rho / (1 - rho F_dr,int)` (`nonlinear = true`, the physical one;
+//! colours get more saturated) or `rho / (1 - F_dr,int)` (default:
+//! `diffuse_reflectance` is then the base's albedo seen through the coat
+//! at normal incidence, `rho (1 - F(theta_o))`). A smooth coat
+//! (`roughness` below 1e-3) reflects as a delta.
 //!
 //! Sampling picks the coat with probability proportional to its albedo at
 //! `wo`, `F(theta_o) s / (F(theta_o) s + (1 - F(theta_o)) rho)` (luminances),
 //! else the base (cosine-weighted); `pdf` is the mixture (one-sample MIS
 //! between the lobes). One-sided.
 //!
-//! A textured `diffuse_reflectance` is the base's albedo at each hit: the
-//! coat stays white, and `f`, `sample_f` and `pdf` derive the base term and
-//! the lobe choice from the same texture value.
+//! A textured `diffuse_reflectance` is the base's albedo at each hit,
+//! clamped to [0, 1]: the coat stays white, and `f`, `sample_f` and `pdf`
+//! derive the base term and the lobe choice from the same texture value.
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -36,7 +39,7 @@ use crate::microfacet::{half_vector, Microfacet, MicrofacetParams, Roughness};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "plastic",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "diffuse base under a smooth or rough dielectric coat; lobe choice by albedo; one-sided",
     params: PlasticParams::SPECS,
 };

@@ -1,9 +1,13 @@
 //! `twosided`: a reflecting BSDF seen from both sides (Mitsuba 3's
-//! `twosided` with one inner BSDF). A hit from behind evaluates the inner
-//! BSDF with both directions mirrored to the front (z -> -z), so the back
-//! of the surface looks like its front; front hits pass through unchanged.
-//! Energy and reciprocity are the inner BSDF's on each side, and a pair of
-//! directions on opposite sides (transmission) gets nothing.
+//! `twosided` with one inner BSDF).
+//!
+//! A hit from behind evaluates the inner BSDF with both directions mirrored
+//! to the front (z -> -z), so the back of the surface looks like its front;
+//! front hits pass through unchanged. Energy and reciprocity are the inner
+//! BSDF's on each side, and a pair of directions on opposite sides
+//! (transmission) gets nothing; a transmitting inner BSDF is refused. glTF
+//! `doubleSided` materials use it. `lumis check-plugin` sweeps it over three
+//! stand-in inner BSDFs (rough plastic, diffuse, rough gold).
 
 use lumis_api::params::NestedBsdf;
 use lumis_api::{
@@ -14,7 +18,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "twosided",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "a reflecting BSDF on both sides of the surface (Mitsuba's twosided)",
     params: TwoSidedParams::SPECS,
 };

@@ -11,7 +11,7 @@ use crate::ffi::{run_rt_filter, Device, RtImages, RtSettings};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Denoiser,
     name: "oidn",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "Intel Open Image Denoise 2 (CPU), its RT filter guided by the film's albedo and normal; biased: the raw render is always kept",
     params: OidnParams::SPECS,
 };

@@ -25,7 +25,7 @@ use lumis_sampling::warp;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "phong",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "modified Phong (Lafortune-Willems 1994): diffuse + normalized cos^n lobe, lobe-mixture sampling; one-sided",
     params: PhongParams::SPECS,
 };

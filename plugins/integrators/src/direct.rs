@@ -1,9 +1,10 @@
 //! `direct`: direct lighting only (emission seen by the camera, plus light
 //! reaching the first surface straight from an emitter), with the same
-//! strategy switches and sample counts as `path`. This is the estimator the
-//! MIS literature compares (Veach 1997, figure 9.2; pbrt-v3
-//! `DirectLightingIntegrator`): no indirect light dilutes the difference
-//! between the strategies.
+//! strategy switches and sample counts as `path`.
+//!
+//! This is the estimator the MIS literature compares (Veach 1997, figure
+//! 9.2; pbrt-v3 `DirectLightingIntegrator`): no indirect light dilutes the
+//! difference between the strategies.
 
 use lumis_api::{
     Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene,
@@ -15,7 +16,7 @@ use crate::specialize::{integrator_by_trace, Trace};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "direct",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "direct lighting at the first hit: n_f BSDF and n_g light samples combined by MIS (or one strategy alone); specular surfaces pass one BSDF sample on to the emitter it hits",
     params: EstimatorParams::SPECS,
 };

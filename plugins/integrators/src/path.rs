@@ -2,16 +2,35 @@
 //! importance sampling and Russian roulette (Veach 1997, ch. 9; pbrt-v4
 //! `PathIntegrator`).
 //!
+//! Each vertex takes `n_g` light samples (next-event estimation) and `n_f`
+//! BSDF samples: the first continues the path, the other `n_f - 1` only
+//! look for emitters. MIS combines the two strategies, with weights from
+//! [`lumis_sampling::mis`]: `estimator = "multi-sample"` takes all of them
+//! (Veach eq. 9.3), `"one-sample"` one strategy per vertex, chosen with
+//! probability `n_f : n_g` (Veach section 9.2.4). The estimator, shared with
+//! `direct`, lives in `plugins/integrators/src/estimator.rs`. Delta lights
+//! and specular lobes are told apart by flags, never by infinite pdfs. Rays
+//! leave a vertex from origins offset by pbrt-v4's floating-point error
+//! bounds, with no scene-scale epsilon. Russian roulette ends a path with
+//! survival probability `max(beta)` after `rr_depth` segments. NaN or
+//! infinite samples are counted, reported and dropped.
+//!
+//! The built-in integrators are compiled for lumis's own scene type as well
+//! as for `dyn Scene` (`plugins/integrators/src/specialize.rs`), so the
+//! closest-hit query inlines into the path loop; both loops give the same
+//! image, bit for bit.
+//!
 //! The order of the loop is chosen for speed where the estimator allows
-//! (docs/performance-log.md has the measurements): a vertex's numbers are
-//! drawn before its intersection, whose latency they then overlap; the
-//! interaction is borrowed where `intersect` wrote it (moving it out of the
-//! `Option` copies 128 bytes); `wo` comes from `-ray.d`, still in registers,
-//! rather than from the interaction's copy, which the CPU cannot forward
-//! from the stores that wrote it; the continuation's BSDF sample, a chain of
-//! dependent latencies the next ray waits on, is issued before next-event
-//! estimation so that the two overlap; and both offset ray origins are
-//! worked out once per vertex.
+//! (the [performance log](performance-log.md) has the measurements): a
+//! vertex's numbers are drawn before its intersection, whose latency they
+//! then overlap; the interaction is borrowed where `intersect` wrote it
+//! (moving it out of the `Option` copies 128 bytes); `wo` comes from
+//! `-ray.d`, still in registers, rather than from the interaction's copy,
+//! which the CPU cannot forward from the stores that wrote it; the
+//! continuation's BSDF sample, a chain of dependent latencies the next ray
+//! waits on, is issued before next-event estimation so that the two
+//! overlap; and both offset ray origins are worked out once per vertex and
+//! shared by its continuation and shadow rays.
 
 use lumis_api::{
     Params, PluginKind, PluginParams, PluginSpec, Ray, RenderStats, Result, Rgb, Sampler, Scene,
@@ -26,7 +45,7 @@ use crate::specialize::{integrator_by_trace, Trace};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "path",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "unidirectional path tracer: BSDF sampling, light sampling, or both combined with MIS",
     params: PathParams::SPECS,
 };

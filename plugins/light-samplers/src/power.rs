@@ -1,15 +1,18 @@
 //! `power`: each light with probability proportional to its emitted power
-//! (pbrt-v4 `PowerLightSampler`, section 12.6.2). Bright lights get the
-//! shadow rays; a scene of one bright and many dim lights no longer spends
-//! most samples on the dim ones. It ignores position: a light far from the
-//! shading point still gets its share.
+//! (pbrt-v4 `PowerLightSampler`, section 12.6.2).
+//!
+//! A light's weight is the luminance of its `power()`; if every weight is
+//! zero, the choice is uniform. Bright lights get the shadow rays; a scene
+//! of one bright and many dim lights no longer spends most samples on the
+//! dim ones. It ignores position: a light far from the shading point still
+//! gets its share.
 
 use lumis_api::{Light, LightSampleContext, LightSampler, PluginKind, PluginSpec, SampledLight};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "power",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "picks each light with probability proportional to the luminance of its emitted power (uniform if all are zero)",
     params: &[],
 };

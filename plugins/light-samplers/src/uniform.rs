@@ -5,7 +5,7 @@ use lumis_api::{LightSampleContext, LightSampler, PluginKind, PluginSpec, Sample
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "uniform",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "picks each of the N lights with probability 1/N",
     params: &[],
 };

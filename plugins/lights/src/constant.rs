@@ -12,7 +12,7 @@ use lumis_sampling::warp;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "constant",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "constant environment radiance from all directions, sampled uniformly over the sphere",
     params: ConstantLightParams::SPECS,
 };

@@ -2,11 +2,19 @@
 //! equirectangular image (pbrt-v4 `ImageInfiniteLight`, Mitsuba 3
 //! `envmap`), importance-sampled by luminance.
 //!
-//! Sampling draws a point of the image from a piecewise-constant 2D
-//! distribution of luminance times `sin theta`, and maps it to a direction;
-//! the Jacobian of `(u, v) -> direction` is `2 pi^2 sin theta`, so the
-//! density in solid angle is `p(u, v) / (2 pi^2 sin theta)` (pbrt-v4,
-//! section 12.5.2).
+//! The image (EXR or Radiance `.hdr`) is looked up bilinearly between texel
+//! centres. `sampling = "importance"` draws a texel from a piecewise-constant
+//! 2D distribution (a marginal over rows, a conditional in each row:
+//! [`lumis_sampling::Distribution2D`]) of each texel's average interpolated
+//! luminance times `sin theta`, then a point uniformly inside it, and maps
+//! that to a direction; the Jacobian of `(u, v) -> direction` is
+//! `2 pi^2 sin theta`, so the density in solid angle is
+//! `p(u, v) / (2 pi^2 sin theta)` (pbrt-v4, section 12.5.2). Averaging the
+//! interpolation (1/8, 3/4, 1/8 of the neighbours along each axis) gives
+//! every texel the interpolation reaches a density. `"uniform"` samples the
+//! sphere, the baseline the bench compares against. `power()` is pbrt-v4's
+//! `Phi`: `pi r^2`, r the scene's bounding radius, times the integral of
+//! radiance over the sphere.
 
 mod equirect;
 
@@ -27,7 +35,7 @@ pub use equirect::Equirect;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "envmap",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "environment radiance from an equirectangular EXR or Radiance .hdr image (Mitsuba's convention: +y up, the image centre along +z), looked up bilinearly and importance-sampled by luminance",
     params: EnvMapParams::SPECS,
 };

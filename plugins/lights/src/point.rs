@@ -10,7 +10,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "point",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "isotropic point light: never hit by rays, sampled with probability 1 (MIS weight 1)",
     params: PointLightParams::SPECS,
 };

@@ -1,6 +1,13 @@
 //! `quad`: a parallelogram emitter, sampled uniformly by area or, for
 //! rectangles, uniformly over the spherical rectangle it subtends (Urena et
 //! al. 2013).
+//!
+//! `sampling = "area"` draws a point uniformly by area and converts its
+//! density to solid angle, `pdf = d^2 / (|cos theta_l| A)`. `"solid-angle"`
+//! is uniform over the spherical rectangle, `pdf = 1 / Omega`, for
+//! rectangles subtending at least 3e-4 sr; smaller ones and skewed
+//! parallelograms are sampled by area. [Lights and MIS](studies/mis.md)
+//! compares the two.
 
 use lumis_api::math::gamma;
 use lumis_api::ray::SurfacePoint;
@@ -17,7 +24,7 @@ use crate::textured::boxed;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "quad",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "emission of a quad shape: uniform area sampling converted to solid angle, or spherical-rectangle sampling (Urena et al. 2013) for rectangles subtending at least 3e-4 sr",
     params: EmissionParams::SPECS,
 };

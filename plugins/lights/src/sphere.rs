@@ -1,8 +1,15 @@
-//! `sphere`: an emissive sphere. From outside it samples the cone of
-//! directions the sphere subtends, uniformly in solid angle; from inside (or
-//! on it) it samples the surface uniformly by area (pbrt-v4 `Sphere::Sample`,
+//! `sphere`: an emissive sphere, sampled by the cone it subtends from
+//! outside and by area from inside.
+//!
+//! With `sampling = "solid-angle"`, a point outside the sphere samples the
+//! cone of directions the sphere subtends, uniformly in solid angle, with
+//! `1 - cos theta_max` from the half-angle form `sin^2 / (1 + cos)`, exact
+//! for a sphere of radius 1e-4 at a distance of 1e4; a point inside (or on)
+//! it samples the surface uniformly by area (pbrt-v4 `Sphere::Sample`,
 //! section 6.2.4; Shirley, Wang and Zimmerman 1996, "Monte Carlo Techniques
-//! for Direct Lighting Calculations", section 3.2).
+//! for Direct Lighting Calculations", section 3.2). `"area"` samples the
+//! surface by area everywhere; from outside, a point on the far side, hidden
+//! behind the near one, gives no sample.
 
 use std::f32::consts::PI;
 
@@ -23,7 +30,7 @@ use crate::area::{Emission, EmissionParams, Sampling};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "sphere",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "emission of a sphere shape: uniform cone sampling from outside, uniform area sampling from inside or on it",
     params: SphereLightParams::SPECS,
 };

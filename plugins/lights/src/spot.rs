@@ -1,5 +1,9 @@
 //! `spot`: a point light emitting in a cone with a smooth falloff (a delta
 //! distribution in position; pbrt-v4 `SpotLight`, section 12.2.1).
+//!
+//! The intensity is full inside `falloff_start` and falls with a smoothstep
+//! in `cos theta` to zero at `cutoff`. Being a delta in position, the light
+//! is never hit by a ray, so its samples take MIS weight 1.
 
 use lumis_api::interaction::LightSampleContext;
 use lumis_api::ray::SurfacePoint;
@@ -11,7 +15,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "spot",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "point light emitting into a cone, full intensity inside falloff_start, smoothstep to zero at cutoff; never hit by rays (MIS weight 1)",
     params: SpotLightParams::SPECS,
 };

@@ -1,5 +1,11 @@
 //! `triangle`: one emissive triangle of a mesh, sampled uniformly by area or
 //! uniformly over the spherical triangle it subtends (Arvo 1995).
+//!
+//! `sampling = "solid-angle"` uses Arvo's spherical triangle sampling
+//! between 3e-4 sr and 6.22 sr (pbrt-v4's bounds) and area sampling outside
+//! that range: below it the spherical excess cancels in float, and area
+//! sampling is almost proportional to solid angle anyway; above it the arcs
+//! degenerate.
 
 use lumis_api::math::gamma;
 use lumis_api::ray::SurfacePoint;
@@ -17,7 +23,7 @@ use crate::textured::boxed;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "triangle",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "emission of one mesh triangle: uniform area sampling converted to solid angle, or spherical-triangle sampling (Arvo 1995) where it subtends 3e-4 to 6.22 sr",
     params: EmissionParams::SPECS,
 };

@@ -1,6 +1,13 @@
 //! `measured`: an isotropic BRDF tabulated in the MERL format, rendered
 //! from the table or from its tensor approximation, with a choice of
 //! importance sampling.
+//!
+//! The table (Matusik et al. 2003) runs over Rusinkiewicz's half/difference
+//! angles `(theta_h, theta_d, phi_d)` and is looked up trilinearly.
+//! `sampling = "factored"` is the factored representation of Lawrence,
+//! Rusinkiewicz and Ramamoorthi 2004. One-sided: black from behind.
+//! [Measured BRDFs](studies/measured.md) has the format, the
+//! representations and what each sampling strategy buys.
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -20,7 +27,7 @@ use crate::reflectance::Reflectance;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "isotropic BRDF tabulated in the MERL format (trilinear f, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
     params: MeasuredParams::SPECS,
 };

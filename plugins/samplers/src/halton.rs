@@ -1,4 +1,10 @@
 //! `halton`: the Halton sequence over the whole image, scrambled.
+//!
+//! Dimension d is the radical inverse in base prime(d) (1000 primes, then
+//! wrap); pixels modulo 128 get their own sub-sequence through the Chinese
+//! remainder theorem (pbrt-v4 section 8.6). `randomize = "owen"` applies
+//! nested digit permutations (a random affine map of each digit keyed by the
+//! digits before it); `"digits"`, one random permutation per digit position.
 
 use lumis_api::{
     ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
@@ -15,7 +21,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "halton",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "one Halton sequence over the image (dimension d in base prime(d)); each pixel gets its own sub-sequence; digits scrambled",
     params: HaltonParams::SPECS,
 };

@@ -1,5 +1,9 @@
 //! `hammersley`: the finite Hammersley point set of the pixel's samples,
 //! Owen-scrambled per pixel.
+//!
+//! Sample i of a pixel is (i/spp, phi_2(i), phi_3(i), phi_5(i), ...), phi_b
+//! the radical inverse in base b, each dimension with its own scramble; the
+//! set is a (0,m,2)-net in the film plane when spp = 2^m.
 
 use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
@@ -17,7 +21,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "hammersley",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "the Hammersley set (i/spp, radical inverses in 2, 3, 5, ...) of each pixel, Owen-scrambled per pixel; a (0,m,2)-net in the pixel when spp = 2^m",
     params: SppParams::SPECS,
 };

@@ -1,4 +1,10 @@
 //! `independent`: uniform random numbers, no stratification.
+//!
+//! The numbers come from PCG32 (lumis's own implementation, checked against
+//! the reference output of pcg-c-basic), one generator per (pixel, sample
+//! index, seed), seeded by splitmix64 hashes. It is the baseline the other
+//! samplers are measured against; [Samplers](studies/samplers.md) measures
+//! what each buys.
 
 use lumis_api::{
     ConcreteLanes, Params, PluginKind, PluginParams, PluginSpec, Result, Sampler, SamplerLanes,
@@ -11,7 +17,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "independent",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "uniform random samples (PCG32, one stream per pixel); the baseline every other sampler is measured against",
     params: SppParams::SPECS,
 };

@@ -1,4 +1,9 @@
 //! `poisson-disk`: Poisson disk patterns for the film plane.
+//!
+//! Film-plane positions come from a pool of toroidal dart-throwing patterns,
+//! one picked and randomly shifted per pixel; the other dimensions are
+//! independent. A `min_distance` too large to place `spp` points is an error
+//! that names the largest usable one.
 
 use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
@@ -12,7 +17,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "poisson-disk",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "film-plane positions from toroidal Poisson disk patterns (dart throwing), randomly chosen and shifted per pixel; other dimensions independent",
     params: PoissonDiskParams::SPECS,
 };

@@ -1,4 +1,11 @@
 //! `sobol`: the Sobol' sequence per pixel, Owen-scrambled.
+//!
+//! The film plane takes the (0,2)-sequence and the dimensions beyond take
+//! Joe and Kuo's direction numbers (1024 dimensions, then wrap); every
+//! dimension is Owen-scrambled per pixel with Burley's hash (2020), so every
+//! power-of-two prefix of a pixel's samples is a (0,m,2)-net.
+//! `dimensions = "padded"` serves every request from the first two
+//! dimensions with an Owen-shuffled index (Burley 2020).
 
 use std::fmt;
 use std::marker::PhantomData;
@@ -18,7 +25,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "sobol",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "Sobol' points per pixel (the (0,2)-sequence in the film plane, Joe-Kuo dimensions beyond), Owen-scrambled per pixel; progressive: every power-of-two prefix is a (0,m,2)-net",
     params: SobolParams::SPECS,
 };

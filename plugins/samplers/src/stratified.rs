@@ -1,5 +1,12 @@
 //! `stratified`: jittered strata in every dimension pair, decorrelated
 //! across dimensions by per-pixel random permutations (padding).
+//!
+//! Each 1D dimension has `spp` strata and each 2D pair an `nx x ny = spp`
+//! grid, `nx` the largest divisor of `spp` not above its square root (32
+//! gives 4 x 8; a prime `spp` gives 1 x `spp` strips, stratified along one
+//! axis only). Each dimension gets its own per-pixel random permutation of
+//! the strata (Kensler's hash permutation), so high dimensions stay
+//! stratified and uncorrelated.
 
 use lumis_api::{
     ConcreteLanes, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result, Sampler,
@@ -14,7 +21,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "stratified",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "jittered stratification: spp strata in 1D, an nx x ny grid (nx the largest divisor of spp <= sqrt(spp)) in 2D; dimensions padded by per-pixel permutations",
     params: StratifiedParams::SPECS,
 };

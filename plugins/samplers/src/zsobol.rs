@@ -1,5 +1,14 @@
 //! `zsobol`: one Sobol' sequence over the image in Morton (Z) order of the
 //! pixels, for blue-noise error between neighbouring pixels.
+//!
+//! Screen-space blue noise after Ahmed and Wonka 2020 (pbrt-v4's default
+//! sampler): pixels own consecutive blocks of the sequence in Morton order,
+//! the index's base-4 digits randomly permuted (nested), and every dimension
+//! pair is padded from Sobol' dimensions 0-1 and Owen-scrambled. A pixel's
+//! samples are a (0,m,2)-net and an aligned 2x2 group of pixels a
+//! (0,m+2,2)-net, so the errors of neighbouring pixels cancel. Pixels are
+//! taken modulo 65536; a `spp` that is not a power of two uses the block of
+//! the next power of two.
 
 use lumis_api::{
     ConcreteLanes, ParamChoice, Params, PixelPattern, PluginKind, PluginParams, PluginSpec, Result,
@@ -15,7 +24,7 @@ use crate::spp::SppParams;
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "zsobol",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "Ahmed and Wonka's screen-space blue noise: pixels take consecutive blocks of one Sobol' sequence in Morton order, with randomly permuted base-4 digits; error is anti-correlated between neighbouring pixels (pbrt-v4's default)",
     params: ZSobolParams::SPECS,
 };

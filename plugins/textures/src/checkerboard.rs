@@ -9,7 +9,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Texture,
     name: "checkerboard",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "two values in alternating squares, 2x2 over the unit uv square",
     params: CheckerboardParams::SPECS,
 };

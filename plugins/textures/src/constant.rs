@@ -5,7 +5,7 @@ use lumis_api::{Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Textu
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Texture,
     name: "constant",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "one value everywhere",
     params: ConstantParams::SPECS,
 };

@@ -2,11 +2,14 @@
 //! [`ParamType`] each Rust type declares ([`Param`]).
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use glam::{UVec2, Vec2, Vec3};
 
 use super::ParamType;
-use crate::doc::{Node, Value};
+use crate::doc::{Node, Table, Value};
+use crate::error::Location;
+use crate::image::DecodedImage;
 use crate::spectrum::Rgb;
 
 /// A value that can be read from a document node.
@@ -185,6 +188,40 @@ impl FromParam for PathBuf {
     }
 }
 
+/// A table given as a parameter, with where it was written: for a value
+/// with keys of its own that its reader checks (a pixel filter, a
+/// placement).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocatedTable {
+    pub table: Table,
+    pub location: Location,
+}
+
+impl FromParam for LocatedTable {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match &node.value {
+            Value::Table(table) => Ok(Self {
+                table: table.clone(),
+                location: node.location.clone(),
+            }),
+            other => Err(format!("expected a table, found {}", other.type_name())),
+        }
+    }
+}
+
+/// Texels a host decoded (an asset's embedded image): shared, not copied.
+impl FromParam for Arc<DecodedImage> {
+    fn from_node(node: &Node) -> std::result::Result<Self, String> {
+        match &node.value {
+            Value::Image(image) => Ok(Arc::clone(image)),
+            other => Err(format!(
+                "expected decoded texels, which only lumis itself passes, found {}",
+                other.type_name()
+            )),
+        }
+    }
+}
+
 /// A type a declared parameter can have: the [`ParamType`] its declaration
 /// shows, and the checks every value of it gets.
 pub trait Param: FromParam {
@@ -256,5 +293,8 @@ plain_param!(
     Vec<f32> => FloatArray,
     Vec<i64> => IntArray,
     Vec<String> => StringArray,
-    Vec<Vec3> => Vec3Array
+    Vec<PathBuf> => StringArray,
+    Vec<Vec3> => Vec3Array,
+    Arc<DecodedImage> => Image,
+    LocatedTable => Table
 );

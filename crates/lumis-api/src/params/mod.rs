@@ -20,7 +20,7 @@ mod typed;
 use std::borrow::Cow;
 use std::cell::RefCell;
 
-pub use convert::{FromParam, Param};
+pub use convert::{FromParam, LocatedTable, Param};
 pub use nested::NestedBsdf;
 pub use spec::{
     check_unique, concat, declares, override_default, total_len, ParamDefault, ParamSpec,

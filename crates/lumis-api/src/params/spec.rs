@@ -37,6 +37,8 @@ pub enum ParamType {
     IntArray,
     StringArray,
     Table,
+    /// Decoded texels, given by the host (an image embedded in an asset).
+    Image,
 }
 
 impl ParamType {
@@ -59,6 +61,7 @@ impl ParamType {
             ParamType::IntArray => "[int]",
             ParamType::StringArray => "[string]",
             ParamType::Table => "table",
+            ParamType::Image => "decoded image (from the host)",
         }
     }
 
@@ -123,7 +126,7 @@ impl ParamValue {
             ParamType::Vec3Array => self.all(ParamType::Vec3),
             ParamType::IntArray => self.all(ParamType::Int),
             ParamType::StringArray => self.all(ParamType::String),
-            ParamType::Table => false,
+            ParamType::Table | ParamType::Image => false,
         }
     }
 

@@ -23,7 +23,7 @@ use lumis_sampling::{simd, warp};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "{{plugin}}",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "Lambertian reflection f = R/pi, cosine-weighted sampling; one-sided",
     params: LambertianParams::SPECS,
 };

@@ -17,7 +17,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "{{plugin}}",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "path tracer with BSDF sampling only: emission found by the rays the BSDFs sample",
     params: BsdfPathParams::SPECS,
 };

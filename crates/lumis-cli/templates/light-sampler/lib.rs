@@ -14,7 +14,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::LightSampler,
     name: "{{plugin}}",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "picks each light with probability proportional to the luminance of its power",
     params: &[],
 };

@@ -24,7 +24,7 @@ use lumis_api::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
     name: "{{plugin}}",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "one-sided emission of a quad shape, sampled uniformly by area (density converted to solid angle)",
     params: QuadEmitterParams::SPECS,
 };

@@ -21,7 +21,7 @@ use lumis_sampling::{
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Sampler,
     name: "{{plugin}}",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "jittered stratification: strata^2 samples per pixel, an n x n grid in each 2D dimension pair, strata permuted per pixel and dimension",
     params: JitteredParams::SPECS,
 };

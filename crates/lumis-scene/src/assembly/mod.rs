@@ -76,7 +76,7 @@ pub(crate) fn assemble(
                 surfaces::add_surface(&shape.owner, surface, &mut asm)?
             }
             ShapeSource::Gltf(request) => {
-                let asset = crate::gltf::import(&request)?;
+                let asset = crate::gltf::import(&request, asm.registry)?;
                 gltf_asset::add_gltf(&shape.owner, &request.file_location, asset, &mut asm)?;
             }
         }

@@ -2,8 +2,8 @@
 //! scene-wide choice of a compact BVH.
 
 use lumis_core::doc::{Node, Table, Value};
-use lumis_core::params::FromParam;
-use lumis_core::{ParamSpec, ParamType, ParamValue, Params, Result};
+use lumis_core::params::{FromParam, Param};
+use lumis_core::{ParamChoice, ParamType, Params, PluginParams, Result};
 use lumis_embree::{BuildQuality, SceneOptions};
 
 use super::document::Located;
@@ -44,6 +44,12 @@ impl Compaction {
     }
 }
 
+/// Declared a string (`"auto"`, its default), though `true` and `false`
+/// read too.
+impl Param for Compaction {
+    const TYPE: ParamType = ParamType::String;
+}
+
 impl FromParam for Compaction {
     fn from_node(node: &Node) -> std::result::Result<Self, String> {
         match &node.value {
@@ -59,33 +65,38 @@ impl FromParam for Compaction {
     }
 }
 
-pub(crate) const ACCEL_PARAMS: &[ParamSpec] = &[
-    ParamSpec::with_default(
-        "quality",
-        ParamType::String,
-        ParamValue::Str("medium"),
-        "Embree BVH build quality: \"low\" (fastest build, Morton), \"medium\" (binned SAH), \"high\" (SAH with spatial splits: slower build, faster rays)",
-    )
-    .one_of(&["low", "medium", "high"]),
-    ParamSpec::with_default(
-        "robust",
-        ParamType::Bool,
-        ParamValue::Bool(false),
-        "RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping through shared edges) at some cost in speed",
-    ),
-    ParamSpec::with_default(
-        "compact",
-        ParamType::String,
-        ParamValue::Str("auto"),
-        "true, false or \"auto\". RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves index the shared vertices instead of copying them) at some cost in speed; \"auto\": from 250000 unique triangles on",
-    ),
-    ParamSpec::with_default(
-        "packets",
-        ParamType::Bool,
-        ParamValue::Bool(false),
-        "the wavefront integrator traces camera rays as coherent Embree packets of 8 always; true: its bounce and shadow rays too, as packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray; off by default: slower on most of the bench suite",
-    ),
-];
+/// The keys of `[accel]`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct AccelParams {
+    /// Embree BVH build quality: "low" (fastest build, Morton), "medium"
+    /// (binned SAH), "high" (SAH with spatial splits: slower build, faster
+    /// rays)
+    #[param(default = Medium)]
+    quality: Quality,
+    /// RTC_SCENE_FLAG_ROBUST: watertight traversal (no rays slipping
+    /// through shared edges) at some cost in speed
+    #[param(default = false)]
+    robust: bool,
+    /// true, false or "auto". RTC_SCENE_FLAG_COMPACT: a smaller BVH (leaves
+    /// index the shared vertices instead of copying them) at some cost in
+    /// speed; "auto": from 250000 unique triangles on
+    #[param(default = "auto")]
+    compact: Compaction,
+    /// the wavefront integrator traces camera rays as coherent Embree
+    /// packets of 8 always; true: its bounce and shadow rays too, as
+    /// packets of 8 (rtcIntersect8, rtcOccluded8) instead of ray by ray;
+    /// off by default: slower on most of the bench suite
+    #[param(default = false)]
+    packets: bool,
+}
+
+/// `quality`: Embree's build quality, as a scene names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ParamChoice)]
+enum Quality {
+    Low,
+    Medium,
+    High,
+}
 
 /// What `[accel]` asks for; compaction is decided once the scene's
 /// triangles are counted.
@@ -103,21 +114,21 @@ pub(crate) fn accel_options(accel: Option<Located<Table>>) -> Result<AccelOption
     let Some((table, location)) = accel else {
         return Ok(AccelOptions::default());
     };
-    let params = Params::new("[accel]", &table, location, ACCEL_PARAMS, &[])?;
-    let quality = match params.get_choice("quality")?.as_str() {
-        "low" => BuildQuality::Low,
-        "medium" => BuildQuality::Medium,
-        "high" => BuildQuality::High,
-        other => unreachable!("quality \"{other}\" is one of the declared choices"),
+    let params = Params::new("[accel]", &table, location, AccelParams::SPECS, &[])?;
+    let p = AccelParams::read(&params)?;
+    let quality = match p.quality {
+        Quality::Low => BuildQuality::Low,
+        Quality::Medium => BuildQuality::Medium,
+        Quality::High => BuildQuality::High,
     };
     let options = AccelOptions {
         embree: SceneOptions {
             quality,
-            robust: params.get("robust")?,
+            robust: p.robust,
             compact: false,
         },
-        compaction: params.get("compact")?,
-        packets: params.get("packets")?,
+        compaction: p.compact,
+        packets: p.packets,
     };
     params.finish()?;
     Ok(options)

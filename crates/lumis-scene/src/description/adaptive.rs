@@ -4,30 +4,25 @@
 //! `[sampler] adaptive = { ... }`, which still reads, with a warning.
 
 use lumis_core::doc::{Node, Table, Value};
-use lumis_core::{Error, Location, ParamSpec, ParamType, Params, Result};
+use lumis_core::{Error, Location, Params, PluginParams, Result};
 
 use super::document::Located;
 
 /// The table's name, and the key of its deprecated place in `[sampler]`.
 pub(crate) const ADAPTIVE_KEY: &str = "adaptive";
 
-pub(crate) const ADAPTIVE_PARAMS: &[ParamSpec] = &[
-    ParamSpec::required(
-        "min_spp",
-        ParamType::Int,
-        "samples every pixel takes before it may stop, and between checks (at least 2)",
-    ),
-    ParamSpec::optional(
-        "max_spp",
-        ParamType::Int,
-        "samples no pixel goes beyond (default: the sampler's spp, which it sets)",
-    ),
-    ParamSpec::required(
-        "threshold",
-        ParamType::Float,
-        "relative error under which a pixel stops",
-    ),
-];
+/// The keys of `[adaptive]`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct AdaptiveParams {
+    /// samples every pixel takes before it may stop, and between checks
+    /// (at least 2)
+    min_spp: u32,
+    /// samples no pixel goes beyond (default: the sampler's spp, which it
+    /// sets)
+    max_spp: Option<u32>,
+    /// relative error under which a pixel stops
+    threshold: f32,
+}
 
 /// `adaptive` as written; `max_spp` is settled against the sampler's
 /// `spp` once the sampler exists.
@@ -76,10 +71,18 @@ pub(crate) fn take_adaptive(
         }
     };
     let table = &table;
-    let params = Params::new("[adaptive]", table, location.clone(), ADAPTIVE_PARAMS, &[])?;
-    let min_spp: u32 = params.get("min_spp")?;
-    let max_spp: Option<u32> = params.get_opt("max_spp")?;
-    let threshold: f32 = params.get("threshold")?;
+    let params = Params::new(
+        "[adaptive]",
+        table,
+        location.clone(),
+        AdaptiveParams::SPECS,
+        &[],
+    )?;
+    let AdaptiveParams {
+        min_spp,
+        max_spp,
+        threshold,
+    } = AdaptiveParams::read(&params)?;
     params.finish()?;
     if let Some(max_spp) = max_spp {
         match sampler.get("spp") {

@@ -4,55 +4,42 @@ use std::path::PathBuf;
 
 use lumis_core::doc::Table;
 use lumis_core::glam::Mat4;
-use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2, Vec3};
+use lumis_core::params::LocatedTable;
+use lumis_core::{Error, Location, Params, PluginParams, Result, UVec2, Vec3};
 use lumis_render::PerspectiveCamera;
 
-use super::document::{type_of, Located};
+use super::document::{type_of, written_string, Located};
 use super::transform::parse_transform;
 use crate::gltf::camera::{find_camera, CameraChoice};
 
-pub(crate) const PERSPECTIVE_PARAMS: &[ParamSpec] = &[
-    ParamSpec::required("origin", ParamType::Vec3, "eye position"),
-    ParamSpec::required("target", ParamType::Vec3, "point looked at"),
-    ParamSpec::with_default(
-        "up",
-        ParamType::Vec3,
-        ParamValue::Array(&[
-            ParamValue::Float(0.0),
-            ParamValue::Float(1.0),
-            ParamValue::Float(0.0),
-        ]),
-        "up direction",
-    ),
-    ParamSpec::required(
-        "fov",
-        ParamType::Float,
-        "full angle of the smaller image axis, degrees, in (0, 180)",
-    ),
-];
+/// The keys of `[camera] type = "perspective"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct PerspectiveParams {
+    /// eye position
+    origin: Vec3,
+    /// point looked at
+    target: Vec3,
+    /// up direction
+    #[param(default = [0.0, 1.0, 0.0])]
+    up: Vec3,
+    /// full angle of the smaller image axis, degrees, in (0, 180)
+    fov: f32,
+}
 
-pub(crate) const GLTF_CAMERA_PARAMS: &[ParamSpec] = &[
-    ParamSpec::required(
-        "file",
-        ParamType::Path,
-        "glTF 2.0 asset (.gltf or .glb), relative to the scene file",
-    ),
-    ParamSpec::optional(
-        "name",
-        ParamType::String,
-        "the camera's name in the asset (default: the first camera a node uses)",
-    ),
-    ParamSpec::optional(
-        "index",
-        ParamType::Int,
-        "the camera's index in the asset's cameras array",
-    ),
-    ParamSpec::optional(
-        "transform",
-        ParamType::Table,
-        "placement applied on top of the node's, as for [[shape]] type = \"gltf\"",
-    ),
-];
+/// The keys of `[camera] type = "gltf"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct GltfCameraParams {
+    /// glTF 2.0 asset (.gltf or .glb), relative to the scene file
+    file: PathBuf,
+    /// the camera's name in the asset (default: the first camera a node
+    /// uses)
+    name: Option<String>,
+    /// the camera's index in the asset's cameras array
+    index: Option<i64>,
+    /// placement applied on top of the node's, as for [[shape]] type =
+    /// "gltf"
+    transform: Option<LocatedTable>,
+}
 
 /// Reads `[camera]` for a film of `resolution`.
 pub(crate) fn camera(
@@ -75,21 +62,19 @@ fn perspective(table: &Table, location: Location, resolution: UVec2) -> Result<P
         "[camera] (type = \"perspective\")",
         table,
         location.clone(),
-        PERSPECTIVE_PARAMS,
+        PerspectiveParams::SPECS,
         &["type"],
     )?;
-    let fov: f32 = cam.get("fov")?;
+    let p = PerspectiveParams::read(&cam)?;
+    let fov = p.fov;
     if !(fov > 0.0 && fov < 180.0) {
-        return Err(cam.error("fov", format!("must be in (0, 180) degrees, got {fov}")));
+        return Err(cam.error(
+            PerspectiveParams::KEYS.fov,
+            format!("must be in (0, 180) degrees, got {fov}"),
+        ));
     }
-    let camera = PerspectiveCamera::new(
-        cam.get("origin")?,
-        cam.get("target")?,
-        cam.get("up")?,
-        fov,
-        resolution,
-    )
-    .map_err(|e| Error::at(&location, format!("[camera]: {}", e.message)))?;
+    let camera = PerspectiveCamera::new(p.origin, p.target, p.up, fov, resolution)
+        .map_err(|e| Error::at(&location, format!("[camera]: {}", e.message)))?;
     cam.finish()?;
     Ok(camera)
 }
@@ -102,18 +87,20 @@ fn gltf_camera(table: &Table, location: Location, resolution: UVec2) -> Result<P
         owner,
         table,
         location.clone(),
-        GLTF_CAMERA_PARAMS,
+        GltfCameraParams::SPECS,
         &["type"],
     )?;
-    let file: String = params.get("file")?;
-    let path: PathBuf = params.get("file")?;
-    let base = match params.table("transform")? {
-        Some((t, at)) => parse_transform(&format!("{owner} transform"), t, at)?,
+    let p = GltfCameraParams::read(&params)?;
+    let keys = GltfCameraParams::KEYS;
+    let file = written_string(table, keys.file);
+    let path = p.file;
+    let base = match &p.transform {
+        Some(t) => parse_transform(&format!("{owner} transform"), &t.table, t.location.clone())?,
         None => Mat4::IDENTITY,
     };
-    let choice = match (params.get_opt("name")?, params.get_opt::<i64>("index")?) {
+    let choice = match (p.name, p.index) {
         (Some(_), Some(_)) => {
-            return Err(params.error("index", "give either 'name' or 'index', not both"))
+            return Err(params.error(keys.index, "give either 'name' or 'index', not both"))
         }
         (Some(name), None) => CameraChoice::Named(name),
         (None, Some(index)) => CameraChoice::Index(index),

@@ -80,3 +80,12 @@ pub(crate) fn location_of(table: &Table, key: &str, fallback: &Location) -> Loca
         .get(key)
         .map_or_else(|| fallback.clone(), |n| n.location.clone())
 }
+
+/// The string written at `key` of `table`, for messages that repeat it;
+/// empty where there is none (callers have read it as a string already).
+pub(crate) fn written_string(table: &Table, key: &str) -> String {
+    match table.get(key).map(|node| &node.value) {
+        Some(Value::String(text)) => text.clone(),
+        _ => String::new(),
+    }
+}

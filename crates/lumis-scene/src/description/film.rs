@@ -4,40 +4,31 @@
 use std::path::PathBuf;
 
 use lumis_core::doc::Table;
-use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result, UVec2};
+use lumis_core::params::LocatedTable;
+use lumis_core::{Error, Location, Params, PluginParams, Result, UVec2};
 use lumis_render::Aov;
 
 use super::clamp;
 use super::document::{type_of, Located};
 
-pub(crate) const FILM_PARAMS: &[ParamSpec] = &[
-    ParamSpec::with_default(
-        "resolution",
-        ParamType::UIntPair,
-        ParamValue::Array(&[ParamValue::Int(256), ParamValue::Int(256)]),
-        "image width and height in pixels",
-    ),
-    ParamSpec::optional(
-        "output",
-        ParamType::Path,
-        "output EXR path, relative to the scene file",
-    ),
-    ParamSpec::optional(
-        "filter",
-        ParamType::Table,
-        "pixel filter: { type = \"box\" } (the default)",
-    ),
-    ParamSpec::optional(
-        "aovs",
-        ParamType::StringArray,
-        "outputs written as layers of the EXR beside the colour: albedo, normal, depth, variance, spp",
-    ),
-    ParamSpec::optional(
-        "clamp",
-        ParamType::Float,
-        "the largest component a camera sample's radiance may have (as pbrt-v4's maxcomponentvalue): biased, it trades rare bright samples for less variance; absent, nothing is clamped",
-    ),
-];
+/// The keys of `[film]`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct FilmParams {
+    /// image width and height in pixels
+    #[param(default = [256, 256])]
+    resolution: UVec2,
+    /// output EXR path, relative to the scene file
+    output: Option<PathBuf>,
+    /// pixel filter: { type = "box" } (the default)
+    filter: Option<LocatedTable>,
+    /// outputs written as layers of the EXR beside the colour: albedo,
+    /// normal, depth, variance, spp
+    aovs: Option<Vec<String>>,
+    /// the largest component a camera sample's radiance may have (as
+    /// pbrt-v4's maxcomponentvalue): biased, it trades rare bright samples
+    /// for less variance; absent, nothing is clamped
+    clamp: Option<f32>,
+}
 
 /// What `[film]` asks for.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,18 +45,23 @@ pub(crate) struct FilmDescription {
 /// Reads `[film]` (all defaults when absent; `file` locates its absence).
 pub(crate) fn film(table: Option<Located<Table>>, file: &Location) -> Result<FilmDescription> {
     let (table, location) = table.unwrap_or_else(|| (Table::default(), file.clone()));
-    let film = Params::new("[film]", &table, location, FILM_PARAMS, &[])?;
-    let resolution: UVec2 = film.get("resolution")?;
+    let film = Params::new("[film]", &table, location, FilmParams::SPECS, &[])?;
+    let p = FilmParams::read(&film)?;
+    let keys = FilmParams::KEYS;
+    let resolution = p.resolution;
     if resolution.x == 0 || resolution.y == 0 {
-        return Err(film.error("resolution", "width and height must be at least 1"));
+        return Err(film.error(keys.resolution, "width and height must be at least 1"));
     }
-    let output = film.get_opt::<PathBuf>("output")?;
-    if let Some((filter, location)) = film.table("filter")? {
-        match type_of(filter, &location, "[film] filter")? {
+    if let Some(LocatedTable {
+        table: filter,
+        location,
+    }) = &p.filter
+    {
+        match type_of(filter, location, "[film] filter")? {
             ("box", _) if filter.entries.len() == 1 => {}
             ("box", _) => {
                 return Err(Error::at(
-                    &location,
+                    location,
                     "the box filter takes no parameters (radius 1/2 pixel)",
                 ))
             }
@@ -78,27 +74,27 @@ pub(crate) fn film(table: Option<Located<Table>>, file: &Location) -> Result<Fil
         }
     }
     let mut aovs = Vec::new();
-    for name in film.get_opt::<Vec<String>>("aovs")?.unwrap_or_default() {
+    for name in p.aovs.unwrap_or_default() {
         let allowed = || Aov::ALL.map(|a| format!("\"{a}\"")).join(", ");
         let aov = Aov::from_name(&name).ok_or_else(|| {
             film.error(
-                "aovs",
+                keys.aovs,
                 format!("unknown output \"{name}\"; allowed: {}", allowed()),
             )
         })?;
         if aovs.contains(&aov) {
-            return Err(film.error("aovs", format!("\"{name}\" is listed twice")));
+            return Err(film.error(keys.aovs, format!("\"{name}\" is listed twice")));
         }
         aovs.push(aov);
     }
-    let clamp = film
-        .get_opt::<f32>("clamp")?
-        .map(|value| clamp::checked(value).map_err(|why| film.error("clamp", why)))
+    let clamp = p
+        .clamp
+        .map(|value| clamp::checked(value).map_err(|why| film.error(keys.clamp, why)))
         .transpose()?;
     film.finish()?;
     Ok(FilmDescription {
         resolution,
-        output,
+        output: p.output,
         aovs,
         clamp,
     })

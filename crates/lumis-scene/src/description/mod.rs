@@ -21,11 +21,9 @@ mod shapes;
 mod tables;
 mod transform;
 
-use lumis_core::doc::{Table, Value};
+use lumis_core::doc::Table;
 use lumis_core::entity::TYPE_KEY;
-use lumis_core::{
-    Error, Location, ParamSpec, ParamType, ParamValue, PluginEntity, PluginKind, Result,
-};
+use lumis_core::{Error, Location, Params, PluginEntity, PluginKind, PluginParams, Result};
 use lumis_render::PerspectiveCamera;
 
 pub(crate) use accel::AccelOptions;
@@ -90,7 +88,7 @@ impl SceneDescription {
     /// [`Location::resolve`] says.
     pub fn from_document(mut root: Table, file: &Location) -> Result<Self> {
         check_top_level_keys(&root)?;
-        let seed = seed_of(&root)?;
+        let seed = seed_of(&root, file)?;
         let plugin_libraries =
             plugin_libraries::plugin_libraries(take_table(&mut root, "plugins")?)?;
         let film = film::film(take_table(&mut root, "film")?, file)?;
@@ -219,24 +217,37 @@ fn check_top_level_keys(root: &Table) -> Result<()> {
 }
 
 /// The top level's own key (the others name tables).
-pub(crate) const TOP_LEVEL_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
-    "seed",
-    ParamType::Int,
-    ParamValue::Int(0),
-    "the render's random seed, a non-negative integer (--seed overrides it)",
-)];
+/// The keys outside every table.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct TopLevelParams {
+    /// the render's random seed, a non-negative integer (--seed overrides
+    /// it)
+    #[param(default = 0)]
+    seed: i64,
+}
 
-fn seed_of(root: &Table) -> Result<u64> {
-    match root.get("seed") {
-        None => Ok(0),
-        Some(node) => match node.value {
-            Value::Int(s) if s >= 0 => Ok(s as u64),
-            _ => Err(Error::at(
-                &node.location,
-                "seed: expected a non-negative integer",
-            )),
-        },
+/// `seed`, read through the declaration of the top-level keys (the
+/// tables beside it are read by their own).
+fn seed_of(root: &Table, file: &Location) -> Result<u64> {
+    let mut top = Table::default();
+    top.entries
+        .extend(root.entries.iter().filter(|e| e.key == "seed").cloned());
+    let params = Params::new(
+        "the top level",
+        &top,
+        file.clone(),
+        TopLevelParams::SPECS,
+        &[],
+    )?;
+    let seed = TopLevelParams::read(&params)?.seed;
+    if seed < 0 {
+        return Err(params.error(
+            TopLevelParams::KEYS.seed,
+            format!("expected a non-negative integer, got {seed}"),
+        ));
     }
+    params.finish()?;
+    Ok(seed as u64)
 }
 
 #[cfg(test)]

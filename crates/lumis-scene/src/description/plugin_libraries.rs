@@ -3,16 +3,17 @@
 use std::path::PathBuf;
 
 use lumis_core::doc::Table;
-use lumis_core::{Error, Location, ParamSpec, ParamType, ParamValue, Params, Result};
+use lumis_core::{Error, Location, Params, PluginParams, Result};
 
 use super::document::Located;
 
-pub(crate) const PLUGINS_PARAMS: &[ParamSpec] = &[ParamSpec::with_default(
-    "load",
-    ParamType::StringArray,
-    ParamValue::Array(&[]),
-    "plugin libraries to load, relative to the scene file",
-)];
+/// The keys of `[plugins]`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct PluginsParams {
+    /// plugin libraries to load, relative to the scene file
+    #[param(default = [])]
+    load: Vec<PathBuf>,
+}
 
 /// The libraries of `[plugins] load`, resolved against the scene's directory.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -38,14 +39,20 @@ pub(crate) fn plugin_libraries(table: Option<Located<Table>>) -> Result<PluginLi
     let Some((table, location)) = table else {
         return Ok(PluginLibraries::default());
     };
-    let params = Params::new("[plugins]", &table, location.clone(), PLUGINS_PARAMS, &[])?;
-    let paths: Vec<PathBuf> = params.get("load")?;
+    let params = Params::new(
+        "[plugins]",
+        &table,
+        location.clone(),
+        PluginsParams::SPECS,
+        &[],
+    )?;
+    let paths = PluginsParams::read(&params)?.load;
     params.finish()?;
     Ok(PluginLibraries {
         paths,
         location: Some(
             table
-                .get("load")
+                .get(PluginsParams::KEYS.load)
                 .map_or(location, |node| node.location.clone()),
         ),
     })

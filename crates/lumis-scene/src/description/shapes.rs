@@ -4,13 +4,13 @@
 use std::path::PathBuf;
 
 use lumis_core::doc::Table;
+use lumis_core::params::LocatedTable;
 use lumis_core::{
-    Error, Location, ParamSpec, ParamType, ParamValue, Params, PluginEntity, PluginKind, Result,
-    Vec3,
+    Error, Location, ParamSpec, Params, PluginEntity, PluginKind, PluginParams, Result, Vec3,
 };
 
 use super::document::{location_of, type_of, Located};
-use super::gltf_shape::{gltf_request, GLTF_PARAMS};
+use super::gltf_shape::{gltf_request, GltfShapeParams};
 use crate::bsdf_ref::BsdfRef;
 use crate::gltf::ImportRequest;
 use crate::triangle_mesh::TriangleMesh;
@@ -76,67 +76,80 @@ impl SurfaceGeometry {
     }
 }
 
-macro_rules! shape_params {
-    ($($extra:expr),* $(,)?) => {
-        &[
-            $($extra,)*
-            ParamSpec::required("bsdf", ParamType::String, "name of a [[bsdf]] table"),
-            ParamSpec::optional(
-                "emission",
-                ParamType::Table,
-                "makes the shape an area light: { radiance = [r, g, b], two_sided = false }",
-            ),
-            ParamSpec::with_default("flip_normals", ParamType::Bool, ParamValue::Bool(false), "swap the front and back sides"),
-        ]
-    };
+/// The keys every surface shape shares.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct SurfaceParams {
+    /// name of a [[bsdf]] table
+    bsdf: String,
+    /// makes the shape an area light: { radiance = [r, g, b], two_sided =
+    /// false }
+    emission: Option<LocatedTable>,
+    /// swap the front and back sides
+    #[param(default = false)]
+    flip_normals: bool,
 }
 
-const QUAD_PARAMS: &[ParamSpec] = shape_params![
-    ParamSpec::required("corner", ParamType::Vec3, "one corner of the parallelogram"),
-    ParamSpec::required("edge_u", ParamType::Vec3, "first edge from the corner"),
-    ParamSpec::required(
-        "edge_v",
-        ParamType::Vec3,
-        "second edge; the front faces edge_u x edge_v"
-    ),
-];
-const MESH_PARAMS: &[ParamSpec] = shape_params![
-    ParamSpec::required(
-        "positions",
-        ParamType::Vec3Array,
-        "vertex positions [[x, y, z], ...]"
-    ),
-    ParamSpec::required(
-        "indices",
-        ParamType::IntArray,
-        "three vertex indices per triangle; CCW = front"
-    ),
-    ParamSpec::optional(
-        "normals",
-        ParamType::Vec3Array,
-        "per-vertex shading normals"
-    ),
-];
-const OBJ_PARAMS: &[ParamSpec] = shape_params![ParamSpec::required(
-    "file",
-    ParamType::Path,
-    "Wavefront OBJ file, relative to the scene file; faces are triangulated"
-)];
-const SPHERE_PARAMS: &[ParamSpec] = shape_params![
-    ParamSpec::required("center", ParamType::Vec3, "centre"),
-    ParamSpec::required("radius", ParamType::Float, "radius > 0"),
-];
+/// The keys of `[[shape]] type = "quad"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct QuadParams {
+    /// one corner of the parallelogram
+    corner: Vec3,
+    /// first edge from the corner
+    edge_u: Vec3,
+    /// second edge; the front faces edge_u x edge_v
+    edge_v: Vec3,
+    #[param(flatten)]
+    surface: SurfaceParams,
+}
+
+/// The keys of `[[shape]] type = "mesh"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct MeshParams {
+    /// vertex positions [[x, y, z], ...]
+    positions: Vec<Vec3>,
+    /// three vertex indices per triangle; CCW = front
+    indices: Vec<i64>,
+    /// per-vertex shading normals
+    normals: Option<Vec<Vec3>>,
+    #[param(flatten)]
+    surface: SurfaceParams,
+}
+
+/// The keys of `[[shape]] type = "obj"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct ObjParams {
+    /// Wavefront OBJ file, relative to the scene file; faces are
+    /// triangulated
+    file: PathBuf,
+    #[param(flatten)]
+    surface: SurfaceParams,
+}
+
+/// The keys of `[[shape]] type = "sphere"`.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct SphereParams {
+    /// centre
+    center: Vec3,
+    /// radius > 0
+    radius: f32,
+    #[param(flatten)]
+    surface: SurfaceParams,
+}
 
 /// Each shape type: its name, what it is, its keys.
 pub(crate) const SHAPE_TYPES: &[(&str, &str, &[ParamSpec])] = &[
-    ("quad", "a parallelogram", QUAD_PARAMS),
-    ("mesh", "triangles written in the scene file", MESH_PARAMS),
-    ("obj", "a Wavefront OBJ mesh", OBJ_PARAMS),
-    ("sphere", "an analytic sphere", SPHERE_PARAMS),
+    ("quad", "a parallelogram", QuadParams::SPECS),
+    (
+        "mesh",
+        "triangles written in the scene file",
+        MeshParams::SPECS,
+    ),
+    ("obj", "a Wavefront OBJ mesh", ObjParams::SPECS),
+    ("sphere", "an analytic sphere", SphereParams::SPECS),
     (
         "gltf",
         "a glTF 2.0 asset: its meshes, materials, emissive surfaces and instances",
-        GLTF_PARAMS,
+        GltfShapeParams::SPECS,
     ),
 ];
 
@@ -155,44 +168,67 @@ pub(crate) fn shape(index: usize, (table, location): Located<Table>) -> Result<S
     let source = match kind {
         "gltf" => ShapeSource::Gltf(gltf_request(&owner, &params, &table)?),
         surface_kind => {
-            let geometry = surface_geometry(surface_kind, &params, &table)?;
-            ShapeSource::Surface(surface(&owner, geometry, &params, &table)?)
+            let (geometry, keys) = surface_geometry(surface_kind, &params, &table)?;
+            ShapeSource::Surface(surface(&owner, geometry, keys, &table)?)
         }
     };
     params.finish()?;
     Ok(ShapeEntity { owner, source })
 }
 
-/// The geometry keys of a surface shape of type `kind`.
-fn surface_geometry(kind: &str, params: &Params, table: &Table) -> Result<SurfaceGeometry> {
+/// The geometry of a surface shape of type `kind`, and the keys every
+/// surface shares.
+fn surface_geometry(
+    kind: &str,
+    params: &Params,
+    table: &Table,
+) -> Result<(SurfaceGeometry, SurfaceParams)> {
     match kind {
         "quad" => quad(params),
         "mesh" => mesh(params),
-        "obj" => obj(params, table),
-        "sphere" => Ok(SurfaceGeometry::Sphere {
-            center: params.get("center")?,
-            radius: params.get_positive("radius")?,
-        }),
+        "obj" => {
+            let p = ObjParams::read(params)?;
+            let location = location_of(table, ObjParams::KEYS.file, &Location::Builtin);
+            let file = ObjFile {
+                path: p.file,
+                location,
+            };
+            Ok((SurfaceGeometry::Obj(file), p.surface))
+        }
+        "sphere" => {
+            let p = SphereParams::read(params)?;
+            if p.radius <= 0.0 {
+                return Err(params.error(
+                    SphereParams::KEYS.radius,
+                    format!("must be a positive finite number, got {}", p.radius),
+                ));
+            }
+            let sphere = SurfaceGeometry::Sphere {
+                center: p.center,
+                radius: p.radius,
+            };
+            Ok((sphere, p.surface))
+        }
         other => unreachable!("shape type {other} is one of SHAPE_TYPES"),
     }
 }
 
-/// The keys every surface shape shares: `bsdf`, `emission`, `flip_normals`.
+/// A surface of `geometry` with the keys every surface shape shares.
 fn surface(
     owner: &str,
     geometry: SurfaceGeometry,
-    params: &Params,
+    keys: SurfaceParams,
     table: &Table,
 ) -> Result<Surface> {
     let bsdf = BsdfRef {
-        name: params.get("bsdf")?,
-        location: location_of(table, "bsdf", &Location::Builtin),
+        name: keys.bsdf,
+        location: location_of(table, SurfaceParams::KEYS.bsdf, &Location::Builtin),
     };
-    let emission = match params.table("emission")? {
-        Some((emission, location)) => Some(PluginEntity::from_table_or(
+    let emission = match keys.emission {
+        Some(LocatedTable { table, location }) => Some(PluginEntity::from_table_or(
             PluginKind::Light,
             format!("{owner} emission"),
-            emission.clone(),
+            table,
             location,
             geometry.default_light(),
         )?),
@@ -202,75 +238,68 @@ fn surface(
         geometry,
         bsdf,
         emission,
-        flip_normals: params.get("flip_normals")?,
+        flip_normals: keys.flip_normals,
     })
 }
 
-fn quad(params: &Params) -> Result<SurfaceGeometry> {
-    let corner: Vec3 = params.get("corner")?;
-    let edge_u: Vec3 = params.get("edge_u")?;
-    let edge_v: Vec3 = params.get("edge_v")?;
-    let area = edge_u.cross(edge_v).length();
+fn quad(params: &Params) -> Result<(SurfaceGeometry, SurfaceParams)> {
+    let p = QuadParams::read(params)?;
+    let area = p.edge_u.cross(p.edge_v).length();
     if !(area > 0.0 && area.is_finite()) {
         return Err(params.error(
-            "edge_v",
+            QuadParams::KEYS.edge_v,
             "is parallel to edge_u (or zero): the quad has no area",
         ));
     }
-    Ok(SurfaceGeometry::Quad {
-        corner,
-        edge_u,
-        edge_v,
-    })
+    let quad = SurfaceGeometry::Quad {
+        corner: p.corner,
+        edge_u: p.edge_u,
+        edge_v: p.edge_v,
+    };
+    Ok((quad, p.surface))
 }
 
-fn mesh(params: &Params) -> Result<SurfaceGeometry> {
-    let positions: Vec<Vec3> = params.get("positions")?;
-    let flat: Vec<i64> = params.get("indices")?;
+fn mesh(params: &Params) -> Result<(SurfaceGeometry, SurfaceParams)> {
+    let p = MeshParams::read(params)?;
+    let keys = MeshParams::KEYS;
+    let flat = p.indices;
     if !flat.len().is_multiple_of(3) || flat.is_empty() {
         return Err(params.error(
-            "indices",
+            keys.indices,
             format!(
                 "needs three indices per triangle, got {} values",
                 flat.len()
             ),
         ));
     }
-    let n = positions.len();
+    let n = p.positions.len();
     if let Some((i, bad)) = flat
         .iter()
         .enumerate()
         .find(|(_, &v)| v < 0 || v as usize >= n)
     {
         return Err(params.error(
-            "indices",
+            keys.indices,
             format!("index {bad} (element {i}) is out of range for {n} positions"),
         ));
     }
-    let normals: Option<Vec<Vec3>> = params.get_opt("normals")?;
-    if let Some(ns) = &normals {
+    if let Some(ns) = &p.normals {
         if ns.len() != n {
             return Err(params.error(
-                "normals",
+                keys.normals,
                 format!("has {} entries for {n} positions", ns.len()),
             ));
         }
     }
-    Ok(SurfaceGeometry::Mesh(TriangleMesh {
-        positions: positions.into_iter().map(Into::into).collect(),
+    let mesh = TriangleMesh {
+        positions: p.positions.into_iter().map(Into::into).collect(),
         indices: flat
             .chunks_exact(3)
             .map(|t| [t[0] as u32, t[1] as u32, t[2] as u32])
             .collect(),
-        normals,
-    }))
-}
-
-fn obj(params: &Params, table: &Table) -> Result<SurfaceGeometry> {
-    Ok(SurfaceGeometry::Obj(ObjFile {
-        path: params.get("file")?,
-        location: location_of(table, "file", &Location::Builtin),
-    }))
+        normals: p.normals,
+    };
+    Ok((SurfaceGeometry::Mesh(mesh), p.surface))
 }
 
 /// Errors for a shape `type` that is not one of [`SHAPE_TYPES`].

@@ -3,7 +3,7 @@
 //! [`ParamSpec`] lists that check a scene file, so the page cannot
 //! describe a key the loader does not read.
 
-use lumis_core::ParamSpec;
+use lumis_core::{ParamSpec, PluginParams};
 
 use super::{accel, adaptive, camera, film, plugin_libraries, shapes, transform};
 
@@ -24,22 +24,22 @@ pub fn scene_tables() -> Vec<SceneTable> {
         SceneTable {
             heading: "top level".into(),
             doc: "the keys outside every table",
-            params: super::TOP_LEVEL_PARAMS,
+            params: super::TopLevelParams::SPECS,
         },
         SceneTable {
             heading: "[film]".into(),
             doc: "the image: its size, where it is written, its pixel filter and the outputs beside the colour",
-            params: film::FILM_PARAMS,
+            params: film::FilmParams::SPECS,
         },
         SceneTable {
             heading: "[camera] type = \"perspective\"".into(),
             doc: "a pinhole camera written out",
-            params: camera::PERSPECTIVE_PARAMS,
+            params: camera::PerspectiveParams::SPECS,
         },
         SceneTable {
             heading: "[camera] type = \"gltf\"".into(),
             doc: "a camera of a glTF asset, placed by its node",
-            params: camera::GLTF_CAMERA_PARAMS,
+            params: camera::GltfCameraParams::SPECS,
         },
     ];
     tables.extend(
@@ -55,22 +55,22 @@ pub fn scene_tables() -> Vec<SceneTable> {
         SceneTable {
             heading: "transform = { ... }".into(),
             doc: "an affine placement, in a glTF shape or camera: a matrix, or scale, rotate and translate applied in that order",
-            params: transform::TRANSFORM_PARAMS,
+            params: transform::TransformParams::SPECS,
         },
         SceneTable {
             heading: "[adaptive]".into(),
             doc: "adaptive sampling, which the renderer does for every sampler alike: pixels stop once their estimated relative error is below the threshold (lumis 0.1.0 read it as [sampler] adaptive = { ... }, which still works, with a warning)",
-            params: adaptive::ADAPTIVE_PARAMS,
+            params: adaptive::AdaptiveParams::SPECS,
         },
         SceneTable {
             heading: "[accel]".into(),
             doc: "how Embree builds and traverses the scene's BVH",
-            params: accel::ACCEL_PARAMS,
+            params: accel::AccelParams::SPECS,
         },
         SceneTable {
             heading: "[plugins]".into(),
             doc: "plugin libraries the scene needs",
-            params: plugin_libraries::PLUGINS_PARAMS,
+            params: plugin_libraries::PluginsParams::SPECS,
         },
     ]);
     tables

@@ -6,71 +6,66 @@
 
 use lumis_core::doc::Table;
 use lumis_core::glam::{Mat4, Quat};
-use lumis_core::{Error, Location, ParamSpec, ParamType, Params, Result, Vec3};
+use lumis_core::{Error, Location, Params, PluginParams, Result, Vec3};
 
-pub(crate) const TRANSFORM_PARAMS: &[ParamSpec] = &[
-    ParamSpec::optional(
-        "matrix",
-        ParamType::FloatArray,
-        "16 numbers, a row-major 4x4 affine matrix (last row 0 0 0 1); excludes the other keys",
-    ),
-    ParamSpec::optional(
-        "scale",
-        ParamType::Vec3,
-        "scale factors per axis, applied first",
-    ),
-    ParamSpec::optional(
-        "rotate",
-        ParamType::FloatArray,
-        "[axis_x, axis_y, axis_z, degrees]: rotation about the axis (right-handed), after scale",
-    ),
-    ParamSpec::optional("translate", ParamType::Vec3, "translation, applied last"),
-];
+/// The keys of a `transform = { ... }` table.
+#[derive(Debug, Clone, PluginParams)]
+pub(crate) struct TransformParams {
+    /// 16 numbers, a row-major 4x4 affine matrix (last row 0 0 0 1);
+    /// excludes the other keys
+    matrix: Option<Vec<f32>>,
+    /// scale factors per axis, applied first
+    scale: Option<Vec3>,
+    /// [axis_x, axis_y, axis_z, degrees]: rotation about the axis
+    /// (right-handed), after scale
+    rotate: Option<Vec<f32>>,
+    /// translation, applied last
+    translate: Option<Vec3>,
+}
 
 /// Parses a transform table; `owner` names it in errors (e.g.
 /// `[[shape]] #2 (type = "gltf") transform`).
 pub(crate) fn parse_transform(owner: &str, table: &Table, location: Location) -> Result<Mat4> {
-    let params = Params::new(owner, table, location.clone(), TRANSFORM_PARAMS, &[])?;
-    let matrix = match params.get_opt::<Vec<f32>>("matrix")? {
+    let params = Params::new(owner, table, location.clone(), TransformParams::SPECS, &[])?;
+    let p = TransformParams::read(&params)?;
+    let keys = TransformParams::KEYS;
+    let matrix = match p.matrix {
         Some(m) => {
-            if ["scale", "rotate", "translate"]
-                .iter()
-                .any(|k| params.is_given(k))
-            {
+            if p.scale.is_some() || p.rotate.is_some() || p.translate.is_some() {
                 return Err(params.error(
-                    "matrix",
+                    keys.matrix,
                     "give either 'matrix' or scale/rotate/translate, not both",
                 ));
             }
             if m.len() != 16 {
                 return Err(params.error(
-                    "matrix",
+                    keys.matrix,
                     format!("needs 16 numbers (row-major 4x4), got {}", m.len()),
                 ));
             }
             let last_row = [m[12], m[13], m[14], m[15]];
             if last_row != [0.0, 0.0, 0.0, 1.0] {
                 return Err(params.error(
-                    "matrix",
+                    keys.matrix,
                     format!("must be affine: last row [0, 0, 0, 1], got {last_row:?}"),
                 ));
             }
             Mat4::from_cols_slice(&m).transpose()
         }
         None => {
-            let scale: Vec3 = params.get_opt("scale")?.unwrap_or(Vec3::ONE);
-            let rotation = match params.get_opt::<Vec<f32>>("rotate")? {
+            let scale = p.scale.unwrap_or(Vec3::ONE);
+            let rotation = match p.rotate {
                 None => Quat::IDENTITY,
                 Some(r) if r.len() == 4 => {
                     let axis = Vec3::new(r[0], r[1], r[2]);
                     if !(axis.length_squared() > 0.0 && axis.is_finite()) {
-                        return Err(params.error("rotate", "the axis must be a non-zero vector"));
+                        return Err(params.error(keys.rotate, "the axis must be a non-zero vector"));
                     }
                     Quat::from_axis_angle(axis.normalize(), r[3].to_radians())
                 }
                 Some(r) => {
                     return Err(params.error(
-                        "rotate",
+                        keys.rotate,
                         format!(
                             "needs [axis_x, axis_y, axis_z, degrees], got {} numbers",
                             r.len()
@@ -78,7 +73,7 @@ pub(crate) fn parse_transform(owner: &str, table: &Table, location: Location) ->
                     ))
                 }
             };
-            let translate: Vec3 = params.get_opt("translate")?.unwrap_or(Vec3::ZERO);
+            let translate = p.translate.unwrap_or(Vec3::ZERO);
             Mat4::from_scale_rotation_translation(scale, rotation, translate)
         }
     };

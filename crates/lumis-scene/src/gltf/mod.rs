@@ -25,7 +25,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use lumis_core::glam::{Mat3, Mat4};
-use lumis_core::{Error, Location, Result, Vec3};
+use lumis_core::{Error, Location, Registry, Result, Vec3};
 use rayon::prelude::*;
 
 use crate::bsdf_ref::BsdfRef;
@@ -78,7 +78,7 @@ pub(crate) struct InstancedMesh {
 }
 
 /// Reads the asset `request` names.
-pub(crate) fn import(request: &ImportRequest) -> Result<GltfImport> {
+pub(crate) fn import(request: &ImportRequest, registry: &Registry) -> Result<GltfImport> {
     let at = &request.file_location;
     let err = |e: String| Error::at(at, format!("{}: {e}", request.owner));
     let start = Instant::now();
@@ -93,7 +93,7 @@ pub(crate) fn import(request: &ImportRequest) -> Result<GltfImport> {
         .map(|w| format!("'{}': {w}", request.label))
         .collect();
     let uses = uses.placements;
-    let resolved = resolve::resolve_materials(request, &asset)?;
+    let resolved = resolve::resolve_materials(request, &asset, registry)?;
     warnings.extend(resolved.warnings);
     let materials = resolved.materials;
     let uv_set = |material: Option<usize>| materials.get(&material).and_then(|m| m.uv_set);

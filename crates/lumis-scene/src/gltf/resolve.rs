@@ -7,11 +7,13 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use lumis_core::{Error, PluginEntity, Result, Rgb, Textures, UvTransform};
-use lumis_files::IMAGE_FILE;
-use lumis_textures::image::{
-    self as image_texture, Encoding, ImageFilter, ImageTexture, StoredValues, Wrap,
+use lumis_core::doc::{Table, Value};
+use lumis_core::{
+    Error, ImageValues, Location, PluginEntity, PluginKind, Registry, Result, Rgb, Texture,
+    Textures, UvTransform,
 };
+use lumis_files::IMAGE_FILE;
+use lumis_image::texture_decode;
 
 use super::{buffers, material, ImportRequest};
 use crate::bsdf_ref::BsdfRef;
@@ -66,6 +68,7 @@ pub(crate) struct ResolvedMaterials {
 pub(crate) fn resolve_materials(
     request: &ImportRequest,
     asset: &buffers::Asset,
+    registry: &Registry,
 ) -> Result<ResolvedMaterials> {
     let owner = &request.owner;
     let label = &request.label;
@@ -131,6 +134,8 @@ pub(crate) fn resolve_materials(
         let mut loader = TextureLoader {
             asset,
             asset_path: &request.path,
+            registry,
+            at,
             material: format!("'{label}': material {material_label}"),
             uv_set: None,
             resolved: &mut out,
@@ -259,6 +264,10 @@ impl<'a> Slot<'a> {
 struct TextureLoader<'a> {
     asset: &'a buffers::Asset,
     asset_path: &'a Path,
+    /// Makes the `image` textures, as it makes a scene's.
+    registry: &'a Registry,
+    /// Where the scene names the asset: the textures' location.
+    at: &'a Location,
     /// The material, for warnings: `'file': material "name"`.
     material: String,
     /// The set the textures loaded so far read.
@@ -281,18 +290,27 @@ impl TextureLoader<'_> {
             return false;
         };
         let loaded = match (
-            texture_of(self.asset, &slot, self.asset_path, usage),
+            texture_of(self.asset, &slot, self.asset_path, usage, self.at),
             self.uv_set,
         ) {
             (Ok((_, set)), Some(other)) if other != set => Err(format!(
                 "it reads TEXCOORD_{set}, the material's other textures TEXCOORD_{other}"
             )),
-            (loaded, _) => loaded,
+            (Ok((table, set)), _) => {
+                let owner = format!("{} {name} texture", self.material);
+                let entity =
+                    PluginEntity::new(PluginKind::Texture, owner, "image", table, self.at.clone());
+                self.registry
+                    .create::<dyn Texture>(&entity, ())
+                    .map(|texture| (texture, set))
+                    .map_err(|e| e.to_string())
+            }
+            (Err(why), _) => Err(why),
         };
         match loaded {
             Ok((texture, set)) => {
-                self.resolved.texture_bytes += texture.byte_size();
-                into.insert(name, Arc::new(texture));
+                self.resolved.texture_bytes += texture.memory_bytes();
+                into.insert(name, texture);
                 self.uv_set = Some(set);
                 true
             }
@@ -323,18 +341,21 @@ enum TextureUse {
     Normal,
 }
 
-/// A material's texture as `usage` reads it, with its sampler and uv
-/// transform, as the `image` texture plugin; and the TEXCOORD set it reads.
+/// The parameter table (located `at`) of the `image` texture that reads a
+/// material's texture as `usage` says, with its sampler and uv transform
+/// (the texels decoded here, while the asset's buffers are loaded); and
+/// the TEXCOORD set it reads.
 fn texture_of(
     asset: &buffers::Asset,
     slot: &Slot,
     asset_path: &Path,
     usage: TextureUse,
-) -> std::result::Result<(ImageTexture, u32), String> {
+    at: &Location,
+) -> std::result::Result<(Table, u32), String> {
     let (texture, transform, set) = (&slot.texture, slot.transform, slot.tex_coord);
     let image = texture.source();
     let bytes = image_bytes(asset, &image, asset_path)?;
-    let mut stored = image_texture::decode(&bytes).map_err(|e| {
+    let mut texels = texture_decode::decode(&bytes).map_err(|e| {
         let mime = match image.source() {
             gltf::image::Source::View { mime_type, .. } => Some(mime_type),
             gltf::image::Source::Uri { mime_type, .. } => mime_type,
@@ -347,9 +368,9 @@ fn texture_of(
     })?;
     let sampler = texture.sampler();
     let wrap = |mode: gltf::texture::WrappingMode| match mode {
-        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
-        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        gltf::texture::WrappingMode::Repeat => "repeat",
+        gltf::texture::WrappingMode::MirroredRepeat => "mirror",
+        gltf::texture::WrappingMode::ClampToEdge => "clamp",
     };
     // Mip-mapped minification, as the sampler asks or by default (the
     // specification leaves an absent filter to the renderer), is the
@@ -357,34 +378,35 @@ fn texture_of(
     let filter = {
         use gltf::texture::{MagFilter, MinFilter};
         match (sampler.min_filter(), sampler.mag_filter()) {
-            (Some(MinFilter::Nearest), _) | (None, Some(MagFilter::Nearest)) => {
-                ImageFilter::Nearest
-            }
-            (Some(MinFilter::Linear), _) => ImageFilter::Bilinear,
-            _ => ImageFilter::Trilinear,
+            (Some(MinFilter::Nearest), _) | (None, Some(MagFilter::Nearest)) => "nearest",
+            (Some(MinFilter::Linear), _) => "bilinear",
+            _ => "trilinear",
         }
     };
     let (encoding, scale) = match usage {
-        TextureUse::Colour(factor) => (Encoding::Srgb, factor),
+        TextureUse::Colour(factor) => ("srgb", factor),
         TextureUse::Roughness(factor) => {
             let alpha = |v: Rgb| Rgb::splat((factor * v.g).clamp(0.0, 1.0).powi(2));
-            stored.values = StoredValues::Floats {
-                values: stored.floats().into_iter().map(alpha).collect(),
+            texels.values = ImageValues::Floats {
+                values: texels.floats().into_iter().map(alpha).collect(),
                 is_float: false,
             };
-            (Encoding::Linear, Rgb::WHITE)
+            ("linear", Rgb::WHITE)
         }
-        TextureUse::Normal => (Encoding::Linear, Rgb::WHITE),
+        TextureUse::Normal => ("linear", Rgb::WHITE),
     };
-    let texture = ImageTexture::new(
-        stored,
-        encoding,
-        [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
-        filter,
-        transform,
-        scale,
-    );
-    Ok((texture, set))
+    let params = [
+        ("texels", Value::Image(Arc::new(texels))),
+        ("encoding", encoding.into()),
+        ("wrap", wrap(sampler.wrap_s()).into()),
+        ("wrap_v", wrap(sampler.wrap_t()).into()),
+        ("filter", filter.into()),
+        ("scale", scale.to_array().into()),
+        ("uv_scale", transform.uv_scale.to_array().into()),
+        ("uv_rotation", transform.uv_rotation.into()),
+        ("uv_offset", transform.uv_offset.to_array().into()),
+    ];
+    Ok((Table::built(at, params), set))
 }
 
 /// `KHR_texture_transform` as the texture plugins' uv transform: scale,

@@ -2,21 +2,50 @@
 //! (Laine, Karras and Aila 2013, "Megakernels Considered Harmful:
 //! Wavefront Path Tracing on GPUs"; pbrt-v4's `WavefrontPathIntegrator`).
 //!
-//! Each bounce runs as stages over every live path of the wave: draw the
-//! vertex's numbers, trace all rays ([`Scene::intersect_batch`]: SIMD
-//! packets in the renderer's scene), add the emission they find, sample
-//! every BSDF grouped by material ([`lumis_api::Bsdf::sample_f_batch`]),
-//! sample the lights grouped by light
+//! # Stages
+//!
+//! A wave holds `wave_size` paths (256 by default). Each bounce runs as
+//! stages over every live path of the wave: draw the vertex's numbers (one
+//! batched request per kind, [`SamplerLanes::get_1d_2d_batch`]), trace all
+//! rays ([`Scene::intersect_batch`]: SIMD packets in the renderer's scene),
+//! add the emission they find, sample every BSDF grouped by material
+//! ([`lumis_api::Bsdf::sample_f_batch`]), sample the lights grouped by light
 //! ([`lumis_api::Light::sample_li_batch`]), evaluate the BSDFs at the
 //! light samples grouped by material ([`lumis_api::Bsdf::eval_batch`]),
-//! trace all shadow rays ([`Scene::occluded_batch`]), and continue each path
-//! as `path` does ([`PathState`]). Every stage sees many independent lanes
-//! of one kind, which a plugin may compute with SIMD.
+//! trace all shadow rays ([`Scene::occluded_batch`]), and continue each
+//! path as `path` does ([`PathState`], shared by both). Every stage sees
+//! many independent lanes of one kind, which a plugin may compute with SIMD.
+//! A lane whose path ends takes the next camera ray, so the wave stays full
+//! through the bounces (regeneration, Laine et al. section 4).
 //!
-//! The arithmetic of each path is `path`'s, in the same order, and each path
-//! draws its sampler's numbers in the same order: with plugins and a scene
-//! that keep the scalar defaults, the two integrators give the same image
-//! bit for bit; batched overrides change it only by their rounding.
+//! The render driver hands the integrator its batch of camera rays: a run of
+//! a tile's pixels, several samples of each, with one sampler per lane
+//! ([`Sampler::lanes`]) that keeps its pixel for all its samples, so that
+//! per-pixel work (the Sobol' sampler's scramble seeds) is done once per
+//! pixel, as in `path`.
+//!
+//! # The same image as `path`
+//!
+//! The batched methods default to loops over the scalar ones, so every
+//! plugin works in a wave unchanged; a plugin that overrides them computes
+//! its lanes together. The arithmetic of each path is `path`'s, in the same
+//! order, and each path draws its sampler's numbers in the same order: with
+//! plugins and a scene that keep the scalar defaults, the two integrators
+//! give the same image bit for bit (`tests/batched_integrators.rs`). The
+//! overrides of the built-in plugins and Embree's packet traversal change
+//! only the rounding, and the images agree in the mean; on the bench scenes
+//! they are still the same bit for bit, since the conductor's SIMD
+//! `eval_batch` and `sample_f_batch` and the sphere light's SIMD
+//! `sample_li_batch` repeat the scalar methods' operations on eight lanes,
+//! and Embree's packets find the same hits as its single rays.
+//!
+//! Camera rays go to Embree as coherent packets of eight;
+//! `[accel] packets = true` sends bounce and shadow rays as packets too
+//! (see [the scene format](scene-format.md#acceleration-structure-accel)).
+//! Both integrators run the same furnace, analytic and strategy-agreement
+//! tests (`tests/furnace.rs`, `tests/quad_irradiance.rs`,
+//! `tests/light_scenes.rs`). What the wave costs and buys on the bench
+//! suite is in [Performance](performance.md#the-wavefront-integrator).
 
 mod batched;
 
@@ -36,7 +65,7 @@ use batched::{Batcher, BsdfLane};
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Integrator,
     name: "wavefront",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "the path tracer run a wave of paths at a time: each bounce traces all rays as packets and calls every BSDF and light once per wave, so plugins may compute lanes with SIMD; same estimate as path",
     params: WavefrontParams::SPECS,
 };

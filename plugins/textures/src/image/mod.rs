@@ -1,32 +1,45 @@
 //! `image`: a texture read from a PNG, JPEG or EXR file, wrapped and
 //! filtered.
+//!
+//! A glTF asset's textures are made by this plugin too, through the
+//! registry like a scene's: the importer decodes each image (the
+//! metallic-roughness texture's green channel already turned into the GGX
+//! alpha) and passes the texels as `texels`, with the asset sampler's wrap
+//! modes (`wrap`, `wrap_v`), its filter and the `KHR_texture_transform`.
+//! 8-bit images keep their bytes (3 a texel) and decode sRGB through a
+//! table at each lookup; `trilinear` and `ewa` build a mip map, the others
+//! read the image alone.
 
-mod decode;
 mod mipmap;
 mod texels;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use lumis_api::{
-    ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result, Rgb, Texture, TextureQuery,
-    UvTransform,
+    DecodedImage, ImageValues, ParamChoice, Params, PluginKind, PluginParams, PluginSpec, Result,
+    Rgb, Texture, TextureQuery, UvTransform,
 };
+use lumis_image::texture_decode::{self, srgb_to_linear};
 
-pub use decode::{decode, srgb_to_linear, Stored, StoredValues};
 pub use texels::{Texels, Wrap};
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Texture,
     name: "image",
-    file: file!(),
+    source: lumis_api::source_file!(),
     doc: "an image file (PNG, JPEG or EXR); uv (0, 0) is its top-left corner",
     params: ImageParams::SPECS,
 };
 
 #[derive(Debug, Clone, PluginParams)]
 pub struct ImageParams {
-    /// the image file (PNG, JPEG or EXR), relative to the scene file
-    pub filename: PathBuf,
+    /// the image file (PNG, JPEG or EXR), relative to the scene file;
+    /// required unless the host gives `texels`
+    pub filename: Option<PathBuf>,
+    /// decoded texels in place of a file: what a glTF asset's embedded or
+    /// referenced image becomes (a scene file names a `filename`)
+    pub texels: Option<Arc<DecodedImage>>,
     /// how the stored values encode linear ones: "auto" (sRGB for PNG and
     /// JPEG, linear for EXR), "srgb" or "linear"
     #[param(default = Auto)]
@@ -34,6 +47,9 @@ pub struct ImageParams {
     /// lookups outside [0, 1]: "repeat", "mirror" or "clamp"
     #[param(default = Repeat)]
     pub wrap: Wrap,
+    /// lookups outside [0, 1] in v, where they differ from u (glTF's
+    /// `wrapT`); absent, `wrap` applies to both
+    pub wrap_v: Option<Wrap>,
     /// filtering: "nearest", "bilinear", or over the hit's footprint
     /// through a mip map, "trilinear" or "ewa" (bilinear where a hit has
     /// no footprint)
@@ -90,22 +106,31 @@ impl ImageTexture {
     pub fn from_params(params: &Params) -> Result<Self> {
         let p = ImageParams::read(params)?;
         let keys = ImageParams::KEYS;
-        let stored = decode::read(&p.filename)
-            .map_err(|e| params.error(keys.filename, format!("{}: {e}", p.filename.display())))?;
+        let image = match (p.filename, p.texels) {
+            (Some(path), None) => texture_decode::read(&path)
+                .map_err(|e| params.error(keys.filename, format!("{}: {e}", path.display())))?,
+            (None, Some(texels)) => Arc::unwrap_or_clone(texels),
+            (Some(_), Some(_)) => {
+                return Err(params.error(keys.texels, "give a filename or texels, not both"))
+            }
+            (None, None) => {
+                return Err(params.error(keys.filename, "required: the image file to read"))
+            }
+        };
+        let wrap = [p.wrap, p.wrap_v.unwrap_or(p.wrap)];
         Ok(Self::new(
-            stored,
+            image,
             p.encoding,
-            [p.wrap; 2],
+            wrap,
             p.filter,
             p.transform,
             p.scale,
         ))
     }
 
-    /// A texture of decoded image data (e.g. an image embedded in an
-    /// asset), wrapped in u and in v by `wrap`.
-    pub fn new(
-        stored: Stored,
+    /// A texture of decoded image data, wrapped in u and in v by `wrap`.
+    fn new(
+        stored: DecodedImage,
         encoding: Encoding,
         wrap: [Wrap; 2],
         filter: ImageFilter,
@@ -120,10 +145,10 @@ impl ImageTexture {
         let decode = |v: f32| if srgb { srgb_to_linear(v) } else { v };
         let (width, height) = (stored.width, stored.height);
         let base = match stored.values {
-            StoredValues::Bytes(texels) => {
+            ImageValues::Bytes(texels) => {
                 Texels::bytes(width, height, texels, |b| decode(b as f32 / 255.0))
             }
-            StoredValues::Floats { values, .. } => Texels::linear(
+            ImageValues::Floats { values, .. } => Texels::linear(
                 width,
                 height,
                 values.into_iter().map(|v| v.map(decode)).collect(),

@@ -55,6 +55,65 @@ fn png_decodes_srgb_unless_told_linear() {
     assert_eq!(at(&*linear, 0.75, 0.5), Rgb::splat(188.0 / 255.0));
 }
 
+/// Texels a host decoded (a glTF asset's image) make the texture the file
+/// does, and `wrap_v` wraps v alone; a table with neither a filename nor
+/// texels, or with both, is refused at the key.
+#[test]
+fn decoded_texels_make_the_texture_their_file_makes() {
+    use lumis_core::doc::{Table, Value};
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("two.png");
+    write_png(&path);
+    let from_file = create(dir.path(), "type = \"image\"\nfilename = \"two.png\"\n").unwrap();
+    let texels = lumis_image::texture_decode::read(&path).unwrap();
+    let with = |entries: Vec<(&str, Value)>| {
+        let table = Table::built(&Location::Builtin, entries);
+        let entity = PluginEntity::new(
+            PluginKind::Texture,
+            "asset texture",
+            "image",
+            table,
+            Location::Builtin,
+        );
+        registry().create::<dyn Texture>(&entity, ())
+    };
+    let image = || Value::Image(std::sync::Arc::new(texels.clone()));
+    let from_texels = with(vec![("texels", image())]).unwrap();
+    for (u, v) in [(0.1, 0.5), (0.5, 0.5), (0.9, 0.2), (1.3, -0.4)] {
+        assert_eq!(at(&*from_texels, u, v), at(&*from_file, u, v), "({u}, {v})");
+    }
+    // One column, two rows (black over grey): v = 1.2 is the grey row
+    // clamped and the black one repeated; u repeats either way.
+    let column = lumis_core::DecodedImage {
+        width: 1,
+        height: 2,
+        values: lumis_core::ImageValues::Bytes(vec![[0; 3], [188; 3]]),
+    };
+    let column = |wrap_v: &str| {
+        with(vec![
+            ("texels", Value::Image(std::sync::Arc::new(column.clone()))),
+            ("filter", "nearest".into()),
+            ("wrap_v", wrap_v.into()),
+        ])
+        .unwrap()
+    };
+    assert_eq!(at(&*column("repeat"), 5.5, 1.2), Rgb::BLACK);
+    assert!(at(&*column("clamp"), 5.5, 1.2).g > 0.5);
+    let neither = with(vec![]).err().unwrap().to_string();
+    assert!(
+        neither.contains("filename") && neither.contains("required"),
+        "{neither}"
+    );
+    let both = with(vec![("texels", image()), ("filename", "two.png".into())])
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        both.contains("texels") && both.contains("not both"),
+        "{both}"
+    );
+}
+
 /// An 8-bit image keeps its bytes, 3 a texel (and a table of 256 linear
 /// values), and reads as the float decoding of each byte; an EXR keeps
 /// its floats.
@@ -71,7 +130,7 @@ fn eight_bit_images_take_three_bytes_a_texel() {
     };
     let texture = |filter| {
         ImageTexture::new(
-            super::decode(&png).unwrap(),
+            lumis_image::texture_decode::decode(&png).unwrap(),
             super::Encoding::Srgb,
             [Wrap::Repeat; 2],
             filter,
@@ -82,7 +141,9 @@ fn eight_bit_images_take_three_bytes_a_texel() {
     let bilinear = texture(ImageFilter::Bilinear);
     assert_eq!(bilinear.byte_size(), 64 * 32 * 3 + 256 * 4);
     let texel = |x: usize, y: usize| {
-        let byte = |c: usize| super::srgb_to_linear(pixels[(y * 64 + x) * 3 + c] as f32 / 255.0);
+        let byte = |c: usize| {
+            lumis_image::texture_decode::srgb_to_linear(pixels[(y * 64 + x) * 3 + c] as f32 / 255.0)
+        };
         Rgb::new(byte(0), byte(1), byte(2))
     };
     for (x, y) in [(0, 0), (17, 5), (63, 31)] {

@@ -4,44 +4,9 @@
 
 use std::path::Path;
 
-use lumis_api::Rgb;
+use crate::limits::{check_claimed_size, check_expansion, DEFLATE_MAX_RATIO};
+use lumis_api::{DecodedImage, ImageValues, Rgb};
 use lumis_files::{read_bounded, read_prefix, IMAGE_FILE};
-use lumis_image::limits::{check_claimed_size, check_expansion, DEFLATE_MAX_RATIO};
-
-/// An image as stored: its texel values before any decoding of their
-/// encoding.
-pub struct Stored {
-    pub width: usize,
-    pub height: usize,
-    pub values: StoredValues,
-}
-
-/// Texel values as the file stores them.
-pub enum StoredValues {
-    /// 8 bits per channel (PNG, JPEG): kept as bytes, a quarter of the
-    /// memory of float RGB, and decoded by a table at each lookup.
-    Bytes(Vec<[u8; 3]>),
-    /// 16-bit integers scaled to `[0, 1]`, or floating point (EXR, linear).
-    Floats { values: Vec<Rgb>, is_float: bool },
-}
-
-impl Stored {
-    /// Whether the file stores floating-point values (EXR), which are linear.
-    pub fn is_float(&self) -> bool {
-        matches!(self.values, StoredValues::Floats { is_float: true, .. })
-    }
-
-    /// The values as floats in `[0, 1]` (or as stored, for floating point).
-    pub fn floats(&self) -> Vec<Rgb> {
-        match &self.values {
-            StoredValues::Bytes(b) => b
-                .iter()
-                .map(|p| Rgb::new(p[0] as f32, p[1] as f32, p[2] as f32) / 255.0)
-                .collect(),
-            StoredValues::Floats { values, .. } => values.clone(),
-        }
-    }
-}
 
 const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
 const JPEG_MAGIC: &[u8] = &[0xff, 0xd8, 0xff];
@@ -49,7 +14,7 @@ const EXR_MAGIC: &[u8] = &[0x76, 0x2f, 0x31, 0x01];
 
 /// Reads `path`; the message says what failed, not which file (the caller
 /// names it).
-pub fn read(path: &Path) -> Result<Stored, String> {
+pub fn read(path: &Path) -> Result<DecodedImage, String> {
     let cannot = |e: String| format!("cannot read the file: {e}");
     // An EXR is read by its own reader, header first: its bytes are not
     // read here (they would be held twice while it decodes).
@@ -61,7 +26,7 @@ pub fn read(path: &Path) -> Result<Stored, String> {
 }
 
 /// Decodes PNG or JPEG bytes (an image embedded in an asset).
-pub fn decode(bytes: &[u8]) -> Result<Stored, String> {
+pub fn decode(bytes: &[u8]) -> Result<DecodedImage, String> {
     let stored = if bytes.starts_with(PNG_MAGIC) {
         png(bytes)?
     } else if bytes.starts_with(JPEG_MAGIC) {
@@ -75,7 +40,7 @@ pub fn decode(bytes: &[u8]) -> Result<Stored, String> {
     Ok(stored)
 }
 
-fn png(bytes: &[u8]) -> Result<Stored, String> {
+fn png(bytes: &[u8]) -> Result<DecodedImage, String> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     decoder.set_transformations(png::Transformations::EXPAND);
     let mut reader = decoder.read_info().map_err(|e| format!("bad PNG: {e}"))?;
@@ -124,7 +89,7 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
             .collect();
         (
             values.len(),
-            StoredValues::Floats {
+            ImageValues::Floats {
                 values,
                 is_float: false,
             },
@@ -133,21 +98,21 @@ fn png(bytes: &[u8]) -> Result<Stored, String> {
         let values: Vec<[u8; 3]> = pixels
             .map(|px| rgb(&|i| px[i] as u16).map(|c| c as u8))
             .collect();
-        (values.len(), StoredValues::Bytes(values))
+        (values.len(), ImageValues::Bytes(values))
     };
     if values.0 != width * height {
         return Err(format!(
             "bad PNG: {width}x{height} pixels could not be read"
         ));
     }
-    Ok(Stored {
+    Ok(DecodedImage {
         width,
         height,
         values: values.1,
     })
 }
 
-fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
+fn jpeg(bytes: &[u8]) -> Result<DecodedImage, String> {
     let mut decoder = jpeg_decoder::Decoder::new(std::io::Cursor::new(bytes));
     decoder.read_info().map_err(|e| format!("bad JPEG: {e}"))?;
     let claimed = decoder.info().ok_or("bad JPEG: no frame")?;
@@ -158,7 +123,7 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
     let (count, values) = match info.pixel_format {
         jpeg_decoder::PixelFormat::L8 => {
             let v: Vec<[u8; 3]> = pixels.iter().map(|&l| [l; 3]).collect();
-            (v.len(), StoredValues::Bytes(v))
+            (v.len(), ImageValues::Bytes(v))
         }
         jpeg_decoder::PixelFormat::L16 => {
             let v: Vec<Rgb> = pixels
@@ -167,7 +132,7 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
                 .collect();
             (
                 v.len(),
-                StoredValues::Floats {
+                ImageValues::Floats {
                     values: v,
                     is_float: false,
                 },
@@ -175,7 +140,7 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
         }
         jpeg_decoder::PixelFormat::RGB24 => {
             let v: Vec<[u8; 3]> = pixels.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-            (v.len(), StoredValues::Bytes(v))
+            (v.len(), ImageValues::Bytes(v))
         }
         jpeg_decoder::PixelFormat::CMYK32 => return Err("CMYK JPEGs are not supported".into()),
     };
@@ -184,15 +149,15 @@ fn jpeg(bytes: &[u8]) -> Result<Stored, String> {
             "bad JPEG: {width}x{height} pixels could not be read"
         ));
     }
-    Ok(Stored {
+    Ok(DecodedImage {
         width,
         height,
         values,
     })
 }
 
-fn exr(path: &Path) -> Result<Stored, String> {
-    let image = lumis_image::read_exr(path).map_err(|e| e.to_string())?;
+fn exr(path: &Path) -> Result<DecodedImage, String> {
+    let image = crate::read_exr(path).map_err(|e| e.to_string())?;
     if image.width == 0 || image.height == 0 {
         return Err("the image has no pixels".into());
     }
@@ -205,10 +170,10 @@ fn exr(path: &Path) -> Result<Stored, String> {
             "the EXR holds a value that is not finite ({bad:?}); a texture must be finite everywhere"
         ));
     }
-    Ok(Stored {
+    Ok(DecodedImage {
         width: image.width,
         height: image.height,
-        values: StoredValues::Floats {
+        values: ImageValues::Floats {
             values: image.pixels.into_iter().map(Rgb::from).collect(),
             is_float: true,
         },
