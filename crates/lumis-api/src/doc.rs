@@ -174,23 +174,9 @@ impl From<&str> for Value {
     }
 }
 
-impl From<[f32; 3]> for Value {
-    /// An array of three numbers (located by [`Table::built`]).
-    fn from(v: [f32; 3]) -> Self {
-        Value::Array(
-            v.into_iter()
-                .map(|c| Node {
-                    value: c.into(),
-                    location: Location::Builtin,
-                })
-                .collect(),
-        )
-    }
-}
-
-impl From<[f32; 2]> for Value {
-    /// An array of two numbers (located by [`Table::built`]).
-    fn from(v: [f32; 2]) -> Self {
+impl<const N: usize> From<[f32; N]> for Value {
+    /// An array of `N` numbers (located by [`Table::built`]).
+    fn from(v: [f32; N]) -> Self {
         Value::Array(
             v.into_iter()
                 .map(|c| Node {
