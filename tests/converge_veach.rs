@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use lumis_cli::{converge, ConvergeArgs};
+use lumis_studies::{converge, ConvergeArgs};
 use lumis_tests::scenes_dir;
 
 #[test]

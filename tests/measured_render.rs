@@ -17,7 +17,7 @@ use std::time::Instant;
 
 use indicatif::ProgressBar;
 use lumis_analysis::image_error::error_metrics;
-use lumis_cli::{tabulate_bsdf, TabulateArgs};
+use lumis_brdf::{tabulate_bsdf, TabulateArgs};
 use lumis_core::{Bsdf, BsdfContext, Vec2, Vec3};
 use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::MerlTable;

@@ -302,8 +302,8 @@ pub fn assert_measured_variants_pass(variants: &[lumis_check::bsdf_suite::Varian
 pub fn tabulated(dir: &Path, name: &str, bsdf: &str, set: &[&str]) -> std::path::PathBuf {
     let output = dir.join(format!("{name}.binary"));
     let registry = lumis_app::builtin_registry().unwrap();
-    lumis_cli::tabulate_bsdf(
-        &lumis_cli::TabulateArgs {
+    lumis_brdf::tabulate_bsdf(
+        &lumis_brdf::TabulateArgs {
             bsdf: bsdf.into(),
             set: set.iter().map(|s| s.to_string()).collect(),
             output: output.clone(),

@@ -10,14 +10,20 @@ use lumis_app::{
     denoise_image, merge, registry_with_search_path, render, render_reference, DenoiseArgs,
     MergeArgs, Progress, ReferenceArgs, RenderArgs, Session,
 };
+use lumis_brdf::{
+    compress_table, precompute_table, tabulate_bsdf, CompressArgs, PrecomputeArgs, TabulateArgs,
+};
 use lumis_cli::{
-    analyze_samplers, compress_table, converge, diff_images, lecture, new_plugin, plugin_listing,
-    plugin_markdown, precompute_table, slurm_status, stop_on_interrupt, submit_slurm,
-    tabulate_bsdf, AnalyzeArgs, CompressArgs, ConvergeArgs, DiffArgs, LectureArgs, NewPluginArgs,
-    PrecomputeArgs, SlurmArgs, SlurmCommand, TabulateArgs, INTERRUPTED_EXIT_CODE,
+    new_plugin, plugin_listing, plugin_markdown, stop_on_interrupt, NewPluginArgs,
+    INTERRUPTED_EXIT_CODE,
 };
 use lumis_core::{Error, Registry, Result};
 use lumis_sampling::simd::{self, Isa};
+use lumis_slurm::{slurm_status, submit_slurm, SlurmArgs, SlurmCommand};
+use lumis_studies::{
+    analyze_samplers, converge, diff_images, lecture, AnalyzeArgs, ConvergeArgs, DiffArgs,
+    LectureArgs,
+};
 
 use check_plugin::{check_plugin, PluginNames};
 

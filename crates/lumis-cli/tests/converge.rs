@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use lumis_app::{builtin_registry, render, render_reference, ReferenceArgs, RenderArgs, Session};
-use lumis_cli::{converge, ConvergeArgs};
+use lumis_studies::{converge, ConvergeArgs};
 
 /// A fresh directory for one test's files, removed when the test ends.
 fn scratch(name: &str) -> tempfile::TempDir {

@@ -18,7 +18,7 @@ use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
 use common::*;
-use lumis_cli::SlurmManifest;
+use lumis_slurm::Manifest;
 
 const PARTS: u32 = 4;
 const SPP: &str = "16";
@@ -174,7 +174,7 @@ fn script() -> PathBuf {
 }
 
 /// `lumis slurm` of the small Cornell box into `run`; its manifest.
-fn submit(cluster: &Cluster, run: &Path) -> SlurmManifest {
+fn submit(cluster: &Cluster, run: &Path) -> Manifest {
     let scene = scene("bench/cornell-box.toml");
     let out = run.display().to_string();
     let tasks = PARTS.to_string();
@@ -193,8 +193,8 @@ fn submit(cluster: &Cluster, run: &Path) -> SlurmManifest {
     manifest
 }
 
-fn manifest(run: &Path) -> SlurmManifest {
-    let text = std::fs::read_to_string(run.join(lumis_cli::MANIFEST_NAME)).unwrap();
+fn manifest(run: &Path) -> Manifest {
+    let text = std::fs::read_to_string(run.join(lumis_slurm::MANIFEST_NAME)).unwrap();
     toml::from_str(&text).unwrap()
 }
 
