@@ -4,13 +4,15 @@
 //! ([`convergence`], [`integrands`]), image error metrics against a
 //! reference ([`image_error`]) and its split into bias² and variance
 //! ([`bias_variance`]), stratified sampling and its allocations
-//! ([`stratification`]), the biased `N/(N+1)` mean ([`scaled_mean`]), the
+//! ([`stratification`]), the lecture's biased estimators (half the sample
+//! maximum, [`half_max`]; the `N/(N+1)` mean, [`scaled_mean`]), the
 //! check of a measured variance against a formula ([`sample_variance`]),
 //! and the PNG plots ([`plot`]).
 
 pub mod bias_variance;
 pub mod convergence;
 pub mod discrepancy;
+pub mod half_max;
 pub mod image_error;
 pub mod integrands;
 pub mod plot;

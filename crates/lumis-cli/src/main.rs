@@ -139,7 +139,9 @@ enum Command {
     /// sets: variance of stratified sampling with proportional and Neyman
     /// allocation against the formula, power spectra of 256-point
     /// jittered, Poisson disk and white-noise sets, and the bias, variance
-    /// and MSE of the scaled mean N/(N+1) F_N; tables and PNGs.
+    /// and MSE of two biased estimators against the sample mean: half the
+    /// sample maximum (the lecture's example, MSE O(1/N^2)) and the scaled
+    /// mean N/(N+1) F_N; tables and PNGs.
     Lecture(LectureArgs),
 }
 

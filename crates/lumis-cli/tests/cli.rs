@@ -457,6 +457,7 @@ fn lecture_writes_its_figures_and_tables() {
         "spectrum-poisson-disk-psd.png",
         "spectrum-independent-radial-psd.png",
         "spectrum-radial.png",
+        "half-max.png",
         "scaled-mean-gaussian-1d.png",
         "scaled-mean-ratio.png",
     ] {
@@ -465,7 +466,8 @@ fn lecture_writes_its_figures_and_tables() {
     assert!(
         stdout.contains("Stratified sampling")
             && stdout.contains("Power spectra")
-            && stdout.contains("N < 4.09"),
+            && stdout.contains("N < 4.09")
+            && stdout.contains("from N = 3 on by the formulas"),
         "{stdout}"
     );
     let run = lumis(&["lecture", "--runs", "1", "--out", out.to_str().unwrap()]);

@@ -1,7 +1,10 @@
 //! `lumis lecture`: the Monte Carlo lecture's experiments on test
 //! integrands and point sets, as tables and PNG figures: stratified
 //! sampling and its allocations, the spectra of 256-point jittered,
-//! Poisson disk and white-noise sets, and the biased `N/(N+1)` mean.
+//! Poisson disk and white-noise sets, the lecture's bias example (half the
+//! sample maximum against the sample mean) and the biased `N/(N+1)` mean.
+
+mod half_max;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -57,7 +60,7 @@ const SCALED_COUNTS: [u32; 12] = [1, 2, 3, 4, 5, 6, 8, 12, 16, 32, 64, 256];
 /// The confidence of the printed intervals.
 const ALPHA: f64 = 0.01;
 
-/// Runs the three studies; returns the printed tables.
+/// Runs the four studies; returns the printed tables.
 pub fn lecture(args: &LectureArgs, registry: &Registry) -> Result<String> {
     if args.runs < 2 || args.realizations == 0 {
         return Err(Error::msg(
@@ -68,6 +71,7 @@ pub fn lecture(args: &LectureArgs, registry: &Registry) -> Result<String> {
         .map_err(|e| Error::msg(format!("{}: {e}", args.out.display())))?;
     let mut report = stratified_study(args)?;
     report += &spectrum_study(args, registry)?;
+    report += &half_max::half_max_study(args)?;
     report += &scaled_mean_study(args)?;
     Ok(report)
 }
