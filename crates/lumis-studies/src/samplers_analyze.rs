@@ -135,6 +135,28 @@ pub(crate) struct Spectrum {
 }
 
 impl Spectrum {
+    /// Frequencies per axis of the periodogram.
+    fn size(&self) -> usize {
+        self.size.max(4)
+    }
+
+    /// The periodogram of the sampler's film samples averaged over the
+    /// realizations, `size()` by `size()` with zero frequency at the centre;
+    /// `progress` is called after each realization.
+    pub fn average_psd(&self, sampler: &mut dyn Sampler, mut progress: impl FnMut()) -> Vec<f64> {
+        let size = self.size();
+        let mut psd = vec![0.0; size * size];
+        for r in 0..self.realizations {
+            let seed = self.seed + u64::from(r);
+            let p = sample_points(sampler, self.count, 2, seed, UVec2::new(0, 0)).pair(0, 1);
+            for (acc, v) in psd.iter_mut().zip(periodogram(&p, size)) {
+                *acc += v / f64::from(self.realizations);
+            }
+            progress();
+        }
+        psd
+    }
+
     /// Writes the two pictures into `out`; returns the radial average as a
     /// series named `name`.
     pub fn pictures(
@@ -144,17 +166,9 @@ impl Spectrum {
         out: &Path,
         stem: &str,
     ) -> Result<Series> {
-        let pixel = UVec2::new(0, 0);
-        let size = self.size.max(4);
+        let size = self.size();
         let bar = progress_bar(self.realizations as u64, &format!("{name} spectrum"));
-        let mut psd = vec![0.0; size * size];
-        for r in 0..self.realizations {
-            let p = sample_points(sampler, self.count, 2, self.seed + r as u64, pixel).pair(0, 1);
-            for (acc, v) in psd.iter_mut().zip(periodogram(&p, size)) {
-                *acc += v / self.realizations as f64;
-            }
-            bar.inc(1);
-        }
+        let psd = self.average_psd(sampler, || bar.inc(1));
         bar.finish_and_clear();
         let title = format!(
             "{name}: power spectrum, {} points, {} scrambles",
@@ -202,6 +216,9 @@ impl Spectrum {
         Ok(series)
     }
 }
+
+#[cfg(test)]
+mod tests;
 
 /// Convergence results of one sampler: RMSE per integrand and count.
 struct Convergence {
