@@ -89,6 +89,14 @@ pub fn integrands_1d() -> Vec<Integrand> {
     ]
 }
 
+/// The built-in integrand named `name`, in 2D or 1D.
+pub fn integrand(name: &str) -> Option<Integrand> {
+    integrands_2d()
+        .into_iter()
+        .chain(integrands_1d())
+        .find(|g| g.name == name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,7 +9,7 @@ mod half_max;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use lumis_analysis::integrands::{integrands_1d, integrands_2d, Integrand};
+use lumis_analysis::integrands::{self, Integrand};
 use lumis_analysis::plot::{self, Axes, Series};
 use lumis_analysis::sample_points;
 use lumis_analysis::sample_variance::SampleVariance;
@@ -77,11 +77,7 @@ pub fn lecture(args: &LectureArgs, registry: &Registry) -> Result<String> {
 }
 
 fn integrand(name: &str) -> Integrand {
-    integrands_2d()
-        .into_iter()
-        .chain(integrands_1d())
-        .find(|g| g.name == name)
-        .expect("a built-in integrand")
+    integrands::integrand(name).expect("a built-in integrand")
 }
 
 fn ratio_cell(s: &SampleVariance, predicted: f64) -> String {

@@ -4,7 +4,8 @@
 //! in the integrator's table, `[integrator] clamp`, which still reads,
 //! with a warning.
 
-use lumis_core::doc::{Table, Value};
+use lumis_core::doc::Table;
+use lumis_core::params::FromParam;
 use lumis_core::{Error, Result};
 
 /// The key, in `[film]` and in its deprecated place in `[integrator]`.
@@ -37,21 +38,11 @@ pub(crate) fn take_deprecated_clamp(
             "[integrator] clamp and [film] clamp both given; keep [film] clamp",
         ));
     }
-    let value = match entry.node.value {
-        Value::Float(v) => v as f32,
-        Value::Int(v) => v as f32,
-        ref other => {
-            return Err(Error::at(
-                location,
-                format!(
-                    "[integrator] clamp: expected a positive number (the largest component a sample's radiance may have), found {}",
-                    other.type_name()
-                ),
-            ))
-        }
-    };
-    let value =
-        checked(value).map_err(|why| Error::at(location, format!("[integrator] clamp: {why}")))?;
+    // Read as `[film] clamp` reads it: the parameters' conversion, then
+    // the same check.
+    let value = f32::from_node(&entry.node)
+        .and_then(checked)
+        .map_err(|why| Error::at(location, format!("[integrator] clamp: {why}")))?;
     warnings.push(format!(
         "{location}: [integrator] clamp is deprecated; write it as [film] clamp (--set film.clamp=...)"
     ));

@@ -217,7 +217,6 @@ fn check_top_level_keys(root: &Table) -> Result<()> {
 }
 
 /// The top level's own key (the others name tables).
-/// The keys outside every table.
 #[derive(Debug, Clone, PluginParams)]
 pub(crate) struct TopLevelParams {
     /// the render's random seed, a non-negative integer (--seed overrides
@@ -230,8 +229,12 @@ pub(crate) struct TopLevelParams {
 /// tables beside it are read by their own).
 fn seed_of(root: &Table, file: &Location) -> Result<u64> {
     let mut top = Table::default();
-    top.entries
-        .extend(root.entries.iter().filter(|e| e.key == "seed").cloned());
+    top.entries.extend(
+        root.entries
+            .iter()
+            .filter(|e| e.key == TopLevelParams::KEYS.seed)
+            .cloned(),
+    );
     let params = Params::new(
         "the top level",
         &top,

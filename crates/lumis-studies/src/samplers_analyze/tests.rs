@@ -4,7 +4,7 @@
 //! integrands.
 
 use lumis_analysis::convergence::{loglog_slope, powers_of_two, sampler_rmse};
-use lumis_analysis::integrands::{integrands_1d, integrands_2d, Integrand};
+use lumis_analysis::integrands::{self, Integrand};
 use lumis_analysis::spectrum::radial_average;
 use lumis_core::Registry;
 
@@ -82,11 +82,7 @@ fn slope(registry: &Registry, name: &str, integrand: &Integrand) -> f64 {
 }
 
 fn integrand(name: &str) -> Integrand {
-    integrands_2d()
-        .into_iter()
-        .chain(integrands_1d())
-        .find(|g| g.name == name)
-        .unwrap()
+    integrands::integrand(name).unwrap()
 }
 
 /// The rates the lecture gives: Monte Carlo `N^-1/2` whatever the
