@@ -4,7 +4,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// Where a value came from: a line of a scene file, or a command-line override.
+/// Where a value came from: a line of a scene file, a command-line
+/// override, or a key of a scene given as a mapping.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Location {
     File {
@@ -13,6 +14,10 @@ pub enum Location {
         column: u32,
     },
     Override(Arc<str>),
+    /// A value of a scene given as nested mappings rather than text
+    /// (Python's `lumis.load_dict`), named by its subscripts from the
+    /// root, as the caller wrote them: `scene['bsdf'][0]['reflectance']`.
+    Key(Arc<str>),
     /// Built into lumis (a parameter default, a programmatic table).
     Builtin,
 }
@@ -20,8 +25,9 @@ pub enum Location {
 impl Location {
     /// A file path written here, resolved. A relative path is resolved
     /// against the directory of the scene file that wrote it, so a scene and
-    /// its assets move together; given with `--set` (or built in), it is
-    /// relative to the working directory, as a path typed in a shell is.
+    /// its assets move together; given with `--set`, in a mapping (or built
+    /// in), it is relative to the working directory, as a path typed in a
+    /// shell is.
     pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
         let path = path.as_ref();
         match self {
@@ -38,6 +44,7 @@ impl fmt::Display for Location {
         match self {
             Location::File { path, line, column } => write!(f, "{path}:{line}:{column}"),
             Location::Override(text) => write!(f, "--set {text}"),
+            Location::Key(path) => f.write_str(path),
             Location::Builtin => write!(f, "<built-in>"),
         }
     }

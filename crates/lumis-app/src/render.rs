@@ -2,28 +2,25 @@
 //! the EXR (with its metadata in the header), report.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_render::profile::{profiled_sampler, profiled_scene, Profile};
-use lumis_render::{progress_units, render_pass, Aov, Film, PassContext, RenderPool};
+use lumis_render::{progress_units, Aov, Film, PassContext, RenderPool};
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
 use crate::denoise::{claim_denoised_outputs, denoise_film, ConfiguredDenoiser};
+use crate::film_render::empty_film;
 use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::{partial_path, remove_if_present, Outputs};
 use crate::partial::Partial;
+use crate::passes::{run_passes, PassPlan, PassTotals};
 use crate::render_args::{CheckpointEvery, RenderArgs};
 use crate::render_report::{DenoisedReport, RenderReport};
 use crate::session::Session;
 use crate::slice::SampleSlice;
-
-/// How long a pass should take when `--pass-spp` does not say: short enough
-/// that the first Ctrl-C, which abandons the pass in flight, loses little.
-const PASS_SECONDS: f64 = 2.0;
 
 /// `PATH.exr` and `PATH.png` for an output argument given with `.exr`,
 /// `.png` or neither; for a directory (one that exists, or a path ending
@@ -106,12 +103,8 @@ fn starting_state(
     let saved = Checkpoint::read(checkpoint)
         .map_err(|e| Error::msg(format!("{e}; remove it to start over")))?;
     let fresh = || -> Result<Checkpoint> {
-        let film = Film::try_with_aovs(resolution, aovs)?;
         Ok(Checkpoint {
-            film: match adaptive {
-                Some(settings) => film.with_adaptive(settings)?,
-                None => film,
-            },
+            film: empty_film(loaded)?,
             spp,
             passes: 0,
             seed,
@@ -177,21 +170,6 @@ fn starting_state(
         saved.film.samples
     ));
     Ok(saved)
-}
-
-/// Samples for the next pass: `--pass-spp`, else as many as fit in
-/// [`PASS_SECONDS`] at the pace so far (starting from one, at most
-/// doubling). The image does not depend on the split.
-fn next_pass_spp(args: &RenderArgs, last: Option<(u32, f64)>, remaining: u32) -> u32 {
-    let spp = match (args.pass_spp, last) {
-        (Some(n), _) => n,
-        (None, None) => 1,
-        (None, Some((spp, seconds))) => {
-            let fit = (PASS_SECONDS * spp as f64 / seconds.max(1e-6)).floor();
-            (fit.min(2.0 * spp as f64) as u32).max(1)
-        }
-    };
-    spp.clamp(1, remaining)
 }
 
 /// Writes the film's colour and outputs.
@@ -360,64 +338,32 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
         )
     };
     let profile = args.stats.then(Profile::start);
-    let mut stats = RenderStats::default();
-    let mut seconds = 0.0;
-    let mut last_pass = None;
+    let plan = PassPlan {
+        ctx: &ctx,
+        registry,
+        pass_spp: args.pass_spp,
+        part_ends,
+        resolution,
+        aovs: &loaded.aovs,
+    };
     let mut last_save = Instant::now();
-    let mut interrupted = false;
-    // With --parts, the slice in flight, summed on its own until it ends.
-    let mut in_flight: Option<Film> = None;
-    while state.film.samples < end {
-        let (film, slice_end) = match &part_ends {
-            None => (&mut state.film, end),
-            Some(ends) => {
-                let from = state.film.samples;
-                let slice_end = ends.iter().copied().find(|&e| e > from).unwrap_or(end);
-                let film = match &mut in_flight {
-                    Some(film) => film,
-                    None => in_flight
-                        .insert(Film::try_with_aovs(resolution, &loaded.aovs)?.starting_at(from)),
-                };
-                (film, slice_end)
-            }
-        };
-        let pass_spp = next_pass_spp(args, last_pass, slice_end - film.samples);
-        let Some(pass) = render_pass(&ctx, film, pass_spp)? else {
-            interrupted = true;
-            break;
-        };
-        if film.samples == slice_end {
-            if let Some(slice) = in_flight.take() {
-                state.film.append(&slice)?;
-            }
-        }
-        // A loaded plugin that panicked answered with neutral values: the
-        // pass is not the scene's, so nothing is saved, and the panic is the
-        // error.
-        registry.faults().check()?;
-        stats += pass.stats;
-        seconds += pass.seconds;
-        state.passes += 1;
-        state.seconds += pass.seconds;
-        last_pass = Some((pass_spp, pass.seconds));
+    let passes = run_passes(&plan, &mut state, end, |state| {
         let due = match every {
             CheckpointEvery::Pass => true,
             CheckpointEvery::Seconds(s) => last_save.elapsed().as_secs_f64() >= s,
             CheckpointEvery::Never => false,
         };
         if due && state.film.samples < spp {
-            save(&state)?;
+            save(state)?;
             last_save = Instant::now();
         }
-        interrupted = stop.load(Ordering::Relaxed);
-        if interrupted {
-            break;
-        }
-    }
-    // An interrupted --parts render keeps the samples of its last slice.
-    if let Some(slice) = in_flight.take().filter(|s| s.samples > s.start) {
-        state.film.append(&slice)?;
-    }
+        Ok(())
+    })?;
+    let PassTotals {
+        stats,
+        seconds,
+        mut interrupted,
+    } = passes;
     progress.finish();
     let profile = profile.map(Profile::finish);
     if interrupted && slice.is_some() {
@@ -515,16 +461,30 @@ fn finished_or_kept(
     if args.resume && finished && !checkpoint.exists() {
         return Ok(Some(existing));
     }
-    if existing.spp > spp && !args.force {
-        return Err(Error::msg(format!(
+    refuse_fewer_samples(exr, scene_hash, spp, args.force)?;
+    Ok(None)
+}
+
+/// An error where the image at `exr` holds more samples of this scene than
+/// the `spp` to be written over it, unless `force`: a finished image is
+/// never replaced by a worse one by mistake.
+pub(crate) fn refuse_fewer_samples(
+    exr: &Path,
+    scene_hash: u64,
+    spp: u32,
+    force: bool,
+) -> Result<()> {
+    let existing = ImageMetadata::read(exr).ok().flatten();
+    match existing.filter(|m| m.scene_hash == scene_hash) {
+        Some(existing) if existing.spp > spp && !force => Err(Error::msg(format!(
             "{}: refusing to replace it: it holds {} spp of this scene (`lumis {}`), more \
              than the {spp} this render makes; --force replaces it",
             exr.display(),
             existing.spp,
             existing.command
-        )));
+        ))),
+        _ => Ok(()),
     }
-    Ok(None)
 }
 
 /// The report of a `--resume` that finds its render finished: the image on

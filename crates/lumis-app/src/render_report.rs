@@ -38,12 +38,7 @@ pub struct RenderReport {
 impl RenderReport {
     /// One warning line per loaded plugin whose answers held defects.
     pub fn defect_warnings(&self) -> Vec<String> {
-        self.defects
-            .iter()
-            .map(|(plugin, defects)| {
-                format!("warning: {plugin}: {}", defects.describe().join("; "))
-            })
-            .collect()
+        defect_warnings(&self.defects)
     }
 
     /// With `--strict`, the error that defects are.
@@ -104,4 +99,12 @@ pub struct DenoisedReport {
     /// Wall time of the denoiser and of writing its image, which a
     /// comparison at equal time adds to the render's.
     pub seconds: f64,
+}
+
+/// One warning line per loaded plugin whose answers held defects.
+pub(crate) fn defect_warnings(defects: &[(Arc<str>, Defects)]) -> Vec<String> {
+    defects
+        .iter()
+        .map(|(plugin, defects)| format!("warning: {plugin}: {}", defects.describe().join("; ")))
+        .collect()
 }

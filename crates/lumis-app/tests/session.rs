@@ -6,7 +6,11 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-use lumis_app::{builtin_registry, render, Progress, RenderArgs, Session};
+use lumis_app::{
+    builtin_registry, render, render_film, FilmRequest, ImageMetadata, Progress, RenderArgs,
+    SampleSlice, Session,
+};
+use lumis_scene::SceneDocument;
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -115,5 +119,68 @@ fn a_stop_ends_the_render_with_the_passes_done() {
     assert!(
         !report.exr.exists(),
         "an unfinished render is not the image"
+    );
+}
+
+/// A render in memory is the render to files, bit for bit; a slice of it
+/// written from memory is the partial image `lumis merge` reads.
+#[test]
+fn a_render_in_memory_is_the_render_to_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let registry = builtin_registry().unwrap();
+    let stop = AtomicBool::new(false);
+    let session = Session::silent(&registry, &stop);
+    let args = small_box(dir.path(), 4);
+    let on_disk = render(&args, &session).unwrap();
+    let document = SceneDocument::read(&args.scene)
+        .unwrap()
+        .with_overrides(args.set.clone());
+    let loaded = document
+        .load(&["sampler.spp=4".to_string()], &registry)
+        .unwrap();
+    let request = FilmRequest {
+        threads: 2,
+        ..Default::default()
+    };
+    let in_memory = render_film(&loaded, &request, &session).unwrap();
+    assert_eq!(in_memory.spp(), 4);
+    assert!(!in_memory.interrupted);
+    assert_eq!(in_memory.film.image().pixels, on_disk.image.pixels);
+
+    // Written, it is the command line's image with the same header.
+    let (exr, png) = in_memory
+        .write(&dir.path().join("memory"), &document, false)
+        .unwrap();
+    assert!(png.is_some_and(|p| p.exists()));
+    let written = ImageMetadata::read(&exr).unwrap().unwrap();
+    let expected = ImageMetadata::read(&on_disk.exr).unwrap().unwrap();
+    assert_eq!(
+        (
+            written.scene_hash,
+            written.scene_file_hash,
+            written.spp,
+            written.seed
+        ),
+        (
+            expected.scene_hash,
+            expected.scene_file_hash,
+            expected.spp,
+            expected.seed
+        )
+    );
+
+    // A slice outside the scene's samples is refused.
+    let beyond = FilmRequest {
+        samples: Some(SampleSlice {
+            start: 2,
+            end: 9,
+            total: 4,
+        }),
+        ..Default::default()
+    };
+    let refused = render_film(&loaded, &beyond, &session).err().unwrap();
+    assert!(
+        refused.message.contains("expected sample indices"),
+        "{refused}"
     );
 }

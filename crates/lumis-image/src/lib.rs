@@ -21,7 +21,7 @@ pub use exr_io::{
 };
 pub use hdr_io::{is_hdr, read_hdr};
 pub use output_lock::{lock_path, OutputLock};
-pub use png_io::{linear_to_srgb8, stage_png, write_png, write_rgb8_png};
+pub use png_io::{encode_png, linear_to_srgb8, stage_png, write_png, write_rgb8_png};
 pub use process::{process_is_running, process_start};
 
 use std::path::PathBuf;

@@ -26,12 +26,24 @@ pub fn write_png(path: &Path, image: &Image) -> Result<(), ImageError> {
 /// Writes the PNG of [`write_png`] under a temporary name, to be renamed
 /// into place with [`StagedFile::commit`].
 pub fn stage_png(path: &Path, image: &Image) -> Result<StagedFile, ImageError> {
-    let data: Vec<u8> = image
+    stage_rgb8_png(path, image.width, image.height, &srgb8(image))
+}
+
+/// The bytes of the PNG [`write_png`] writes: an image shown where no file
+/// is wanted (a notebook's cell).
+pub fn encode_png(image: &Image) -> Result<Vec<u8>, String> {
+    let mut bytes = Vec::new();
+    encode_rgb8_png(&mut bytes, image.width, image.height, &srgb8(image))?;
+    Ok(bytes)
+}
+
+/// The image tone-mapped to 8-bit sRGB rows.
+fn srgb8(image: &Image) -> Vec<u8> {
+    image
         .pixels
         .iter()
         .flat_map(|p| p.map(linear_to_srgb8))
-        .collect();
-    stage_rgb8_png(path, image.width, image.height, &data)
+        .collect()
 }
 
 /// Writes 8-bit sRGB RGB rows (e.g. a drawn plot) to a PNG, atomically.
@@ -51,15 +63,25 @@ fn stage_rgb8_png(
     data: &[u8],
 ) -> Result<StagedFile, ImageError> {
     stage(path, |w| {
-        let mut encoder = png::Encoder::new(&mut *w, width as u32, height as u32);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
-        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-        writer.write_image_data(data).map_err(|e| e.to_string())?;
-        writer.finish().map_err(|e| e.to_string())?;
+        encode_rgb8_png(&mut *w, width, height, data)?;
         flush(w)
     })
+}
+
+/// Encodes 8-bit sRGB RGB rows as a PNG into `w`.
+fn encode_rgb8_png(
+    w: impl std::io::Write,
+    width: usize,
+    height: usize,
+    data: &[u8],
+) -> Result<(), String> {
+    let mut encoder = png::Encoder::new(w, width as u32, height as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(data).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

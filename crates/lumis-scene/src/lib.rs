@@ -15,6 +15,7 @@
 mod assembly;
 mod bsdf_ref;
 mod description;
+mod document;
 mod gltf;
 mod instantiate;
 mod load;
@@ -25,6 +26,7 @@ mod scene_hash;
 mod triangle_mesh;
 
 pub use description::{scene_tables, Compaction, SceneTable, AUTO_COMPACT_TRIANGLES};
+pub use document::SceneDocument;
 pub use load::{load_file, load_str, LoadedScene, SceneDenoiser};
 pub use render_scene::{LoadReport, RenderScene, SceneCounts};
 pub use scene_hash::{scene_file_hash, scene_hash, Fnv1a};

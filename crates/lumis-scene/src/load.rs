@@ -1,18 +1,18 @@
 //! Loading a scene file: the three stages in order.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
-use lumis_core::doc;
+use lumis_core::doc::Table;
 use lumis_core::{
     Denoiser, Error, Integrator, LightSampler, Location, PluginEntity, Registry, Result, Sampler,
 };
-use lumis_files::{read_text_bounded, FileKind, MIB};
+use lumis_files::{FileKind, MIB};
 use lumis_render::{Aov, PerspectiveCamera};
 
 use crate::assembly::assemble;
 use crate::description::SceneDescription;
+use crate::document::SceneDocument;
 use crate::instantiate::{instantiate, scene_registry};
 use crate::render_scene::{RenderScene, SceneBsdf};
 use crate::report::LoadReport;
@@ -54,41 +54,35 @@ pub const SCENE_FILE: FileKind = FileKind::new("scene", 64 * MIB);
 
 /// Reads and loads a scene file.
 pub fn load_file(path: &Path, overrides: &[String], registry: &Registry) -> Result<LoadedScene> {
-    let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
-    load_str(&text, path, overrides, registry)
+    SceneDocument::read(path)?.load(overrides, registry)
 }
 
-/// Loads a scene from TOML text as if it were the file at `path` (which
-/// need not exist): `path` names it in error locations, its directory
-/// resolves the relative paths the text writes, and its stem names the
-/// scene.
-///
-/// The document is described (every key checked, nothing created), its
-/// plugins are created through the registry (extended with the libraries
-/// the scene loads), and its shapes are assembled into Embree with their
-/// area lights; the light sampler comes last, over every light.
+/// Loads a scene from TOML text as if it were the file at `path`
+/// ([`SceneDocument::parse`]).
 pub fn load_str(
     text: &str,
     path: &Path,
     overrides: &[String],
     registry: &Registry,
 ) -> Result<LoadedScene> {
-    let label = path.display().to_string();
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".into());
+    SceneDocument::parse(text, path)?.load(overrides, registry)
+}
+
+/// Loads a document whose overrides are applied; `origin` locates its
+/// root, and `name` names the scene.
+///
+/// The document is described (every key checked, nothing created), its
+/// plugins are created through the registry (extended with the libraries
+/// the scene loads), and its shapes are assembled into Embree with their
+/// area lights; the light sampler comes last, over every light.
+pub(crate) fn load_document(
+    root: Table,
+    origin: &Location,
+    name: &str,
+    registry: &Registry,
+) -> Result<LoadedScene> {
     let parse_start = Instant::now();
-    let mut root = doc::parse(text, &label)?;
-    for assignment in overrides {
-        doc::apply_override(&mut root, assignment)?;
-    }
-    let file = Location::File {
-        path: Arc::from(label.as_str()),
-        line: 1,
-        column: 1,
-    };
-    let description = SceneDescription::from_document(root, &file)?;
+    let description = SceneDescription::from_document(root, origin)?;
     let parse = parse_start.elapsed();
     let extended = scene_registry(&description.plugin_libraries, registry)?;
     let registry = extended.as_ref().unwrap_or(registry);
@@ -172,7 +166,7 @@ pub fn load_str(
         }
     }
     Ok(LoadedScene {
-        name,
+        name: name.to_string(),
         scene,
         camera: description.camera,
         sampler: plugins.sampler,

@@ -17,11 +17,11 @@
 use std::io::{BufRead, Read};
 use std::path::Path;
 
-use lumis_core::doc::{self, Node, Table, Value};
+use lumis_core::doc::{Node, Table, Value};
 use lumis_core::{Error, Result};
-use lumis_files::{open_bounded, read_text_bounded, FileKind, GIB};
+use lumis_files::{open_bounded, FileKind, GIB};
 
-use crate::load::SCENE_FILE;
+use crate::document::SceneDocument;
 
 /// FNV-1a 64 (Fowler, Noll, Vo): stable across Rust versions and
 /// platforms, unlike `DefaultHasher`, so a hash written today still matches
@@ -74,36 +74,30 @@ impl Fnv1a {
 }
 
 /// The hash of the scene file at `path` with `overrides` applied, as the
-/// module documentation describes. A file the scene names that cannot be
-/// read is an error: the render would fail on it too.
+/// module documentation describes ([`SceneDocument::hash`]).
 pub fn scene_hash(path: &Path, overrides: &[String]) -> Result<u64> {
-    hash_scene(path, overrides, Unreadable::Fails)
+    SceneDocument::read(path)?
+        .with_overrides(overrides.iter().cloned())
+        .hash()
 }
 
 /// The hash of the scene file at `path` as written, without the render's
-/// overrides: which file a render came from, whatever was set on top.
-/// A file it names that cannot be read counts by its name, since an
-/// override may have put another in its place (`--set
-/// bsdf.sample.file=...` where the scene's own table is absent).
+/// overrides ([`SceneDocument::file_hash`]).
 pub fn scene_file_hash(path: &Path) -> Result<u64> {
-    hash_scene(path, &[], Unreadable::CountsByName)
+    SceneDocument::read(path)?.file_hash()
 }
 
 /// What a named file that cannot be read does to a hash.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Unreadable {
+pub(crate) enum Unreadable {
     Fails,
     CountsByName,
 }
 
-fn hash_scene(path: &Path, overrides: &[String], unreadable: Unreadable) -> Result<u64> {
-    let text = read_text_bounded(path, SCENE_FILE).map_err(Error::msg)?;
-    let mut root = doc::parse(&text, &path.display().to_string())?;
-    for assignment in overrides {
-        doc::apply_override(&mut root, assignment)?;
-    }
+/// The hash of a document whose overrides are applied.
+pub(crate) fn hash_document(root: &Table, unreadable: Unreadable) -> Result<u64> {
     let mut hash = Fnv1a::default();
-    hash_table(&mut hash, &root, &[], unreadable)?;
+    hash_table(&mut hash, root, &[], unreadable)?;
     Ok(hash.finish())
 }
 
