@@ -19,8 +19,9 @@ pyo3::create_exception!(
     lumis,
     Interrupted,
     PyKeyboardInterrupt,
-    "Ctrl-C (or a notebook's interrupt) stopped a render: `render` holds the passes \
-     finished before it, as a Render."
+    "Ctrl-C (or a notebook's interrupt) stopped a render or a study: `render` holds the \
+     passes finished before it, as a Render (None before the first), and a study's \
+     `study` what it measured."
 );
 
 /// The [`Error`] exception for a lumis error.

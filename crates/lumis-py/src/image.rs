@@ -39,7 +39,7 @@ pub fn read_image(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 
 /// An image given to `lumis.diff`: a [`Render`], the path of an EXR, or
 /// an array of shape (height, width, 3).
-fn image_from(value: &Bound<'_, PyAny>) -> PyResult<Image> {
+pub fn image_from(value: &Bound<'_, PyAny>) -> PyResult<Image> {
     let py = value.py();
     if let Ok(render) = value.cast::<Render>() {
         return Ok(render.get().image());

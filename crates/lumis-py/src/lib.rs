@@ -13,6 +13,8 @@ mod image;
 mod mapping;
 mod render;
 mod scene;
+mod stoppable;
+mod study;
 
 use pyo3::prelude::*;
 
@@ -32,6 +34,8 @@ mod lumis {
     use crate::render::Render;
     #[pymodule_export]
     use crate::scene::{load_dict, load_file, Scene};
+    #[pymodule_export]
+    use crate::study::{bias_variance, converge, Study};
 
     #[pymodule_init]
     fn init(m: &pyo3::Bound<'_, pyo3::types::PyModule>) -> pyo3::PyResult<()> {

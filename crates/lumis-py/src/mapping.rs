@@ -86,7 +86,8 @@ pub fn document_of(table: &toml::Table, at: &str) -> Table {
     }
 }
 
-fn node_of(value: &toml::Value, at: String) -> Node {
+/// A TOML value as a scene value located by its subscripts `at`.
+pub fn node_of(value: &toml::Value, at: String) -> Node {
     let value = match value {
         toml::Value::Boolean(b) => Value::Bool(*b),
         toml::Value::Integer(i) => Value::Int(*i),

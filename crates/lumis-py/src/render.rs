@@ -1,15 +1,8 @@
 //! A render run from Python, and what it returns.
-//!
-//! The render runs on a thread of its own with the GIL released; the
-//! calling thread wakes every [`POLL`] to run Python's signal handlers
-//! (so Ctrl-C, or a notebook's interrupt, sets the session's stop flag and
-//! the pass in flight is abandoned) and to report progress. Every Python
-//! call is made on the calling thread.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
 
 use lumis_app::{render_film, FilmRender, FilmRequest, Progress, Session};
 use lumis_core::{Error, Registry};
@@ -18,11 +11,9 @@ use lumis_scene::{LoadedScene, SceneDocument};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 
-use crate::errors::{lumis_error, Interrupted, OrRaise};
+use crate::errors::{Interrupted, OrRaise};
 use crate::image::array_of;
-
-/// How often the calling thread looks at signals and progress.
-const POLL: Duration = Duration::from_millis(50);
+use crate::stoppable::run_stoppable;
 
 /// How a render reports how far it is.
 pub enum Report {
@@ -75,9 +66,8 @@ impl Report {
     }
 }
 
-/// Renders `loaded` on a thread of its own while this thread, with the GIL
-/// released between looks, runs Python's signal handlers and `report`;
-/// the render's warnings become Python warnings.
+/// Renders `loaded`, stoppable by Ctrl-C ([`run_stoppable`]), showing
+/// `report`; the render's warnings become Python warnings.
 /// Returns the render, and the exception that stopped it (a
 /// `KeyboardInterrupt`, or one the progress callback raised).
 pub fn run(
@@ -101,34 +91,21 @@ pub fn run(
             reported.1.store(total, Ordering::Relaxed);
         })),
     };
-    let (rendered, stopped_by) = py.detach(|| {
-        std::thread::scope(|threads| {
-            let worker = threads.spawn(|| render_film(loaded, request, &session));
-            let mut stopped_by: Option<PyErr> = None;
-            while !worker.is_finished() {
-                std::thread::park_timeout(POLL);
-                Python::attach(|py| {
-                    let looked = py.check_signals().and_then(|()| {
-                        let (units, total) = (&done.0, &done.1);
-                        report.show(
-                            py,
-                            units.load(Ordering::Relaxed),
-                            total.load(Ordering::Relaxed),
-                        )
-                    });
-                    if let (Err(e), None) = (looked, &stopped_by) {
-                        stop.store(true, Ordering::Relaxed);
-                        stopped_by = Some(e);
-                    }
-                });
-            }
-            (worker.join(), stopped_by)
-        })
-    });
+    let (rendered, stopped_by) = run_stoppable(
+        py,
+        &stop,
+        || render_film(loaded, request, &session),
+        |py| {
+            let (units, total) = (&done.0, &done.1);
+            report.show(
+                py,
+                units.load(Ordering::Relaxed),
+                total.load(Ordering::Relaxed),
+            )
+        },
+    )?;
     report.close(py)?;
-    let rendered = rendered
-        .map_err(|_| lumis_error(py, &Error::msg("the render panicked")))?
-        .or_raise(py)?;
+    let rendered = rendered.or_raise(py)?;
     let warnings = py.import("warnings")?;
     let notes = notes.into_inner().unwrap_or_default();
     for line in notes.iter().chain(&rendered.defect_warnings()) {

@@ -1,12 +1,13 @@
 //! Runs the Python module's pytest suite (`tests/python/`) against this
 //! build: `cargo build` makes the module and the `lumis` command line it
 //! is compared with, the module is put in a scratch directory as
-//! `lumis.abi3.so`, and pytest (with NumPy) is installed from PyPI under
-//! the target directory where the interpreter lacks it.
+//! `lumis.abi3.so`, and pytest, NumPy and pandas (for a study's
+//! DataFrame) are installed from PyPI under the target directory where
+//! the interpreter lacks them.
 //!
 //! Where there is no Python 3 the test says why on stderr and returns
 //! (`cargo test -p lumis-py -- --nocapture` shows it); a failure to
-//! install pytest or NumPy fails it.
+//! install them fails it.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -65,7 +66,8 @@ fn the_pytest_suite_passes() {
     // The test dependencies, installed once per target directory.
     let deps = Path::new(env!("CARGO_TARGET_TMPDIR")).join("python-test-deps");
     let path = format!("{}:{}", scratch.path().display(), deps.display());
-    if !imports(&python, &path, &["numpy", "pytest"]) {
+    let needed = ["numpy", "pytest", "pandas"];
+    if !imports(&python, &path, &needed) {
         let install = Command::new(&python)
             .args([
                 "-m",
@@ -75,12 +77,12 @@ fn the_pytest_suite_passes() {
                 "--disable-pip-version-check",
             ])
             .args(["--target".as_ref(), deps.as_os_str()])
-            .args(["numpy", "pytest"])
+            .args(needed)
             .output()
             .expect("python runs");
         assert!(
             install.status.success(),
-            "pip could not install numpy and pytest: {}",
+            "pip could not install {needed:?}: {}",
             String::from_utf8_lossy(&install.stderr)
         );
     }

@@ -12,7 +12,8 @@ mod lecture;
 mod samplers_analyze;
 
 pub use converge::{
-    converge, parse_variants, ConvergeArgs, ConvergeReport, MeasuredImage, Point, Run, Variant,
+    converge, converge_variants, parse_variants, read_variants, variant_of, ConvergeArgs,
+    ConvergeReport, MeasuredImage, Point, Run, Variant,
 };
 pub use diff::{diff as diff_images, parse_regions, DiffArgs, Region};
 pub use lecture::{lecture, LectureArgs};

@@ -2,7 +2,7 @@
 //! several variants of one scene, over several seeds.
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
@@ -19,7 +19,7 @@ mod variants;
 use report::{ranked_table, summarise, write_outputs};
 pub use report::{ConvergeReport, Point, Run};
 use variants::VARIANTS_FILE;
-pub use variants::{parse_variants, MeasuredImage, Variant};
+pub use variants::{parse_variants, variant_of, MeasuredImage, Variant};
 
 #[derive(clap::Args, Debug, Clone)]
 pub struct ConvergeArgs {
@@ -70,22 +70,40 @@ fn parse_seconds(text: &str) -> std::result::Result<f64, String> {
     }
 }
 
-/// Renders every variant at each spp and seed and measures its error.
-/// When `stop` becomes true (Ctrl-C) it finishes the render in flight,
-/// then writes and reports everything measured so far.
+/// Renders every variant of the file `args.variants` at each spp and seed
+/// and measures its error ([`converge_variants`]).
 pub fn converge(
     args: &ConvergeArgs,
+    registry: &Registry,
+    stop: &AtomicBool,
+) -> Result<ConvergeReport> {
+    converge_variants(args, &read_variants(&args.variants)?, registry, stop)
+}
+
+/// The variants of the variants file at `path`.
+pub fn read_variants(path: &Path) -> Result<Vec<Variant>> {
+    let text = read_text_bounded(path, VARIANTS_FILE).map_err(Error::msg)?;
+    parse_variants(&text, &path.display().to_string())
+}
+
+/// Renders every one of `variants` at each spp and seed and measures its
+/// error (`args.variants` is not read). When `stop` becomes true (Ctrl-C)
+/// it finishes the render in flight, then writes and reports everything
+/// measured so far.
+pub fn converge_variants(
+    args: &ConvergeArgs,
+    variants: &[Variant],
     registry: &Registry,
     stop: &AtomicBool,
 ) -> Result<ConvergeReport> {
     if let Some(warning) = threads_capped(args.threads) {
         eprintln!("{warning}");
     }
+    if variants.is_empty() {
+        return Err(Error::msg("no variants to measure"));
+    }
     let reference = read_exr(&args.reference).map_err(|e| Error::msg(e.to_string()))?;
     let provenance = reference_provenance(args);
-    let variants_path = args.variants.display().to_string();
-    let text = read_text_bounded(&args.variants, VARIANTS_FILE).map_err(Error::msg)?;
-    let variants = parse_variants(&text, &variants_path)?;
     if args.seeds == 0 || args.spp.is_empty() || args.spp.contains(&0) {
         return Err(Error::msg(
             "--seeds and every --spp value must be at least 1",
@@ -228,8 +246,8 @@ pub fn converge(
             (v.name.clone(), loglog_slope(&xs, &ys))
         })
         .collect();
-    write_outputs(args, &variants, &runs, &points)?;
-    let mut table = provenance + &ranked_table(&variants, &points, &slopes, args.time_budget);
+    write_outputs(args, variants, &runs, &points)?;
+    let mut table = provenance + &ranked_table(variants, &points, &slopes, args.time_budget);
     if interrupted {
         table += "(interrupted: the rows above are those measured before Ctrl-C)\n";
     }
