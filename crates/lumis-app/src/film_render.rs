@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use lumis_core::audit::Defects;
 use lumis_core::{Error, RenderStats, Result};
-use lumis_render::{progress_units, Film, PassContext, RenderPool};
+use lumis_render::{progress_units, Film, PassContext};
 use lumis_scene::{LoadedScene, SceneDocument};
 
 use crate::checkpoint::Checkpoint;
@@ -110,7 +110,7 @@ pub fn render_film(
     if let Some(warning) = threads_capped(request.threads) {
         session.note(&warning);
     }
-    let pool = RenderPool::new(request.threads)?;
+    let pool = session.pool(request.threads)?;
     let progress = session
         .progress
         .over(progress_units(resolution, end - state.film.samples));

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use lumis_core::{Error, Result};
 use lumis_image::{read_exr, Image};
-use lumis_render::{progress_units, render_pass, Film, PassContext, RenderPool};
+use lumis_render::{progress_units, render_pass, Film, PassContext};
 
 use crate::metadata::{lumis_version, other_scene_or_seed, ImageMetadata};
 use crate::outputs::Outputs;
@@ -167,7 +167,7 @@ pub fn render_reference(
             None,
         ),
     };
-    let pool = RenderPool::new(args.threads)?;
+    let pool = session.pool(args.threads)?;
     while meta.spp < args.spp {
         let pass = args.pass_spp.min(args.spp - meta.spp);
         let seed = base_seed.wrapping_add(meta.passes);

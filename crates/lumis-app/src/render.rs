@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use lumis_core::{Error, RenderStats, Result, Sampler, Scene};
 use lumis_render::profile::{profiled_sampler, profiled_scene, Profile};
-use lumis_render::{progress_units, Aov, Film, PassContext, RenderPool};
+use lumis_render::{progress_units, Aov, Film, PassContext};
 use lumis_scene::LoadedScene;
 
 use crate::checkpoint::{checkpoint_path, Checkpoint};
@@ -297,7 +297,7 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
         Some(sampler) => (&profiled_scene, sampler),
         None => (&loaded.scene, loaded.sampler.as_ref()),
     };
-    let pool = RenderPool::new(args.threads)?;
+    let pool = session.pool(args.threads)?;
     let units = progress_units(resolution, end - state.film.samples);
     let progress = match args.quiet {
         true => crate::Progress::Hidden.over(units),

@@ -5,7 +5,7 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use lumis_core::Registry;
-use lumis_render::{ProgressFn, RenderProgress};
+use lumis_render::{ProgressFn, RenderPool, RenderProgress, ThreadHost};
 
 /// The caller's side of a render. The library prints nothing itself: the
 /// command line passes `eprintln!` as [`Session::notes`] and
@@ -19,6 +19,9 @@ pub struct Session<'a> {
     /// line, in the order a user should read them.
     pub notes: &'a (dyn Fn(&str) + Sync),
     pub progress: Progress,
+    /// What runs each render thread, for a host that prepares its threads
+    /// once (Python); `None` runs them as they are.
+    pub thread_host: Option<ThreadHost>,
 }
 
 impl<'a> Session<'a> {
@@ -29,11 +32,17 @@ impl<'a> Session<'a> {
             stop,
             notes: &|_| {},
             progress: Progress::Hidden,
+            thread_host: None,
         }
     }
 
     pub(crate) fn note(&self, line: &str) {
         (self.notes)(line)
+    }
+
+    /// The worker threads of a render of `threads` (0: one per core).
+    pub(crate) fn pool(&self, threads: usize) -> lumis_core::Result<RenderPool> {
+        RenderPool::hosted(threads, self.thread_host.clone())
     }
 }
 

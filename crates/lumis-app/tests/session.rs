@@ -50,6 +50,7 @@ fn notes_and_progress_reach_the_caller() {
             let mut seen = seen.lock().unwrap();
             *seen = (seen.0.max(done), total);
         })),
+        thread_host: None,
     };
     let report = render(&small_box(dir.path(), 4), &session).unwrap();
     assert_eq!(report.spp, 4);
@@ -107,6 +108,7 @@ fn a_stop_ends_the_render_with_the_passes_done() {
                 stopper.store(true, Ordering::Relaxed);
             }
         })),
+        thread_host: None,
     };
     let report = render(&small_box(dir.path(), spp), &session).unwrap();
     assert!(report.interrupted);

@@ -16,6 +16,8 @@ pub mod light_sampler_suite;
 pub mod light_suite;
 pub mod lobe_zoom;
 pub mod outcome;
+#[cfg(feature = "integrators")]
+pub mod plugins;
 pub mod quadrature;
 pub mod sampler_suite;
 pub mod sweep;

@@ -25,7 +25,8 @@ use lumis_studies::{
     LectureArgs,
 };
 
-use check_plugin::{check_plugin, PluginNames};
+use check_plugin::check_plugin;
+use lumis_check::plugins::PluginNames;
 
 #[derive(Parser)]
 #[command(
@@ -93,7 +94,8 @@ enum Command {
         /// Check this integrator (built-in or from the library); repeatable.
         #[arg(long)]
         integrator: Vec<String>,
-        /// Samples per chi-square test.
+        /// Samples per chi-square test; the albedo, consistency and
+        /// reciprocity checks take 100,000, or this many if fewer.
         #[arg(long, default_value_t = 1_000_000)]
         samples: usize,
         /// Bins per axis (cos theta and phi) of the chi-square histogram.
@@ -380,6 +382,7 @@ fn on_stderr<'a>(registry: &'a Registry, stop: &'a std::sync::atomic::AtomicBool
         stop,
         notes: &|line| eprintln!("{line}"),
         progress: Progress::Stderr,
+        thread_host: None,
     }
 }
 

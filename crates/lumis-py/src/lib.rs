@@ -11,6 +11,7 @@
 mod errors;
 mod image;
 mod mapping;
+mod plugins;
 mod render;
 mod scene;
 mod stoppable;
@@ -30,6 +31,8 @@ mod lumis {
     use crate::errors::{Error, Interrupted};
     #[pymodule_export]
     use crate::image::{diff, read_image};
+    #[pymodule_export]
+    use crate::plugins::{check_plugin, register_bsdf, register_light, register_sampler};
     #[pymodule_export]
     use crate::render::Render;
     #[pymodule_export]

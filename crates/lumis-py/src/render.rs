@@ -13,6 +13,7 @@ use pyo3::types::{PyBytes, PyDict};
 
 use crate::errors::{Interrupted, OrRaise};
 use crate::image::array_of;
+use crate::plugins::{self, raise_plugin_exception, take_exception};
 use crate::stoppable::run_stoppable;
 
 /// How a render reports how far it is.
@@ -90,7 +91,9 @@ pub fn run(
             reported.0.store(units, Ordering::Relaxed);
             reported.1.store(total, Ordering::Relaxed);
         })),
+        thread_host: Some(plugins::thread_host()),
     };
+    take_exception();
     let (rendered, stopped_by) = run_stoppable(
         py,
         &stop,
@@ -105,7 +108,7 @@ pub fn run(
         },
     )?;
     report.close(py)?;
-    let rendered = rendered.or_raise(py)?;
+    let rendered = raise_plugin_exception(py, rendered)?;
     let warnings = py.import("warnings")?;
     let notes = notes.into_inner().unwrap_or_default();
     for line in notes.iter().chain(&rendered.defect_warnings()) {

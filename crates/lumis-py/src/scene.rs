@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use lumis_app::{registry_with_search_path, FilmRequest, SampleSlice};
+use lumis_app::{FilmRequest, SampleSlice};
 use lumis_core::{Error, Location, Registry};
 use lumis_scene::{LoadedScene, SceneDocument};
 use pyo3::prelude::*;
@@ -11,6 +11,7 @@ use pyo3::types::{PyDict, PyRange, PyRangeMethods};
 
 use crate::errors::{lumis_error, OrRaise};
 use crate::mapping::{assignment, document_of, toml_of};
+use crate::plugins;
 use crate::render::{run, Render, Report};
 
 /// A loaded scene, ready to render.
@@ -30,7 +31,7 @@ pub struct Scene {
 impl Scene {
     fn load(py: Python<'_>, document: SceneDocument) -> PyResult<Self> {
         py.detach(|| {
-            let registry = registry_with_search_path()?;
+            let registry = plugins::registry()?;
             let loaded = document.load(&[], &registry)?;
             Ok(Self {
                 document,

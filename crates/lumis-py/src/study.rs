@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 
 use lumis_analysis::bias_variance::{BiasVariance, Split};
-use lumis_app::registry_with_search_path;
 use lumis_core::Error;
 use lumis_image::Image;
 use lumis_studies::{converge_variants, read_variants, variant_of, ConvergeArgs, Point, Run};
@@ -15,6 +14,7 @@ use pyo3::types::{PyDict, PyList};
 use crate::errors::{lumis_error, Interrupted, OrRaise};
 use crate::image::image_from;
 use crate::mapping::{assignment, node_of, toml_of};
+use crate::plugins;
 use crate::stoppable::run_stoppable;
 
 /// What `lumis.converge` measured: each render (`runs`), each variant's
@@ -194,15 +194,16 @@ pub fn converge(
         threads,
         out,
     };
-    let registry = registry_with_search_path().or_raise(py)?;
+    let registry = py.detach(plugins::registry).or_raise(py)?;
     let stop = AtomicBool::new(false);
+    plugins::take_exception();
     let (report, stopped_by) = run_stoppable(
         py,
         &stop,
         || converge_variants(&args, &variants, &registry, &stop),
         |_| Ok(()),
     )?;
-    let report = report.or_raise(py)?;
+    let report = plugins::raise_plugin_exception(py, report)?;
     let runs = report
         .runs
         .iter()

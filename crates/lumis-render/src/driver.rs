@@ -3,6 +3,7 @@
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Instant;
 
 use lumis_core::{
@@ -230,15 +231,42 @@ pub struct RenderPool {
     pool: rayon::ThreadPool,
 }
 
+/// What runs each worker thread's whole life, given the thread's work: a
+/// host embedding lumis prepares its threads once this way rather than on
+/// every call into it (Python keeps one interpreter thread state per
+/// worker instead of making one for each call of a plugin written in
+/// Python).
+pub type ThreadHost = Arc<dyn Fn(Box<dyn FnOnce() + Send>) + Send + Sync>;
+
 impl RenderPool {
     /// Starts [`worker_threads`]`(requested)` threads.
     pub fn new(requested: usize) -> Result<Self> {
+        Self::hosted(requested, None)
+    }
+
+    /// [`Self::new`], each thread run inside `host` where one is given.
+    pub fn hosted(requested: usize, host: Option<ThreadHost>) -> Result<Self> {
         let threads = worker_threads(requested);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .map_err(|e| Error::msg(format!("cannot start {threads} render threads: {e}")))?;
+        let builder = rayon::ThreadPoolBuilder::new().num_threads(threads);
+        let pool = match host {
+            None => builder.build(),
+            Some(host) => builder
+                .spawn_handler(move |thread| {
+                    let host = host.clone();
+                    std::thread::Builder::new()
+                        .spawn(move || host(Box::new(move || thread.run())))
+                        .map(drop)
+                })
+                .build(),
+        };
+        let pool =
+            pool.map_err(|e| Error::msg(format!("cannot start {threads} render threads: {e}")))?;
         Ok(Self { pool })
+    }
+
+    /// Runs `work` in the pool: its parallel iterators use these threads.
+    pub fn install<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
+        self.pool.install(work)
     }
 }
 
