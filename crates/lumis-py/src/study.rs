@@ -232,6 +232,7 @@ pub fn converge(
                 "interrupted: the exception's `study` holds what was measured",
             );
             error.value(py).setattr("study", Py::new(py, study)?)?;
+            error.value(py).setattr("render", py.None())?;
             Err(error)
         }
         Some(e) => Err(e),

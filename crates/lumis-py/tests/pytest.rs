@@ -1,9 +1,9 @@
 //! Runs the Python module's pytest suite (`tests/python/`) against this
 //! build: `cargo build` makes the module and the `lumis` command line it
 //! is compared with, the module is put in a scratch directory as
-//! `lumis.abi3.so`, and pytest, NumPy and pandas (for a study's
-//! DataFrame) are installed from PyPI under the target directory where
-//! the interpreter lacks them.
+//! `lumis.abi3.so`, and pytest, NumPy, pandas (for a study's DataFrame)
+//! and tqdm (for the progress bar) are installed from PyPI under the
+//! target directory where the interpreter lacks them.
 //!
 //! Where there is no Python 3 the test says why on stderr and returns
 //! (`cargo test -p lumis-py -- --nocapture` shows it); a failure to
@@ -66,7 +66,7 @@ fn the_pytest_suite_passes() {
     // The test dependencies, installed once per target directory.
     let deps = Path::new(env!("CARGO_TARGET_TMPDIR")).join("python-test-deps");
     let path = format!("{}:{}", scratch.path().display(), deps.display());
-    let needed = ["numpy", "pytest", "pandas"];
+    let needed = ["numpy", "pytest", "pandas", "tqdm"];
     if !imports(&python, &path, &needed) {
         let install = Command::new(&python)
             .args([

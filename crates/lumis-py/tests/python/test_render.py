@@ -98,6 +98,12 @@ def test_progress_reaches_the_total(cornell_box):
     assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
 
 
+def test_a_tqdm_bar_shows_progress_by_default(cornell_box, capsys):
+    pytest.importorskip("tqdm")
+    small(cornell_box).render(spp=2, pass_spp=1)
+    assert "tile" in capsys.readouterr().err
+
+
 def test_a_progress_callback_that_raises_stops_the_render(cornell_box):
     def fail(done, total):
         raise RuntimeError("from the callback")
