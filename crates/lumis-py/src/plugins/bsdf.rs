@@ -4,6 +4,7 @@ use lumis_api::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, Error, Result, Rgb, Ve
 use pyo3::prelude::*;
 
 use super::object::PluginObject;
+use super::values::{rgb, tuple};
 
 /// A Python object with `flags`, `f`, `pdf` and `sample_f`, as a [`Bsdf`]:
 /// directions cross as `(x, y, z)` tuples of the local shading frame.
@@ -38,15 +39,6 @@ pub fn flags_named(text: &str) -> std::result::Result<BsdfFlags, String> {
         };
         Ok(flags | flag)
     })
-}
-
-fn tuple(v: Vec3) -> (f32, f32, f32) {
-    (v.x, v.y, v.z)
-}
-
-fn rgb(value: &Bound<'_, PyAny>) -> PyResult<Rgb> {
-    let (r, g, b) = value.extract::<(f32, f32, f32)>()?;
-    Ok(Rgb::new(r, g, b))
 }
 
 impl Bsdf for PythonBsdf {

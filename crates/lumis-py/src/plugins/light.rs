@@ -7,6 +7,7 @@ use lumis_api::{
 use pyo3::prelude::*;
 
 use super::object::PluginObject;
+use super::values::{rgb, tuple, vec3};
 
 /// A Python object with `kind`, `sample_li`, `pdf_li`, `l` and `power`
 /// (and optionally `preprocess`), as a [`Light`]: points and directions
@@ -31,20 +32,6 @@ impl PythonLight {
         };
         Ok(Self { object, kind })
     }
-}
-
-fn tuple(v: Vec3) -> (f32, f32, f32) {
-    (v.x, v.y, v.z)
-}
-
-fn vec3(value: &Bound<'_, PyAny>) -> PyResult<Vec3> {
-    let (x, y, z) = value.extract::<(f32, f32, f32)>()?;
-    Ok(Vec3::new(x, y, z))
-}
-
-fn rgb(value: &Bound<'_, PyAny>) -> PyResult<Rgb> {
-    let (r, g, b) = value.extract::<(f32, f32, f32)>()?;
-    Ok(Rgb::new(r, g, b))
 }
 
 impl Light for PythonLight {
