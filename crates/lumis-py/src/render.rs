@@ -27,12 +27,11 @@ pub enum Report {
 
 impl Report {
     /// The caller's `progress` argument: a callable, `False` for none, or
-    /// `None` for a `tqdm` bar where `tqdm` is installed.
+    /// `None` (or `True`) for a `tqdm` bar where `tqdm` is installed.
     pub fn of(py: Python<'_>, progress: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         match progress {
             Some(p) if p.is_callable() => Ok(Self::Callback(p.clone().unbind())),
             Some(p) if !p.is_truthy()? => Ok(Self::Silent),
-            Some(p) if p.is_none() => Ok(Self::Silent),
             Some(_) | None => match py.import("tqdm.auto") {
                 Ok(tqdm) => {
                     let kwargs = PyDict::new(py);
