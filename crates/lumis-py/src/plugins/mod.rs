@@ -169,65 +169,61 @@ fn leak(text: String) -> &'static str {
     Box::leak(text.into_boxed_str())
 }
 
-/// Registers a BSDF written in Python. `cls(**params)` makes it; its
-/// methods, in the local shading frame (`z` the normal, directions as
-/// `(x, y, z)` tuples pointing away from the surface), are
-/// `f(wo, wi) -> (r, g, b)` (no cosine), `pdf(wo, wi) -> float` (solid
-/// angle) and `sample_f(wo, u1, (u2x, u2y))` returning `None` or
-/// `(f, wi, pdf)` (optionally `flags` and `eta` after them), and its
-/// `flags` attribute names its lobes (`"diffuse|reflection"`). `params`
-/// declares its parameters: `{"name": default}` or `{"name": {"type":
-/// "float", "default": 0.5, "range": [0, 1], "doc": "..."}}` (types
-/// `bool`, `int`, `float`, `string`, `rgb`, `vec3`).
-#[pyfunction]
-#[pyo3(signature = (name, cls, params = None, doc = None))]
-pub fn register_bsdf(
-    py: Python<'_>,
-    name: &str,
-    cls: &Bound<'_, PyType>,
-    params: Option<&Bound<'_, PyDict>>,
-    doc: Option<&str>,
-) -> PyResult<()> {
-    declare(py, PluginKind::Bsdf, name, cls, params, doc)
+/// A `register_*` function of the module: one per kind a Python class
+/// can be, each taking the plugin's name, its class, its parameters'
+/// declarations and a line of documentation (else the class's docstring).
+macro_rules! registration {
+    ($(#[$doc:meta])* $function:ident => $kind:expr) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (name, cls, params = None, doc = None))]
+        pub fn $function(
+            py: Python<'_>,
+            name: &str,
+            cls: &Bound<'_, PyType>,
+            params: Option<&Bound<'_, PyDict>>,
+            doc: Option<&str>,
+        ) -> PyResult<()> {
+            declare(py, $kind, name, cls, params, doc)
+        }
+    };
 }
 
-/// Registers a light written in Python, used as a `[[light]]` table. Its
-/// `kind` attribute is `"delta_position"` (a point: never hit) or
-/// `"infinite"` (an environment: seen by escaping rays, with an optional
-/// `preprocess(center, radius)` given the scene's bounding sphere). With
-/// `p` and `n` the shaded point and its normal (zero off surfaces), its
-/// methods are `sample_li(p, n, (u1, u2))` returning `None` or
-/// `(radiance, wi, pdf, point)`, `pdf_li(p, n, wi) -> float`,
-/// `l(p, n, uv, w) -> (r, g, b)` (for an infinite light, the radiance
-/// arriving along `-w`) and `power() -> (r, g, b)`. `params` as for
-/// `register_bsdf`.
-#[pyfunction]
-#[pyo3(signature = (name, cls, params = None, doc = None))]
-pub fn register_light(
-    py: Python<'_>,
-    name: &str,
-    cls: &Bound<'_, PyType>,
-    params: Option<&Bound<'_, PyDict>>,
-    doc: Option<&str>,
-) -> PyResult<()> {
-    declare(py, PluginKind::Light, name, cls, params, doc)
+registration! {
+    /// Registers a BSDF written in Python. `cls(**params)` makes it; its
+    /// methods, in the local shading frame (`z` the normal, directions as
+    /// `(x, y, z)` tuples pointing away from the surface), are
+    /// `f(wo, wi) -> (r, g, b)` (no cosine), `pdf(wo, wi) -> float` (solid
+    /// angle) and `sample_f(wo, u1, (u2x, u2y))` returning `None` or
+    /// `(f, wi, pdf)` (optionally `flags` and `eta` after them), and its
+    /// `flags` attribute names its lobes (`"diffuse|reflection"`). `params`
+    /// declares its parameters: `{"name": default}` or `{"name": {"type":
+    /// "float", "default": 0.5, "range": [0, 1], "doc": "..."}}` (types
+    /// `bool`, `int`, `float`, `string`, `rgb`, `vec3`).
+    register_bsdf => PluginKind::Bsdf
 }
 
-/// Registers a sampler written in Python. `cls(**params)` makes it (an
-/// `spp` parameter is the samples per pixel, as the built-ins'); its
-/// methods are `start_pixel_sample((x, y), index, seed)`, `get_1d() ->
-/// float`, `get_2d() -> (u, v)` and `get_pixel_2d() -> (u, v)`, numbers in
-/// [0, 1). Each render thread works on a copy (`copy.deepcopy`).
-#[pyfunction]
-#[pyo3(signature = (name, cls, params = None, doc = None))]
-pub fn register_sampler(
-    py: Python<'_>,
-    name: &str,
-    cls: &Bound<'_, PyType>,
-    params: Option<&Bound<'_, PyDict>>,
-    doc: Option<&str>,
-) -> PyResult<()> {
-    declare(py, PluginKind::Sampler, name, cls, params, doc)
+registration! {
+    /// Registers a light written in Python, used as a `[[light]]` table. Its
+    /// `kind` attribute is `"delta_position"` (a point: never hit) or
+    /// `"infinite"` (an environment: seen by escaping rays, with an optional
+    /// `preprocess(center, radius)` given the scene's bounding sphere). With
+    /// `p` and `n` the shaded point and its normal (zero off surfaces), its
+    /// methods are `sample_li(p, n, (u1, u2))` returning `None` or
+    /// `(radiance, wi, pdf, point)`, `pdf_li(p, n, wi) -> float`,
+    /// `l(p, n, uv, w) -> (r, g, b)` (for an infinite light, the radiance
+    /// arriving along `-w`) and `power() -> (r, g, b)`. `params` as for
+    /// `register_bsdf`.
+    register_light => PluginKind::Light
+}
+
+registration! {
+    /// Registers a sampler written in Python. `cls(**params)` makes it; its
+    /// `spp` attribute is its samples per pixel (declare an `spp` parameter,
+    /// as the built-ins do, for a scene to set it), and its methods are `start_pixel_sample((x, y), index, seed)`, `get_1d() ->
+    /// float`, `get_2d() -> (u, v)` and `get_pixel_2d() -> (u, v)`, numbers in
+    /// [0, 1). Each render thread works on a copy (`copy.deepcopy`).
+    register_sampler => PluginKind::Sampler
 }
 
 /// What runs each worker thread of a render or a check: the thread joins
