@@ -6,6 +6,8 @@
 //! 2. A closed cube of emissive faces (radiance Le) with albedo a, seen from
 //!    inside, Russian roulette off: the radiance is the truncated series
 //!    Le (1 + a + ... + a^(D-1)) for max_depth D, which tends to Le / (1 - a).
+//!    The same holds inside a sphere light whose normals face inward: the
+//!    camera is inside the light, which is sampled from inside it.
 
 use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 
@@ -13,10 +15,10 @@ use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 /// packet one.
 const PATH_TRACERS: [&str; 3] = ["path", "wavefront", "packet"];
 
-/// 2 integrators x 3 strategies x 6 scenes x 3 channels, overall
+/// 3 integrators x 3 strategies x 7 scenes x 3 channels, overall
 /// false-alarm rate 1e-3.
 fn z_limit() -> f64 {
-    bonferroni_z(1e-3, 108)
+    bonferroni_z(1e-3, 189)
 }
 
 fn check_uniform_image(toml: &str, strategy: &str, expected: [f64; 3]) {
@@ -137,6 +139,49 @@ fn closed_emissive_box_reproduces_the_neumann_series() {
         for strategy in ["bsdf", "light", "mis"] {
             check_uniform_image(&toml, strategy, [series, 0.5 * series, 0.25 * series]);
         }
+    }
+}
+
+/// The camera inside a sphere light (normals flipped to face the inside),
+/// off its centre: every path bounces inside the emitter, so the image is
+/// the closed box's series. From inside, the light is sampled uniformly by
+/// area (the cone of a point inside is the whole sphere of directions), and
+/// BSDF samples hit it everywhere; every strategy must agree.
+#[test]
+fn inside_a_sphere_light_the_image_is_the_series() {
+    let (albedo, depth) = (0.6f64, 10u32);
+    let series: f64 = (0..depth).map(|k| albedo.powi(k as i32)).sum();
+    let toml = format!(
+        r#"
+[film]
+resolution = [16, 16]
+[camera]
+type = "perspective"
+origin = [0.3, -0.2, 0.1]
+target = [0.5, 0.1, -1.0]
+fov = 100.0
+[sampler]
+type = "independent"
+spp = 64
+[integrator]
+type = "path"
+max_depth = {depth}
+rr_depth = 100000
+[[bsdf]]
+name = "grey"
+type = "diffuse"
+reflectance = {albedo}
+[[shape]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+bsdf = "grey"
+flip_normals = true
+emission = {{ radiance = [1.0, 0.5, 0.25] }}
+"#
+    );
+    for strategy in ["bsdf", "light", "mis"] {
+        check_uniform_image(&toml, strategy, [series, 0.5 * series, 0.25 * series]);
     }
 }
 
