@@ -79,25 +79,28 @@ fn albedo_one_sphere_in_constant_light_is_invisible() {
     }
 }
 
-/// Six outward-facing quads flipped to face the inside of [-s, s]^3,
-/// offset by `shift` (to put the box far from the origin).
-fn emissive_cube(albedo: f64, max_depth: u32, scale: f64, shift: f64) -> String {
-    let faces = [
-        ([1, -1, -1], [0, 2, 0], [0, 0, 2]),
-        ([-1, -1, -1], [0, 0, 2], [0, 2, 0]),
-        ([-1, 1, -1], [0, 0, 2], [2, 0, 0]),
-        ([-1, -1, -1], [2, 0, 0], [0, 0, 2]),
-        ([-1, -1, 1], [2, 0, 0], [0, 2, 0]),
-        ([-1, -1, -1], [0, 2, 0], [2, 0, 0]),
-    ];
-    let mut toml = format!(
+/// The bsdf, normals and emission of a closed emitter's surfaces: grey,
+/// facing inward, radiance [1, 0.5, 0.25].
+const INWARD_EMITTER: &str =
+    "bsdf = \"grey\"\nflip_normals = true\nemission = { radiance = [1.0, 0.5, 0.25] }\n";
+
+/// A scene seen from `origin` towards `target` inside a closed emitter of
+/// albedo `albedo` (its shapes to follow, each with [`INWARD_EMITTER`]),
+/// paths of up to `max_depth` segments, Russian roulette off.
+fn inside_closed_emitter(
+    origin: [f64; 3],
+    target: [f64; 3],
+    albedo: f64,
+    max_depth: u32,
+) -> String {
+    format!(
         r#"
 [film]
 resolution = [16, 16]
 [camera]
 type = "perspective"
-origin = [{cx}, {cy}, {cz}]
-target = [{tx}, {ty}, {tz}]
+origin = {origin:?}
+target = {target:?}
 fov = 100.0
 [sampler]
 type = "independent"
@@ -110,19 +113,28 @@ rr_depth = 100000
 name = "grey"
 type = "diffuse"
 reflectance = {albedo}
-"#,
-        cx = shift + 0.1 * scale,
-        cy = shift - 0.2 * scale,
-        cz = shift + 0.05 * scale,
-        tx = shift + 0.3 * scale,
-        ty = shift + 0.1 * scale,
-        tz = shift + scale,
-    );
+"#
+    )
+}
+
+/// Six outward-facing quads flipped to face the inside of [-s, s]^3,
+/// offset by `shift` (to put the box far from the origin).
+fn emissive_cube(albedo: f64, max_depth: u32, scale: f64, shift: f64) -> String {
+    let faces = [
+        ([1, -1, -1], [0, 2, 0], [0, 0, 2]),
+        ([-1, -1, -1], [0, 0, 2], [0, 2, 0]),
+        ([-1, 1, -1], [0, 0, 2], [2, 0, 0]),
+        ([-1, -1, -1], [2, 0, 0], [0, 0, 2]),
+        ([-1, -1, 1], [2, 0, 0], [0, 2, 0]),
+        ([-1, -1, -1], [0, 2, 0], [2, 0, 0]),
+    ];
+    let at = |x: f64, y: f64, z: f64| [shift + x * scale, shift + y * scale, shift + z * scale];
+    let mut toml = inside_closed_emitter(at(0.1, -0.2, 0.05), at(0.3, 0.1, 1.0), albedo, max_depth);
     let point = |a: [i32; 3]| format!("{:?}", a.map(|c| shift + c as f64 * scale));
     let edge = |a: [i32; 3]| format!("{:?}", a.map(|c| c as f64 * scale));
     for (corner, u, w) in faces {
         toml += &format!(
-            "[[shape]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\nbsdf = \"grey\"\nflip_normals = true\nemission = {{ radiance = [1.0, 0.5, 0.25] }}\n",
+            "[[shape]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\n{INWARD_EMITTER}",
             point(corner),
             edge(u),
             edge(w)
@@ -151,34 +163,9 @@ fn closed_emissive_box_reproduces_the_neumann_series() {
 fn inside_a_sphere_light_the_image_is_the_series() {
     let (albedo, depth) = (0.6f64, 10u32);
     let series: f64 = (0..depth).map(|k| albedo.powi(k as i32)).sum();
-    let toml = format!(
-        r#"
-[film]
-resolution = [16, 16]
-[camera]
-type = "perspective"
-origin = [0.3, -0.2, 0.1]
-target = [0.5, 0.1, -1.0]
-fov = 100.0
-[sampler]
-type = "independent"
-spp = 64
-[integrator]
-type = "path"
-max_depth = {depth}
-rr_depth = 100000
-[[bsdf]]
-name = "grey"
-type = "diffuse"
-reflectance = {albedo}
-[[shape]]
-type = "sphere"
-center = [0.0, 0.0, 0.0]
-radius = 1.0
-bsdf = "grey"
-flip_normals = true
-emission = {{ radiance = [1.0, 0.5, 0.25] }}
-"#
+    let mut toml = inside_closed_emitter([0.3, -0.2, 0.1], [0.5, 0.1, -1.0], albedo, depth);
+    toml += &format!(
+        "[[shape]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n{INWARD_EMITTER}"
     );
     for strategy in ["bsdf", "light", "mis"] {
         check_uniform_image(&toml, strategy, [series, 0.5 * series, 0.25 * series]);
