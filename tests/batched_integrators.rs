@@ -39,7 +39,7 @@ fn render_opaque(loaded: &LoadedScene) -> RenderOutput {
 /// so with scalar scene queries the two integrators agree bit for bit, in
 /// the image and in every counter: for each strategy, several light and
 /// BSDF samples per vertex, the one-sample estimator, specular chains and
-/// roulette (glass and plastic), waves that do not divide the samples, and
+/// roulette (glass and plastic), the indirect clamp, waves that do not divide the samples, and
 /// packets that refill only below five live lanes.
 #[test]
 fn same_image_as_path_bit_for_bit() {
@@ -53,6 +53,7 @@ fn same_image_as_path_bit_for_bit() {
         ),
         (cornell, &["integrator.n_f=3", "integrator.n_g=2"]),
         (cornell, &["integrator.estimator=\"one-sample\""]),
+        (cornell, &["integrator.clamp_indirect=0.05"]),
         (glass, &["integrator.rr_depth=1"]),
     ] {
         let mut overrides = vec![

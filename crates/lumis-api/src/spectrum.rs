@@ -39,6 +39,22 @@ impl Rgb {
         self.r.max(self.g).max(self.b)
     }
 
+    /// Scaled down, where its largest component exceeds `max`, to have
+    /// `max` there (pbrt-v4 `RGBFilm::AddSample`, `maxcomponentvalue`): the
+    /// hue stays, and the rare paths whose radiance is huge (caustics
+    /// through a small light, found by a BSDF sample) stop showing as
+    /// fireflies. Biased: the energy above the cap is lost. A value whose
+    /// components are all within the cap is returned as it was, bit for bit.
+    #[inline]
+    pub fn clamp_max_component(self, max: f32) -> Rgb {
+        let m = self.max_component();
+        if m > max {
+            self * (max / m)
+        } else {
+            self
+        }
+    }
+
     #[inline]
     pub fn min_component(&self) -> f32 {
         self.r.min(self.g).min(self.b)

@@ -30,7 +30,7 @@ pub struct RenderSettings {
     pub threads: usize,
     /// Draw a progress bar on stderr (hidden when stderr is not a terminal).
     pub progress: bool,
-    /// The cap on each sample's largest component ([`clamp_radiance`]).
+    /// The cap on each sample's largest component ([`Rgb::clamp_max_component`]).
     pub clamp: Option<f32>,
 }
 
@@ -85,23 +85,6 @@ struct Batch {
     filled: usize,
 }
 
-/// `l` scaled down, where its largest component exceeds `max`, to have
-/// `max` there (pbrt-v4 `RGBFilm::AddSample`, `maxcomponentvalue`): the
-/// hue stays, and the rare paths whose radiance is huge (caustics through
-/// a small light, found by a BSDF sample) stop showing as fireflies.
-/// Biased: the energy above the cap is lost, so the image is darker than
-/// the converged one wherever such paths carry light. A sample whose
-/// components are all within the cap is returned as it was, bit for bit.
-#[inline]
-pub fn clamp_radiance(l: Rgb, max: f32) -> Rgb {
-    let m = l.r.max(l.g).max(l.b);
-    if m > max {
-        l * (max / m)
-    } else {
-        l
-    }
-}
-
 impl Batch {
     /// Traces the filled lanes and adds their radiance (clamped, where the
     /// scene asks) to their pixels in `film`, in lane order.
@@ -136,7 +119,7 @@ impl Batch {
                 continue;
             }
             match clamp {
-                Some(max) => film.add_sample(i, index, clamp_radiance(*l, max)),
+                Some(max) => film.add_sample(i, index, l.clamp_max_component(max)),
                 None => film.add_sample(i, index, *l),
             }
         }
@@ -277,7 +260,7 @@ pub struct PassContext<'a> {
     pub integrator: &'a dyn Integrator,
     pub sampler: &'a dyn Sampler,
     pub seed: u64,
-    /// The cap on each sample's largest component ([`clamp_radiance`]).
+    /// The cap on each sample's largest component ([`Rgb::clamp_max_component`]).
     pub clamp: Option<f32>,
     pub pool: &'a RenderPool,
     pub progress: &'a RenderProgress,

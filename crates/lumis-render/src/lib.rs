@@ -14,8 +14,8 @@ pub use adaptive::{pixel_error, AdaptiveSampling};
 pub use aov::Aov;
 pub use camera::PerspectiveCamera;
 pub use driver::{
-    clamp_radiance, progress_units, render, render_pass, worker_threads, PassContext, PassOutput,
-    RenderOutput, RenderPool, RenderSettings, ThreadHost, MAX_THREADS_PER_CORE, TILE_SIZE,
+    progress_units, render, render_pass, worker_threads, PassContext, PassOutput, RenderOutput,
+    RenderPool, RenderSettings, ThreadHost, MAX_THREADS_PER_CORE, TILE_SIZE,
 };
 pub use film::{AdaptiveState, Film, FirstHitSums};
 pub use first_hit::{first_hit, first_hit_rng, FirstHit, MAX_SPECULAR_BOUNCES};

@@ -13,7 +13,9 @@
 //! leave a vertex from origins offset by pbrt-v4's floating-point error
 //! bounds, with no scene-scale epsilon. Russian roulette ends a path with
 //! survival probability `max(beta)` after `rr_depth` segments. NaN or
-//! infinite samples are counted, reported and dropped.
+//! infinite samples are counted, reported and dropped. `clamp_direct` and
+//! `clamp_indirect` cap what direct and indirect light may add to a path's
+//! radiance, as Cycles' clamps do (`BounceClamp`, in `path_state.rs`).
 //!
 //! The built-in integrators are compiled for lumis's own scene type as well
 //! as for `dyn Scene` (`plugins/integrators/src/specialize.rs`), so the
@@ -39,7 +41,7 @@ use lumis_api::{
 use crate::estimator::{
     bsdf_context, Estimator, EstimatorParams, Heuristic, SceneView, Strategy, Vertex, VertexPlan,
 };
-use crate::path_state::PathState;
+use crate::path_state::{BounceClamp, PathState};
 use crate::specialize::{integrator_by_trace, Trace};
 
 pub const SPEC: PluginSpec = PluginSpec {
@@ -61,6 +63,15 @@ pub struct PathParams {
     /// (unbiased); large = off
     #[param(default = 5)]
     pub rr_depth: u32,
+    /// largest component of direct lighting (light after one bounce) a
+    /// path may add per vertex; larger contributions are scaled down
+    /// (Cycles' "Clamp Direct"). Biased: trades fireflies' variance for
+    /// darker highlights. Unset: no clamp
+    pub clamp_direct: Option<f32>,
+    /// largest component of indirect light (after two bounces or more) a
+    /// path may add per vertex, as clamp_direct (Cycles' "Clamp Indirect").
+    /// Unset: no clamp
+    pub clamp_indirect: Option<f32>,
     #[param(flatten)]
     pub estimator: EstimatorParams,
 }
@@ -69,6 +80,7 @@ pub struct PathParams {
 pub struct PathIntegrator {
     pub(crate) max_depth: u32,
     pub(crate) rr_depth: u32,
+    pub(crate) clamp: BounceClamp,
     pub(crate) estimator: Estimator,
 }
 
@@ -81,6 +93,7 @@ impl PathIntegrator {
         Self {
             max_depth,
             rr_depth,
+            clamp: BounceClamp::NONE,
             estimator,
         }
     }
@@ -97,11 +110,22 @@ impl PathIntegrator {
                 "must be at least 1 (1 = emitters seen directly)",
             ));
         }
-        Ok(Self::with_estimator(
-            p.max_depth,
-            p.rr_depth,
-            Estimator::from_read(&p.estimator, params)?,
-        ))
+        let clamp = |max: Option<f32>, key| match max {
+            None => Ok(f32::INFINITY),
+            Some(max) if max > 0.0 => Ok(max),
+            Some(_) => Err(params.error(key, "must be positive (leave it out for no clamp)")),
+        };
+        Ok(Self {
+            clamp: BounceClamp {
+                direct: clamp(p.clamp_direct, PathParams::KEYS.clamp_direct)?,
+                indirect: clamp(p.clamp_indirect, PathParams::KEYS.clamp_indirect)?,
+            },
+            ..Self::with_estimator(
+                p.max_depth,
+                p.rr_depth,
+                Estimator::from_read(&p.estimator, params)?,
+            )
+        })
     }
 }
 
@@ -123,6 +147,7 @@ impl Trace for PathIntegrator {
             path.add_emission(
                 self.estimator
                     .emission(scene, &path.ray, found.as_ref(), &path.from),
+                &self.clamp,
                 stats,
             );
             let Some(hit) = &found else {
@@ -145,21 +170,21 @@ impl Trace for PathIntegrator {
                 wo,
             };
             if plan.light_samples > 0 {
-                path.radiance += path.beta
-                    * self.estimator.sample_lights(
-                        &plan,
-                        &vertex,
-                        scene,
-                        numbers.light,
-                        sampler,
-                        stats,
-                    );
+                let l = self.estimator.sample_lights(
+                    &plan,
+                    &vertex,
+                    scene,
+                    numbers.light,
+                    sampler,
+                    stats,
+                );
+                path.add_vertex_light(l, &self.clamp);
             }
             if plan.extra_bsdf_samples > 0 {
-                path.radiance += path.beta
-                    * self
-                        .estimator
-                        .extra_bsdf_samples(&plan, &vertex, scene, sampler, stats);
+                let l = self
+                    .estimator
+                    .extra_bsdf_samples(&plan, &vertex, scene, sampler, stats);
+                path.add_vertex_light(l, &self.clamp);
             }
             let Some(bs) = sampled else {
                 break;
@@ -176,6 +201,10 @@ impl Trace for PathIntegrator {
 mod tests {
     use super::*;
     use lumis_core::doc;
+
+    fn default_clamp() -> BounceClamp {
+        build("").unwrap().clamp
+    }
 
     fn build(text: &str) -> Result<PathIntegrator> {
         let table = doc::parse(text, "i.toml")?;
@@ -210,6 +239,25 @@ mod tests {
             Strategy::Bsdf
         );
         assert!(build("max_depth = 0\n").is_err());
+        assert_eq!(default_clamp(), BounceClamp::NONE);
+        let clamp = build("clamp_direct = 4.0\nclamp_indirect = 0.5\n")
+            .unwrap()
+            .clamp;
+        assert_eq!((clamp.direct, clamp.indirect), (4.0, 0.5));
+        for (bad, key) in [
+            ("clamp_direct = 0.0", "'clamp_direct': must be positive"),
+            (
+                "clamp_indirect = -1.0",
+                "'clamp_indirect': must be positive",
+            ),
+            (
+                "clamp_indirect = nan",
+                "'clamp_indirect': expected a finite number",
+            ),
+        ] {
+            let err = build(bad).unwrap_err().to_string();
+            assert!(err.contains(key), "{bad}: {err}");
+        }
         assert!(build("strategy = \"nee\"\n").is_err());
     }
 }

@@ -7,6 +7,38 @@ use lumis_api::{BsdfFlags, BsdfSample, Ray, RenderStats, Rgb, Sampler};
 
 use crate::estimator::{BsdfRay, Vertex, VertexPlan};
 
+/// Caps on the light a path adds to its pixel, by how many bounces the
+/// light took (Cycles' "Clamp Direct" and "Clamp Indirect"): contributions
+/// whose largest component exceeds the cap are scaled down to it
+/// ([`Rgb::clamp_max_component`]). Biased, darker where the cap binds; it
+/// buys the variance of rare bright paths. Light the camera sees directly
+/// is left to the film's clamp (`[film] clamp`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BounceClamp {
+    /// The cap on direct lighting: light over two segments, one bounce.
+    pub direct: f32,
+    /// The cap on indirect light: three segments or more.
+    pub indirect: f32,
+}
+
+impl BounceClamp {
+    pub const NONE: Self = Self {
+        direct: f32::INFINITY,
+        indirect: f32::INFINITY,
+    };
+
+    /// `contribution`, light that reached the camera over `segments`
+    /// segments, capped.
+    #[inline]
+    pub fn apply(&self, contribution: Rgb, segments: u32) -> Rgb {
+        match segments {
+            0 | 1 => contribution,
+            2 => contribution.clamp_max_component(self.direct),
+            _ => contribution.clamp_max_component(self.indirect),
+        }
+    }
+}
+
 /// One path's state between vertices.
 #[derive(Clone, Copy)]
 pub struct PathState {
@@ -43,14 +75,26 @@ impl PathState {
     /// Adds the emission `ray` found, as [`crate::Estimator::emission`]
     /// answers it: weighted radiance and the number of emitters.
     #[inline]
-    pub fn add_emission(&mut self, (le, emitters): (Rgb, u64), stats: &mut RenderStats) {
+    pub fn add_emission(
+        &mut self,
+        (le, emitters): (Rgb, u64),
+        clamp: &BounceClamp,
+        stats: &mut RenderStats,
+    ) {
         if emitters > 0 {
-            self.radiance += self.beta * le;
+            self.radiance += clamp.apply(self.beta * le, self.segments);
             // What the camera sees is not found by BSDF sampling.
             if self.segments > 1 {
                 stats.bsdf_light_hits += emitters;
             }
         }
+    }
+
+    /// Adds light `l` gathered at the vertex `ray` reaches (next-event
+    /// estimation, extra BSDF samples): paths one segment longer.
+    #[inline]
+    pub fn add_vertex_light(&mut self, l: Rgb, clamp: &BounceClamp) {
+        self.radiance += clamp.apply(self.beta * l, self.segments + 1);
     }
 
     /// Continues the path from `vertex` along its BSDF sample `bs`, then

@@ -1,6 +1,6 @@
 //! The clamp on each camera sample's radiance, which the render driver
 //! applies to every integrator's samples alike
-//! (`lumis_render::clamp_radiance`): `[film] clamp`. lumis 0.1.0 read it
+//! (`lumis_api::Rgb::clamp_max_component`): `[film] clamp`. lumis 0.1.0 read it
 //! in the integrator's table, `[integrator] clamp`, which still reads,
 //! with a warning.
 

@@ -109,8 +109,18 @@ pub(super) fn ranked_table(
         None => last.sort_by(|a, b| b.efficiency.total_cmp(&a.efficiency)),
     }
     let mut out = format!(
-        "{:20} {:>6} {:>9} {:>11} {:>10} {:>11} {:>11} {:>11} {:>8}\n",
-        "variant", "spp", "seconds", "relMSE", "+-se", "bias²", "variance", "efficiency", "slope"
+        "{:20} {:>6} {:>9} {:>11} {:>10} {:>11} {:>10} {:>11} {:>10} {:>11} {:>8}\n",
+        "variant",
+        "spp",
+        "seconds",
+        "relMSE",
+        "+-se",
+        "bias²",
+        "+-se",
+        "variance",
+        "+-se",
+        "efficiency",
+        "slope"
     );
     for p in last {
         let slope = slopes
@@ -118,22 +128,29 @@ pub(super) fn ranked_table(
             .find(|s| s.0 == p.variant)
             .and_then(|s| s.1)
             .map_or("-".into(), |s| format!("{s:+.2}"));
-        let (bias2, variance) = p.split.map_or(("-".into(), "-".into()), |s| {
-            (
-                format!("{:.4e}", s.rel_mse.bias2),
-                format!("{:.4e}", s.rel_mse.variance),
-            )
-        });
+        let [bias2, bias2_se, variance, variance_se] =
+            p.split
+                .map_or(["-".to_string(), "-".into(), "-".into(), "-".into()], |s| {
+                    let s = s.rel_mse;
+                    [
+                        format!("{:.4e}", s.bias2),
+                        format!("{:.2e}", s.bias2_se),
+                        format!("{:.4e}", s.variance),
+                        format!("{:.2e}", s.variance_se),
+                    ]
+                });
         writeln!(
             out,
-            "{:20} {:>6} {:>9.3} {:>11.4e} {:>10.2e} {:>11} {:>11} {:>11.1} {:>8}",
+            "{:20} {:>6} {:>9.3} {:>11.4e} {:>10.2e} {:>11} {:>10} {:>11} {:>10} {:>11.1} {:>8}",
             p.variant,
             p.spp,
             p.seconds,
             p.rel_mse,
             p.rel_mse_se,
             bias2,
+            bias2_se,
             variance,
+            variance_se,
             p.efficiency,
             slope
         )
@@ -145,7 +162,7 @@ pub(super) fn ranked_table(
     }
     .as_str();
     out +=
-        "(bias² + variance: the relMSE of one render split over the seeds; they need 2 or more)\n";
+        "(bias² + variance: the relMSE of one render split over the seeds, which need to be 2 or more; their standard errors are over pixels)\n";
     out
 }
 

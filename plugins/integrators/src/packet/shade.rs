@@ -136,6 +136,7 @@ impl<'a, 's> Bounce<'a, 's> {
             let found = self.found[k].as_ref();
             state.add_emission(
                 estimator.emission(self.scene, &state.ray, found, &state.from),
+                &self.path.clamp,
                 stats,
             );
             paths.radiance.set(lane, state.radiance);
@@ -164,21 +165,21 @@ impl<'a, 's> Bounce<'a, 's> {
 
         self.sample_bsdfs(shaded);
         self.sample_lights(paths, samplers, shaded, stats);
+        let clamp = &self.path.clamp;
         for lane in shaded.iter() {
             let plan = self.plans[lane];
-            let beta = paths.beta.get(lane);
-            let mut radiance = paths.radiance.get(lane);
+            let mut state = paths.get(lane);
             if plan.light_samples > 0 {
-                radiance += beta * (self.light_sums.get(lane) * plan.light_scale);
+                state.add_vertex_light(self.light_sums.get(lane) * plan.light_scale, clamp);
             }
             if plan.extra_bsdf_samples > 0 {
                 let vertex = self.vertex(lane);
-                radiance += beta
-                    * samplers.with_lane(paths.path[lane], |sampler| {
-                        estimator.extra_bsdf_samples(&plan, &vertex, self.scene, sampler, stats)
-                    });
+                let l = samplers.with_lane(paths.path[lane], |sampler| {
+                    estimator.extra_bsdf_samples(&plan, &vertex, self.scene, sampler, stats)
+                });
+                state.add_vertex_light(l, clamp);
             }
-            paths.radiance.set(lane, radiance);
+            paths.radiance.set(lane, state.radiance);
         }
 
         for lane in shaded.iter() {

@@ -279,6 +279,7 @@ impl WavefrontIntegrator {
             let path = &mut wave.paths[lane];
             path.add_emission(
                 estimator.emission(scene, &path.ray, found.as_ref(), &path.from),
+                &self.path.clamp,
                 stats,
             );
             let Some(hit) = found else {
@@ -315,11 +316,12 @@ impl WavefrontIntegrator {
         self.extra_bsdf_samples(scene, wave, samplers, stats);
         for (k, v) in wave.vertices.iter().enumerate() {
             let path = &mut wave.paths[v.lane];
+            let clamp = &self.path.clamp;
             if v.plan.light_samples > 0 {
-                path.radiance += path.beta * (wave.light_sums[k] * v.plan.light_scale);
+                path.add_vertex_light(wave.light_sums[k] * v.plan.light_scale, clamp);
             }
             if v.plan.extra_bsdf_samples > 0 {
-                path.radiance += path.beta * wave.extra_sums[k];
+                path.add_vertex_light(wave.extra_sums[k], clamp);
             }
         }
 
