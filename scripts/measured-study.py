@@ -2,20 +2,22 @@
 """The parameterization x representation study of the measured BSDF
 (docs/src/studies/measured.md, "Parameterization x representation").
 
-For each table (two tabulated lumis BSDFs, and every MERL `.binary` file in
---merl DIR), on scenes/measured-sphere.toml (64 x 64, direct lighting, BSDF
-sampling only):
+Each material is a lumis BSDF given to `measured` as its analytic source
+(`bsdf = ...`): the samplers and the tensors of every parameterization are
+fitted to the BSDF itself at their own cells and nodes, with no table in
+between, and the ground truth is the BSDF rendered with its own sampling.
+Every MERL `.binary` file of --merl DIR is added as a table source, its
+reference the table with tabulated half-diff sampling. On
+scenes/measured-sphere.toml (64 x 64, direct lighting, BSDF sampling only),
+for each material:
 
-1. `lumis brdf compress` in every parameterization at rank 2 and 8: the
-   error of the tensor against the table (and it fills the plugin's cache,
-   so the renders do not fit again);
-2. `lumis reference`: the table with tabulated half-diff sampling;
-3. `lumis converge` with scenes/variants/measured-representations.toml at
-   equal spp (--spp, 4 seeds) and at equal time (--time-budget, 2 seeds).
+1. `lumis reference` of the ground truth (--reference-spp, seed 0);
+2. `lumis converge` with scenes/variants/measured-representations.toml at
+   --spp over 4 seeds from 1000: relMSE, its split into bias² (what the
+   representation changes) and variance (what the sampling changes).
 
-It prints the Markdown table of the book and writes it (table.md), the
-converge outputs and the equal-time figures to --out; the references go to
-scenes/measured/ beside the tables (not committed). Run from the repository root:
+It writes each material's scene and converge output, and the Markdown table
+of the book (table.md), to --out. Run from the repository root:
 
     scripts/measured-study.py [--lumis target/release/lumis] [--merl DIR]
 """
@@ -23,46 +25,45 @@ scenes/measured/ beside the tables (not committed). Run from the repository root
 import argparse
 import json
 import os
-import re
 import shutil
 import subprocess
 import sys
 
 SCENE = "scenes/measured-sphere.toml"
 VARIANTS = "scenes/variants/measured-representations.toml"
-TABLES = [
-    ("conductor-0.05", "conductor", ["roughness=0.05", "material=Cu"]),
-    ("plastic-0.3", "plastic", ["roughness=0.3", "diffuse_reflectance=[0.6,0.3,0.1]"]),
+# Three families at two roughnesses each: name, lumis BSDF, its parameters.
+MATERIALS = [
+    ("conductor-0.05", "conductor", 'roughness = 0.05\nmaterial = "Cu"\n'),
+    ("conductor-0.2", "conductor", 'roughness = 0.2\nmaterial = "Cu"\n'),
+    ("plastic-0.05", "plastic", "roughness = 0.05\ndiffuse_reflectance = [0.6, 0.3, 0.1]\n"),
+    ("plastic-0.3", "plastic", "roughness = 0.3\ndiffuse_reflectance = [0.6, 0.3, 0.1]\n"),
+    ("blinn-1000", "blinn", "exponent = 1000.0\nreflectance = [0.9, 0.8, 0.6]\n"),
+    ("blinn-50", "blinn", "exponent = 50.0\nreflectance = [0.9, 0.8, 0.6]\n"),
 ]
 PARAMETERIZATIONS = ["in-out", "half-diff", "pdv"]
-RANKS = [2, 8]
+SEEDS = 4
 
 
 def run(cmd):
     print("+", " ".join(cmd), file=sys.stderr, flush=True)
-    out = subprocess.run(cmd, check=True, stdout=subprocess.PIPE, text=True).stdout
-    return out
+    return subprocess.run(cmd, check=True, stdout=subprocess.PIPE, text=True).stdout
 
 
-def compress(lumis, table, parameterization, rank):
-    out = run([lumis, "brdf", "compress", table, "--parameterization", parameterization,
-               "--rank", str(rank)])
-    rmse = float(re.search(r"relative RMSE of f ([0-9.eE+-]+)", out).group(1))
-    psnr = float(re.search(r"PSNR of ln\(1 \+ f\) ([0-9.eE+-]+) dB", out).group(1))
-    floats = int(re.search(r"tensor (\d+) floats", out).group(1))
-    return rmse, psnr, floats
-
-
-def converge(lumis, table, reference, out, extra, threads):
-    run([lumis, "converge", SCENE, "--reference", reference, "--variants", VARIANTS,
-         "--set", f"bsdf.sample.file={table}", "--first-seed", "1000",
-         "--threads", str(threads), "--out", out] + extra)
-    with open(os.path.join(out, "converge.json")) as f:
-        points = json.load(f)["points"]
-    last = {}
-    for p in points:
-        last[p["variant"]] = p  # the largest spp measured
-    return last
+def analytic_scene(name, bsdf, params):
+    """scenes/measured-sphere.toml with the sphere's `measured` BSDF fitted
+    to the analytic `bsdf` (declared before it, as a nested BSDF must be)."""
+    text = open(SCENE).read()
+    text = text[text.index("seed = "):]  # the scene's own comments are about its table
+    start = text.index('[[bsdf]]\nname = "analytic"')
+    end = text.index('[[bsdf]]\nname = "floor"')
+    text = text[:start] + text[end:]
+    analytic = f'[[bsdf]]\nname = "analytic"\ntype = "{bsdf}"\n{params}\n'
+    sample = text.index('[[bsdf]]\nname = "sample"')
+    text = text[:sample] + analytic + text[sample:]
+    table = 'file = "measured/conductor-0.05.binary"\n'
+    assert table in text
+    header = f"# {name}: the sphere's measured BSDF fitted to an analytic {bsdf}\n# (written by scripts/measured-study.py).\n"
+    return header + text.replace(table, 'bsdf = "analytic"\n')
 
 
 def main():
@@ -70,81 +71,68 @@ def main():
     ap.add_argument("--lumis", default="target/release/lumis")
     ap.add_argument("--merl", help="a directory of MERL .binary files to add")
     ap.add_argument("--out", default="docs/src/converge/measured-study")
-    ap.add_argument("--spp", type=int, default=64, help="equal-spp sample count")
-    ap.add_argument("--time-budget", default="0.2", help="equal-time budget per render, s")
-    ap.add_argument("--reference-spp", type=int, default=1024)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--reference-spp", type=int, default=4096)
     ap.add_argument("--threads", type=int, default=2)
     args = ap.parse_args()
     if not os.path.exists(args.lumis):
         run(["cargo", "build", "--release", "-p", "lumis-cli"])
     lumis = args.lumis
     os.makedirs(args.out, exist_ok=True)
-    os.makedirs("scenes/measured", exist_ok=True)
 
-    tables = []
-    for name, bsdf, sets in TABLES:
-        path = f"scenes/measured/{name}.binary"
-        if not os.path.exists(path):
-            cmd = [lumis, "brdf", "tabulate", "--bsdf", bsdf, "-o", path, "--quiet"]
-            for s in sets:
-                cmd += ["--set", s]
-            run(cmd)
-        tables.append((name, path))
-    # Absolute paths: a file given with --set is relative to the working
-    # directory for the plugin, but the reference's scene hash looks it up
-    # beside the scene.
-    tables = [(name, os.path.abspath(path)) for name, path in tables]
+    # (name, scene, overrides, overrides of the reference, what the source is)
+    sources = []
+    for name, bsdf, params in MATERIALS:
+        scene = os.path.join(args.out, f"{name}.toml")
+        with open(scene, "w") as f:
+            f.write(analytic_scene(name, bsdf, params))
+        sources.append((name, scene, [], ["--set", "shape.0.bsdf=analytic"], "analytic"))
     if args.merl:
         for file in sorted(os.listdir(args.merl)):
             if file.endswith(".binary"):
-                tables.append((file[: -len(".binary")], os.path.abspath(os.path.join(args.merl, file))))
+                table = os.path.abspath(os.path.join(args.merl, file))
+                sets = ["--set", f"bsdf.sample.file={table}"]
+                sources.append((file[: -len(".binary")], SCENE, sets,
+                                sets + ["--set", "bsdf.sample.sampling=tabulated"], "table"))
 
     rows = []
-    for name, path in tables:
-        errors = {(p, r): compress(lumis, path, p, r) for p in PARAMETERIZATIONS for r in RANKS}
-        reference = f"scenes/measured/{name}-reference.exr"  # not committed
-        run([lumis, "reference", SCENE, "--spp", str(args.reference_spp), "--pass-spp", "256",
-             "--set", f"bsdf.sample.file={path}", "--set", "bsdf.sample.sampling=tabulated",
-             "--threads", str(args.threads), "--force", "-o", reference])
-        spp_dir = os.path.join(args.out, f"{name}-equal-spp")
-        time_dir = os.path.join(args.out, f"{name}-equal-time")
-        equal_spp = converge(lumis, path, reference, spp_dir,
-                             ["--spp", str(args.spp), "--seeds", "4"], args.threads)
-        equal_time = converge(lumis, path, reference, time_dir,
-                              ["--time-budget", args.time_budget, "--seeds", "2"], args.threads)
-        for d in (spp_dir, time_dir):
-            shutil.rmtree(os.path.join(d, "renders"), ignore_errors=True)
-        # One point per variant at equal spp: its plots say nothing; at
-        # equal time, relMSE vs seconds is the figure of the book.
-        for plot in (os.path.join(spp_dir, "relmse-vs-spp.png"),
-                     os.path.join(spp_dir, "relmse-vs-seconds.png"),
-                     os.path.join(time_dir, "relmse-vs-spp.png")):
-            os.remove(plot)
-        for variant, s in equal_spp.items():
-            t = equal_time[variant]
-            words = variant.split(" ")
+    for name, scene, sets, reference_sets, kind in sources:
+        reference = os.path.join("scenes", "measured", f"{name}-reference.exr")  # not committed
+        os.makedirs(os.path.dirname(reference), exist_ok=True)
+        run([lumis, "reference", scene, "--spp", str(args.reference_spp), "--pass-spp", "512",
+             "--threads", str(args.threads), "--force", "-o", reference] + reference_sets)
+        out = os.path.join(args.out, name)
+        run([lumis, "converge", scene, "--reference", reference, "--variants", VARIANTS,
+             "--spp", str(args.spp), "--seeds", str(SEEDS), "--first-seed", "1000",
+             "--threads", str(args.threads), "--out", out] + sets)
+        shutil.rmtree(os.path.join(out, "renders"), ignore_errors=True)
+        # One point per variant: the plots say nothing.
+        for plot in ("relmse-vs-spp.png", "relmse-vs-seconds.png"):
+            os.remove(os.path.join(out, plot))
+        with open(os.path.join(out, "converge.json")) as f:
+            points = json.load(f)["points"]
+        for p in points:
+            words = p["variant"].split(" ")
             parameterization = words[0] if words[0] in PARAMETERIZATIONS else "-"
-            if "tensor" in variant:
-                rank = int(variant.split("R=")[1])
-                rmse, psnr, floats = errors[(parameterization, rank)]
-                compression = f"{rmse:.3f} / {psnr:.1f}"
-                size = f"{4 * floats / 1e3:.1f} KB"
+            what = " ".join(words[1:]) if parameterization != "-" else "source cosine"
+            what = what.replace("table", "source")
+            if "tensor" in what:
+                rank = int(what.split("R=")[1])
+                memory = f"{4 * 3 * rank * (90 + 90 + 180) / 1e3:.1f} KB"
             else:
-                compression, size = "0 (the table)", "17.5 MB"
-            representation = " ".join(words[1:]) if parameterization != "-" else "table cosine"
-            bias2 = s.get("rel_mse_split", {}).get("bias2")
-            bias2 = "-" if bias2 is None else f"{bias2:.1e}"
+                memory = "17.5 MB" if kind == "table" else "(analytic)"
+            split = p["rel_mse_split"]
             rows.append(
-                f"| {name} | {parameterization} | {representation} | {size} | {compression} "
-                f"| {s['psnr_db']:.2f} | {s['rel_mse']:.3e} | {bias2} "
-                f"| {t['psnr_db']:.2f} ({t['spp']} spp) | {s['efficiency']:.0f} |"
+                f"| {name} | {parameterization} | {what} | {memory} | {p['psnr_db']:.2f} "
+                f"| {p['rel_mse']:.3e} ± {p['rel_mse_se']:.1e} "
+                f"| {split['bias2']:.1e} ± {split['bias2_se']:.1e} "
+                f"| {split['variance']:.2e} | {p['efficiency']:.0f} |"
             )
     header = (
-        "| table | parameterization | representation, sampling | f memory "
-        "| compression: relRMSE of f / PSNR of ln(1+f) dB "
-        f"| PSNR dB at {args.spp} spp | relMSE at {args.spp} spp | its bias² "
-        f"| PSNR dB at {args.time_budget} s | efficiency 1/(relMSE s) |\n"
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+        "| material | parameterization | representation, sampling | f memory "
+        f"| PSNR dB at {args.spp} spp | relMSE ± se | bias² ± se | variance "
+        "| efficiency 1/(relMSE s) |\n"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
     )
     table = header + "\n".join(rows) + "\n"
     with open(os.path.join(args.out, "table.md"), "w") as f:

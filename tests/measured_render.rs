@@ -215,7 +215,7 @@ fn tabulate_refuses_what_the_format_cannot_hold() {
 /// its cache.
 fn prepare_cached(table: &MerlTable, file: &Path, plan: Plan) -> (Prepared, PrecomputeReport) {
     let reflectance = Reflectance::Table(Arc::new(table.clone()));
-    prepare(&reflectance, file, plan, GRID, true).unwrap()
+    prepare(&reflectance, Some(file), plan, GRID, true).unwrap()
 }
 
 #[test]

@@ -8,7 +8,9 @@
 //! behind). The same kit on the projected-deviation-vector (`pdv`)
 //! parameterization of the factored and tabulated strategies: the
 //! conductor-0.2 table in the default tier, every table and term count in
-//! an ignored sweep.
+//! an ignored sweep. And the kit on an analytic source (`bsdf`, the check
+//! kit's stand-in gold conductor) in every parameterization, its samplers
+//! and a tensor fitted to the BSDF itself.
 
 use lumis_check::bsdf_suite::{variant, Variant};
 use lumis_tests::{assert_measured_variants_pass, tabulated, MEASURED_MATERIALS as MATERIALS};
@@ -33,6 +35,30 @@ fn every_strategy_passes_the_check_kit_down_to_grazing() {
         }
         add(format!("{name} tabulated"), "sampling = \"tabulated\"\n");
     }
+    assert_measured_variants_pass(&variants, &dir);
+}
+
+/// With `bsdf` in place of a table, the samplers and the tensor are
+/// fitted to the analytic BSDF at their own cells and nodes, in every
+/// parameterization; they pass the same kit (the stand-in "gold" is GGX
+/// 0.2 gold).
+#[test]
+fn an_analytic_source_passes_the_check_kit_in_every_parameterization() {
+    let dir = std::env::temp_dir().join(format!("lumis-measured-analytic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut variants: Vec<Variant> = Vec::new();
+    for parameterization in ["half-diff", "pdv", "in-out"] {
+        for sampling in ["factored", "tabulated"] {
+            let toml = format!(
+                "bsdf = \"gold\"\nparameterization = \"{parameterization}\"\nsampling = \"{sampling}\"\n"
+            );
+            let label = format!("gold {parameterization} {sampling}");
+            variants.push(variant(label, &toml).unwrap());
+        }
+    }
+    let tensor =
+        "bsdf = \"gold\"\nparameterization = \"pdv\"\nrepresentation = \"tensor\"\nrank = 2\n";
+    variants.push(variant("gold pdv tensor R=2", tensor).unwrap());
     assert_measured_variants_pass(&variants, &dir);
 }
 

@@ -5,12 +5,19 @@
 //! albedo <= 1, reciprocity, finiteness) in the default case, and, ignored,
 //! over every table and parameterization at rank 8 and 16.
 
+use std::sync::Arc;
+
 use lumis_check::bsdf_suite::{variant, Variant};
+use lumis_core::params::NestedBsdf;
+use lumis_core::texture::BsdfScope;
+use lumis_core::{Bsdf, BsdfContext, Location, PluginEntity, PluginKind};
 use lumis_measured::compress::prepare_tensor;
 use lumis_measured::cp::AlsSettings;
 use lumis_measured::grid::Parameterization;
 use lumis_measured::merl::MerlTable;
-use lumis_measured::tensor::{compression_error, fit};
+use lumis_measured::merl::SAMPLES;
+use lumis_measured::reflectance::Reflectance;
+use lumis_measured::tensor::{compression_error, fit, log_samples, node_pair, to_log, DIMS};
 use lumis_tests::{assert_measured_variants_pass, tabulated, MEASURED_MATERIALS as MATERIALS};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
@@ -27,6 +34,7 @@ fn the_error_falls_with_the_rank_on_a_tabulated_conductor() {
     let dir = temp_dir("rank");
     let file = tabulated(&dir, "gold", "conductor", &["roughness=0.2", "material=Au"]);
     let table = MerlTable::read(&file).unwrap();
+    let source = Reflectance::Table(Arc::new(table.clone()));
     // Few sweeps: the test is about the ordering, not the last digit.
     let settings = AlsSettings {
         max_sweeps: 12,
@@ -34,7 +42,7 @@ fn the_error_falls_with_the_rank_on_a_tabulated_conductor() {
     };
     let mut errors = Vec::new();
     for rank in [1, 2, 4] {
-        let (tensor, fits) = fit(&table, Parameterization::HalfDiff, rank, settings, &|| {});
+        let (tensor, fits) = fit(&source, Parameterization::HalfDiff, rank, settings, &|| {});
         let residual: f64 = fits.iter().map(|f| f.residual).sum();
         let error = compression_error(&table, &|wi, wo| tensor.eval(wi, wo));
         errors.push((rank, residual, error));
@@ -62,12 +70,12 @@ fn the_error_falls_with_the_rank_on_a_tabulated_conductor() {
 fn the_tensor_representation_passes_the_check_kit_and_is_cached() {
     let dir = temp_dir("check");
     let file = tabulated(&dir, "gold", "conductor", &["roughness=0.2", "material=Au"]);
-    let table = MerlTable::read(&file).unwrap();
+    let source = Reflectance::Table(Arc::new(MerlTable::read(&file).unwrap()));
     let (first, report) =
-        prepare_tensor(&table, &file, Parameterization::HalfDiff, 4, true).unwrap();
+        prepare_tensor(&source, Some(&file), Parameterization::HalfDiff, 4, true).unwrap();
     assert!(report.fits.is_some(), "{}", report.message);
     let (second, report) =
-        prepare_tensor(&table, &file, Parameterization::HalfDiff, 4, true).unwrap();
+        prepare_tensor(&source, Some(&file), Parameterization::HalfDiff, 4, true).unwrap();
     assert!(
         report.fits.is_none() && report.message.contains("loaded from"),
         "{}",
@@ -104,4 +112,54 @@ fn the_tensor_representation_passes_the_check_kit_everywhere() {
         }
     }
     assert_measured_variants_pass(&variants, &dir);
+}
+
+/// An analytic source is evaluated at each parameterization's own nodes:
+/// what its tensor is fitted to is the BSDF's value at the node's pair of
+/// directions, exactly, where a table's would be its interpolation.
+#[test]
+fn an_analytic_source_is_fitted_at_its_own_nodes() {
+    let registry = lumis_app::builtin_registry().unwrap();
+    let table = lumis_core::doc::parse("material = \"Cu\"\nroughness = 0.1\n", "<test>").unwrap();
+    let entity = PluginEntity::new(
+        PluginKind::Bsdf,
+        "bsdf \"copper\"",
+        "conductor",
+        table,
+        Location::Builtin,
+    );
+    let bsdf = registry
+        .create::<dyn Bsdf>(&entity, BsdfScope::EMPTY)
+        .unwrap();
+    let source = Reflectance::Analytic(NestedBsdf(bsdf.clone()));
+    for parameterization in [
+        Parameterization::HalfDiff,
+        Parameterization::Pdv,
+        Parameterization::InOut,
+    ] {
+        let (values, known) = log_samples(&source, parameterization);
+        let mut pairs = 0;
+        for n in (0..SAMPLES).step_by(997) {
+            let (a, b, c) = (
+                n / (DIMS[1] * DIMS[2]),
+                (n / DIMS[2]) % DIMS[1],
+                n % DIMS[2],
+            );
+            let Some((wo, wi)) = node_pair(parameterization, a, b, c) else {
+                assert!(!known[0][n], "{parameterization:?} node {n} has no pair");
+                continue;
+            };
+            let f = bsdf.f(&BsdfContext::default(), wo, wi);
+            for (channel, f) in [f.r, f.g, f.b].into_iter().enumerate() {
+                assert!(known[channel][n]);
+                assert_eq!(
+                    values[channel][n],
+                    to_log(f),
+                    "{parameterization:?} node {n}"
+                );
+            }
+            pairs += 1;
+        }
+        assert!(pairs > 800, "{parameterization:?}: {pairs} nodes checked");
+    }
 }

@@ -147,10 +147,11 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
         }
     };
     let table = MerlTable::read(&args.table)?;
+    let table_hash = table.hash();
     let reflectance = Reflectance::Table(std::sync::Arc::new(table));
     // Remove the cache first so that the time is the computation's.
     let cache = lumis_measured::cache::CacheKey {
-        table_hash: reflectance.hash(),
+        table_hash,
         strategy: match plan {
             Plan::Factored { .. } => "factored",
             Plan::Tabulated => "tabulated",
@@ -163,7 +164,7 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
     }
     .path(&args.table);
     let _ = std::fs::remove_file(&cache);
-    let (_, report) = prepare(&reflectance, &args.table, plan, grid, true)?;
+    let (_, report) = prepare(&reflectance, Some(&args.table), plan, grid, true)?;
     Ok(report.message)
 }
 
@@ -176,10 +177,17 @@ pub fn compress_table(args: &CompressArgs) -> Result<String> {
             args.rank
         )));
     }
-    let table = MerlTable::read(&args.table)?;
+    let table = std::sync::Arc::new(MerlTable::read(&args.table)?);
     // Through the plugin's cache: a render with the same settings then
     // loads these factors instead of fitting them again.
-    let (tensor, report) = prepare_tensor(&table, &args.table, parameterization, args.rank, true)?;
+    let source = Reflectance::Table(table.clone());
+    let (tensor, report) = prepare_tensor(
+        &source,
+        Some(&args.table),
+        parameterization,
+        args.rank,
+        true,
+    )?;
     let error = compression_error(&table, &|wi, wo| tensor.eval(wi, wo));
     let (table_floats, tensor_floats) = (3 * SAMPLES, tensor.payload().len());
     let mut out = format!(
@@ -205,7 +213,7 @@ pub fn compress_table(args: &CompressArgs) -> Result<String> {
     if let Some(output) = &args.output {
         cache::store(
             output,
-            &cache_key(&table, parameterization, args.rank),
+            &cache_key(table.hash(), parameterization, args.rank),
             &tensor.payload(),
         )?;
         out += &format!("\nfactors written to {}", output.display());

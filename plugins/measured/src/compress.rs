@@ -1,6 +1,8 @@
 //! Fits (or loads from the cache) the tensor approximation of a table, once
 //! per table, parameterization and rank, as [`crate::precompute`] does for
 //! the samplers: `TABLE.tensor-LR-90x90x180s0[-pdv|-in-out].lumis-cache`.
+//! An analytic source has no file to cache next to: its tensor is fitted
+//! every time.
 
 use std::path::Path;
 use std::time::Instant;
@@ -11,14 +13,16 @@ use lumis_api::{Error, ParamChoice, Result};
 use crate::cache::{self, CacheKey};
 use crate::cp::{AlsReport, AlsSettings};
 use crate::grid::{Grid, Parameterization};
-use crate::merl::MerlTable;
+use crate::precompute::source_name;
+use crate::reflectance::Reflectance;
 use crate::tensor::{fit, TensorBrdf, DIMS};
 
-/// The cache key of the tensor of `table` (the grid records the tensor's
-/// dimensions and parameterization; `supersamples` is unused).
-pub fn cache_key(table: &MerlTable, parameterization: Parameterization, rank: usize) -> CacheKey {
+/// The cache key of the tensor of the table with content hash
+/// `table_hash` (the grid records the tensor's dimensions and
+/// parameterization; `supersamples` is unused).
+pub fn cache_key(table_hash: u64, parameterization: Parameterization, rank: usize) -> CacheKey {
     CacheKey {
-        table_hash: table.hash(),
+        table_hash,
         strategy: "tensor",
         terms: rank,
         grid: Grid {
@@ -42,16 +46,16 @@ pub struct CompressReport {
     pub message: String,
 }
 
-/// Fits `rank` terms per channel to `table`, behind a progress bar.
+/// Fits `rank` terms per channel to `source` (named `name`), behind a
+/// progress bar.
 fn fit_with_progress(
-    table: &MerlTable,
-    table_path: &Path,
+    source: &Reflectance,
+    name: &str,
     parameterization: Parameterization,
     rank: usize,
 ) -> (TensorBrdf, [AlsReport; 3], f64) {
     let progress = ProgressBar::new(3).with_message(format!(
-        "rank-{rank} tensor of {} ({})",
-        table_path.display(),
+        "rank-{rank} tensor of {name} ({})",
         parameterization.name()
     ));
     if let Ok(style) =
@@ -61,7 +65,7 @@ fn fit_with_progress(
     }
     let start = Instant::now();
     let (tensor, fits) = fit(
-        table,
+        source,
         parameterization,
         rank,
         AlsSettings::default(),
@@ -71,28 +75,33 @@ fn fit_with_progress(
     (tensor, fits, start.elapsed().as_secs_f64())
 }
 
-/// The tensor of `table`, from the cache next to `table_path` if it holds
-/// it, else fitted (and cached when `use_cache`).
+/// The tensor of `source` (a table, or an analytic BSDF), from the cache
+/// next to `table_path` if it holds it, else fitted (and cached when
+/// `use_cache` and there is a table file).
 pub fn prepare_tensor(
-    table: &MerlTable,
-    table_path: &Path,
+    source: &Reflectance,
+    table_path: Option<&Path>,
     parameterization: Parameterization,
     rank: usize,
     use_cache: bool,
 ) -> Result<(TensorBrdf, CompressReport)> {
-    let key = cache_key(table, parameterization, rank);
-    let path = key.path(table_path);
-    let count = TensorBrdf::payload_len(rank);
+    let name = source_name(table_path);
     let label = format!("rank-{rank} tensor ({})", parameterization.name());
+    let cache = match (use_cache, table_path, source.cache_hash()) {
+        (true, Some(table_path), Some(hash)) => {
+            let key = cache_key(hash, parameterization, rank);
+            Some((key.path(table_path), key))
+        }
+        _ => None,
+    };
     let mut note = String::new();
-    if use_cache {
-        match cache::load(&path, &key, count) {
+    if let Some((path, key)) = &cache {
+        match cache::load(path, key, TensorBrdf::payload_len(rank)) {
             Ok(data) => {
                 let tensor = TensorBrdf::from_payload(parameterization, rank, &data)
                     .ok_or_else(|| Error::msg(format!("{}: bad tensor payload", path.display())))?;
                 let message = format!(
-                    "{}: {label} loaded from {} ({} KiB)",
-                    table_path.display(),
+                    "{name}: {label} loaded from {} ({} KiB)",
                     path.display(),
                     tensor.memory_bytes() / 1024
                 );
@@ -105,12 +114,12 @@ pub fn prepare_tensor(
                     },
                 ));
             }
-            Err(miss) => note = miss.note(&path),
+            Err(miss) => note = miss.note(path),
         }
     }
-    let (tensor, fits, seconds) = fit_with_progress(table, table_path, parameterization, rank);
-    if use_cache {
-        match cache::store(&path, &key, &tensor.payload()) {
+    let (tensor, fits, seconds) = fit_with_progress(source, &name, parameterization, rank);
+    if let Some((path, key)) = &cache {
+        match cache::store(path, key, &tensor.payload()) {
             Ok(()) => note.push_str(&format!(", cached in {}", path.display())),
             Err(e) => note.push_str(&format!(" (not cached: {e})")),
         }
@@ -120,8 +129,7 @@ pub fn prepare_tensor(
         .map(AlsReport::relative_error)
         .fold(0.0, f64::max);
     let message = format!(
-        "{}: {label} fitted in {seconds:.2} s ({} sweeps, relative error of ln(1 + f) {error:.2e} at most per channel), {} KiB{note}",
-        table_path.display(),
+        "{name}: {label} fitted in {seconds:.2} s ({} sweeps, relative error of ln(1 + f) {error:.2e} at most per channel), {} KiB{note}",
         fits.iter().map(|f| f.sweeps).max().unwrap_or(0),
         tensor.memory_bytes() / 1024
     );

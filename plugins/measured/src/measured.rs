@@ -5,13 +5,16 @@
 //! The table (Matusik et al. 2003) runs over Rusinkiewicz's half/difference
 //! angles `(theta_h, theta_d, phi_d)` and is looked up trilinearly.
 //! `sampling = "factored"` is the factored representation of Lawrence,
-//! Rusinkiewicz and Ramamoorthi 2004. One-sided: black from behind.
+//! Rusinkiewicz and Ramamoorthi 2004. One-sided: black from behind. With
+//! `bsdf` in place of `file`, an analytic BSDF is the source: the samplers
+//! and the tensor are fitted to it directly, at their own nodes.
 //! [Measured BRDFs](studies/measured.md) has the format, the
 //! representations and what each sampling strategy buys.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use lumis_api::params::NestedBsdf;
 use lumis_api::{
     Bsdf, BsdfContext, BsdfFlags, BsdfSample, ParamChoice, Params, PluginKind, PluginParams,
     PluginSpec, Result, Rgb, Vec2, Vec3,
@@ -23,20 +26,28 @@ use crate::grid::{Grid, Parameterization};
 use crate::merl::MerlTable;
 use crate::precompute::{prepare, Plan, PrecomputeReport, Prepared};
 use crate::reflectance::Reflectance;
+use crate::tabulate::check_representable;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
     source: lumis_api::source_file!(),
-    doc: "isotropic BRDF tabulated in the MERL format (trilinear f, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
+    doc: "isotropic BRDF tabulated in the MERL format, or an analytic BSDF fitted directly (f itself, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
     params: MeasuredParams::SPECS,
 };
 
 #[derive(Debug, Clone, PluginParams)]
 pub struct MeasuredParams {
     /// MERL .binary table, relative to the scene file (make one with `lumis
-    /// brdf tabulate`)
-    pub file: PathBuf,
+    /// brdf tabulate`); or give bsdf instead
+    pub file: Option<PathBuf>,
+    /// instead of a table: the name of an isotropic, reflecting lumis BSDF
+    /// declared before this one, which the samplers and the tensor are
+    /// fitted to at their own nodes, and which representation = "table"
+    /// renders as it is (a known ground truth for comparing
+    /// parameterizations); evaluated with a default context, so textures do
+    /// not vary over the surface; never cached
+    pub bsdf: Option<NestedBsdf>,
     /// cosine (the baseline), factored (L separable terms in half-vector
     /// coordinates), tabulated (a 2D table per outgoing elevation, the
     /// memory-hungry reference)
@@ -55,9 +66,10 @@ pub struct MeasuredParams {
     /// part of wi + wo) or in-out (wi itself)
     #[param(default = HalfDiff)]
     pub parameterization: Parameterization,
-    /// what f is rendered from: table (the MERL table, trilinear) or tensor
-    /// (rank terms of products of 1D factors per channel, fitted to ln(1 +
-    /// f); the sampling is built from it)
+    /// what f is rendered from: table (the source itself: the MERL table,
+    /// trilinear, or the analytic bsdf) or tensor (rank terms of products
+    /// of 1D factors per channel, fitted to ln(1 + f); the sampling is
+    /// built from it)
     #[param(default = Table)]
     pub representation: MeasuredRepresentation,
     /// R, the rank-1 terms per colour channel of the tensor (tensor only)
@@ -174,27 +186,42 @@ impl Measured {
             )),
             None => None,
         };
-        let table = MerlTable::read(&p.file).map_err(|e| params.error(keys.file, e))?;
+        let source = match (&p.file, p.bsdf) {
+            (Some(file), None) => Reflectance::Table(Arc::new(
+                MerlTable::read(file).map_err(|e| params.error(keys.file, e))?,
+            )),
+            (None, Some(bsdf)) => {
+                check_representable(bsdf.0.as_ref(), "the bsdf")
+                    .map_err(|e| params.error(keys.bsdf, e))?;
+                params.unread(keys.cache);
+                Reflectance::Analytic(bsdf)
+            }
+            (Some(_), Some(_)) => {
+                return Err(params.error(keys.bsdf, "give a table file or a bsdf, not both"))
+            }
+            (None, None) => {
+                return Err(params.error(
+                    keys.file,
+                    "missing: give a MERL table file (or an analytic bsdf)",
+                ))
+            }
+        };
+        let file = p.file.as_deref();
         let mut messages = Vec::new();
         let reflectance = if tensor {
-            let (tensor, report) = prepare_tensor(
-                &table,
-                &p.file,
-                p.parameterization,
-                p.rank as usize,
-                p.cache,
-            )?;
+            let (tensor, report) =
+                prepare_tensor(&source, file, p.parameterization, p.rank as usize, p.cache)?;
             messages.push(report.message);
-            // The table is not needed any more: renders use the factors.
+            // The source is not needed any more: renders use the factors.
             Reflectance::Tensor(Arc::new(tensor))
         } else {
-            Reflectance::Table(Arc::new(table))
+            source
         };
         let Some((plan, grid, use_cache)) = setup else {
             return Ok((Self::cosine(reflectance), messages));
         };
         let (prepared, report): (Prepared, PrecomputeReport) =
-            prepare(&reflectance, &p.file, plan, grid, use_cache)?;
+            prepare(&reflectance, file, plan, grid, use_cache)?;
         messages.push(report.message);
         Ok((Self::with_sampler(reflectance, prepared), messages))
     }

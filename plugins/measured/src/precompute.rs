@@ -116,35 +116,40 @@ pub fn compute(
 }
 
 /// The sampler for `plan`, from the cache next to `table_path` if it holds
-/// this source's, else computed (and cached when `use_cache`).
+/// this source's, else computed (and cached when `use_cache`). Without a
+/// table file (an analytic source) it is computed every time.
 pub fn prepare(
     reflectance: &Reflectance,
-    table_path: &Path,
+    table_path: Option<&Path>,
     plan: Plan,
     grid: Grid,
     use_cache: bool,
 ) -> Result<(Prepared, PrecomputeReport)> {
-    let key = CacheKey {
-        table_hash: reflectance.hash(),
-        strategy: plan.name(),
-        terms: plan.terms(),
-        grid,
-    };
-    let path = key.path(table_path);
-    let count = plan.count(&grid);
+    let name = source_name(table_path);
     let label = match plan {
         Plan::Factored { terms } => format!("factored L = {terms}"),
         Plan::Tabulated => "tabulated".to_string(),
     };
+    let cache = match (use_cache, table_path, reflectance.cache_hash()) {
+        (true, Some(table_path), Some(table_hash)) => {
+            let key = CacheKey {
+                table_hash,
+                strategy: plan.name(),
+                terms: plan.terms(),
+                grid,
+            };
+            Some((key.path(table_path), key))
+        }
+        _ => None,
+    };
     let mut note = String::new();
-    if use_cache {
-        match cache::load(&path, &key, count) {
+    if let Some((path, key)) = &cache {
+        match cache::load(path, key, plan.count(&grid)) {
             Ok(data) => {
                 let prepared = from_payload(plan, grid, &data);
                 let memory_bytes = prepared.memory_bytes();
                 let message = format!(
-                    "{}: {label} sampling loaded from {} ({} KiB)",
-                    table_path.display(),
+                    "{name}: {label} sampling loaded from {} ({} KiB)",
                     path.display(),
                     memory_bytes / 1024
                 );
@@ -158,7 +163,7 @@ pub fn prepare(
                     },
                 ));
             }
-            Err(miss) => note = miss.note(&path),
+            Err(miss) => note = miss.note(path),
         }
     }
     let total = grid.n_o as u64
@@ -166,8 +171,7 @@ pub fn prepare(
             Plan::Factored { .. } => (NMF_ITERATIONS + REFINE_ITERATIONS) as u64,
             Plan::Tabulated => 0,
         };
-    let progress = ProgressBar::new(total)
-        .with_message(format!("{label} sampling of {}", table_path.display()));
+    let progress = ProgressBar::new(total).with_message(format!("{label} sampling of {name}"));
     if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {elapsed}") {
         progress.set_style(style.progress_chars("=> "));
     }
@@ -175,8 +179,8 @@ pub fn prepare(
     let data = compute(&|wo, wi| reflectance.eval(wi, wo), plan, grid, &progress);
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
-    if use_cache {
-        if let Err(e) = cache::store(&path, &key, &data) {
+    if let Some((path, key)) = &cache {
+        if let Err(e) = cache::store(path, key, &data) {
             note.push_str(&format!(" (not cached: {e})"));
         } else {
             note.push_str(&format!(", cached in {}", path.display()));
@@ -185,8 +189,7 @@ pub fn prepare(
     let prepared = from_payload(plan, grid, &data);
     let memory_bytes = prepared.memory_bytes();
     let message = format!(
-        "{}: {label} sampling on a {} x {} x {} grid precomputed in {seconds:.2} s, {} KiB{note}",
-        table_path.display(),
+        "{name}: {label} sampling on a {} x {} x {} grid precomputed in {seconds:.2} s, {} KiB{note}",
         grid.n_o,
         grid.n_w,
         grid.n_phi,
@@ -201,4 +204,9 @@ pub fn prepare(
             message,
         },
     ))
+}
+
+/// What the messages call a source: its table file, or the analytic BSDF.
+pub fn source_name(table_path: Option<&Path>) -> String {
+    table_path.map_or("the analytic BSDF".to_string(), |p| p.display().to_string())
 }

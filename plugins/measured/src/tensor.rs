@@ -50,6 +50,7 @@ use crate::grid::{Grid, Parameterization};
 use crate::merl::{
     clamped_axis, node_directions, MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES,
 };
+use crate::reflectance::Reflectance;
 
 /// Nodes per axis, in every parameterization (the MERL table's).
 pub const DIMS: [usize; 3] = [THETA_H_RES, THETA_D_RES, PHI_D_RES];
@@ -316,12 +317,14 @@ pub fn node_pair(
     (wo.z > 0.0 && wi.z > 0.0).then_some((wo, wi))
 }
 
-/// `ln(1 + f)` of `table` at the nodes of `parameterization`, per channel,
-/// and which nodes are known: the MERL nodes for half-diff (an invalid
-/// sample is missing), else the table's interpolation at the node's pair
-/// (a node with no pair is missing).
+/// `ln(1 + f)` of `source` at the nodes of `parameterization`, per
+/// channel, and which nodes are known. A table in half-diff gives its own
+/// MERL nodes (an invalid sample is missing); otherwise each node's pair
+/// is evaluated (a node with no pair is missing): a table through its
+/// interpolation, an analytic BSDF exactly, at the parameterization's own
+/// nodes.
 pub fn log_samples(
-    table: &MerlTable,
+    source: &Reflectance,
     parameterization: Parameterization,
 ) -> ([Vec<f64>; 3], [Vec<bool>; 3]) {
     let nodes: Vec<[Option<f32>; 3]> = (0..SAMPLES)
@@ -332,11 +335,11 @@ pub fn log_samples(
                 (n / DIMS[2]) % DIMS[1],
                 n % DIMS[2],
             );
-            match parameterization {
-                Parameterization::HalfDiff => table.node(a, b, c),
+            match (source, parameterization) {
+                (Reflectance::Table(table), Parameterization::HalfDiff) => table.node(a, b, c),
                 _ => match node_pair(parameterization, a, b, c) {
                     Some((wo, wi)) => {
-                        let f = table.eval(wi, wo);
+                        let f = source.eval(wi, wo);
                         [Some(f.r), Some(f.g), Some(f.b)]
                     }
                     None => [None; 3],
@@ -349,16 +352,16 @@ pub fn log_samples(
     (values, known)
 }
 
-/// Fits `rank` terms per channel to `table` in `parameterization`; calls
+/// Fits `rank` terms per channel to `source` in `parameterization`; calls
 /// `tick` after each channel.
 pub fn fit(
-    table: &MerlTable,
+    source: &Reflectance,
     parameterization: Parameterization,
     rank: usize,
     settings: AlsSettings,
     tick: &(dyn Fn() + Sync),
 ) -> (TensorBrdf, [AlsReport; 3]) {
-    let (values, known) = log_samples(table, parameterization);
+    let (values, known) = log_samples(source, parameterization);
     let fits: Vec<(Cp, AlsReport)> = (0..3)
         .map(|c| {
             let fit = Cp::fit(&values[c], Some(&known[c]), DIMS, rank, settings);
