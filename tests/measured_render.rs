@@ -299,6 +299,51 @@ fn scene_errors_name_the_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// An analytic source (`bsdf`) must be declared before, must be
+/// representable, and excludes a table file; each mistake is named.
+#[test]
+fn analytic_source_errors_name_the_key() {
+    let registry = lumis_app::builtin_registry().unwrap();
+    let table = "file = \"measured/conductor-0.05.binary\"\n";
+    let text = read_scene("measured-sphere.toml");
+    assert!(
+        text.contains(table),
+        "scenes/measured-sphere.toml changed its table"
+    );
+    // The sphere's BSDF with `keys` in place of its table, after a BSDF
+    // "source" of `source`.
+    let load = |keys: &str, source: &str| {
+        let text = text.replace(table, keys);
+        let sample = "[[bsdf]]\nname = \"sample\"\n";
+        let declared = format!("[[bsdf]]\nname = \"source\"\n{source}\n{sample}");
+        let text = text.replace(sample, &declared);
+        lumis_scene::load_str(&text, &scenes_dir().join("s.toml"), &[], &registry)
+            .err()
+            .map(|e| e.to_string())
+    };
+    let gold = "type = \"conductor\"\nroughness = 0.2\nmaterial = \"Au\"\n";
+    assert_eq!(
+        load("bsdf = \"source\"\n", gold),
+        None,
+        "an analytic source loads"
+    );
+    let both = load(&format!("{table}bsdf = \"source\"\n"), gold).unwrap();
+    assert!(
+        both.contains("'bsdf'") && both.contains("not both"),
+        "{both}"
+    );
+    let neither = load("", gold).unwrap();
+    assert!(
+        neither.contains("'file'") && neither.contains("analytic bsdf"),
+        "{neither}"
+    );
+    let glass = load("bsdf = \"source\"\n", "type = \"dielectric\"\n").unwrap();
+    assert!(
+        glass.contains("'bsdf'") && glass.contains("transmits"),
+        "{glass}"
+    );
+}
+
 /// One row of the results table.
 struct Row {
     strategy: String,
