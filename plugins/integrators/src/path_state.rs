@@ -28,9 +28,13 @@ impl BounceClamp {
     };
 
     /// `contribution`, light that reached the camera over `segments`
-    /// segments, capped.
+    /// segments, capped. Without caps (the default) it is one predictable
+    /// branch: the unclamped path tracer keeps its instruction count.
     #[inline]
     pub fn apply(&self, contribution: Rgb, segments: u32) -> Rgb {
+        if *self == Self::NONE {
+            return contribution;
+        }
         match segments {
             0 | 1 => contribution,
             2 => contribution.clamp_max_component(self.direct),
