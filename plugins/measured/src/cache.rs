@@ -20,6 +20,24 @@ const MAGIC: &[u8; 8] = b"LUMISMSC";
 const VERSION: u32 = 1;
 const HEADER_BYTES: usize = 8 + 4 + 8 + 4 * 7 + 8;
 
+/// Where a source's precomputation is cached and the key its file must
+/// match: beside its table file, when the caller caches and the source has
+/// a table to hash (`table_hash`); an analytic source has none.
+pub fn slot(
+    use_cache: bool,
+    table_path: Option<&Path>,
+    table_hash: Option<u64>,
+    key: impl FnOnce(u64) -> CacheKey,
+) -> Option<(PathBuf, CacheKey)> {
+    match (use_cache, table_path, table_hash) {
+        (true, Some(table_path), Some(hash)) => {
+            let key = key(hash);
+            Some((key.path(table_path), key))
+        }
+        _ => None,
+    }
+}
+
 /// What a cache file holds and must match.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CacheKey {

@@ -87,13 +87,9 @@ pub fn prepare_tensor(
 ) -> Result<(TensorBrdf, CompressReport)> {
     let name = source_name(table_path);
     let label = format!("rank-{rank} tensor ({})", parameterization.name());
-    let cache = match (use_cache, table_path, source.cache_hash()) {
-        (true, Some(table_path), Some(hash)) => {
-            let key = cache_key(hash, parameterization, rank);
-            Some((key.path(table_path), key))
-        }
-        _ => None,
-    };
+    let cache = cache::slot(use_cache, table_path, source.cache_hash(), |hash| {
+        cache_key(hash, parameterization, rank)
+    });
     let mut note = String::new();
     if let Some((path, key)) = &cache {
         match cache::load(path, key, TensorBrdf::payload_len(rank)) {

@@ -130,18 +130,17 @@ pub fn prepare(
         Plan::Factored { terms } => format!("factored L = {terms}"),
         Plan::Tabulated => "tabulated".to_string(),
     };
-    let cache = match (use_cache, table_path, reflectance.cache_hash()) {
-        (true, Some(table_path), Some(table_hash)) => {
-            let key = CacheKey {
-                table_hash,
-                strategy: plan.name(),
-                terms: plan.terms(),
-                grid,
-            };
-            Some((key.path(table_path), key))
-        }
-        _ => None,
-    };
+    let cache = cache::slot(
+        use_cache,
+        table_path,
+        reflectance.cache_hash(),
+        |table_hash| CacheKey {
+            table_hash,
+            strategy: plan.name(),
+            terms: plan.terms(),
+            grid,
+        },
+    );
     let mut note = String::new();
     if let Some((path, key)) = &cache {
         match cache::load(path, key, plan.count(&grid)) {
