@@ -9,6 +9,7 @@
 //!    The same holds inside a sphere light whose normals face inward: the
 //!    camera is inside the light, which is sampled from inside it.
 
+use lumis_check::integrator_suite::CUBE_FACES;
 use lumis_tests::{bonferroni_z, mean_and_se, render_toml};
 
 /// The integrators that trace paths: the scalar one, the wavefront and the
@@ -120,19 +121,11 @@ reflectance = {albedo}
 /// Six outward-facing quads flipped to face the inside of [-s, s]^3,
 /// offset by `shift` (to put the box far from the origin).
 fn emissive_cube(albedo: f64, max_depth: u32, scale: f64, shift: f64) -> String {
-    let faces = [
-        ([1, -1, -1], [0, 2, 0], [0, 0, 2]),
-        ([-1, -1, -1], [0, 0, 2], [0, 2, 0]),
-        ([-1, 1, -1], [0, 0, 2], [2, 0, 0]),
-        ([-1, -1, -1], [2, 0, 0], [0, 0, 2]),
-        ([-1, -1, 1], [2, 0, 0], [0, 2, 0]),
-        ([-1, -1, -1], [0, 2, 0], [2, 0, 0]),
-    ];
     let at = |x: f64, y: f64, z: f64| [shift + x * scale, shift + y * scale, shift + z * scale];
     let mut toml = inside_closed_emitter(at(0.1, -0.2, 0.05), at(0.3, 0.1, 1.0), albedo, max_depth);
     let point = |a: [i32; 3]| format!("{:?}", a.map(|c| shift + c as f64 * scale));
     let edge = |a: [i32; 3]| format!("{:?}", a.map(|c| c as f64 * scale));
-    for (corner, u, w) in faces {
+    for (corner, u, w) in CUBE_FACES {
         toml += &format!(
             "[[shape]]\ntype = \"quad\"\ncorner = {}\nedge_u = {}\nedge_v = {}\n{INWARD_EMITTER}",
             point(corner),

@@ -518,9 +518,10 @@ fn furnace_scene(cfg: &IntegratorCheckConfig) -> String {
     )
 }
 
-/// The inward faces of [-1, 1]^3: corner, two edges (outward normal
-/// `u x v`, flipped in the scene).
-const CUBE_FACES: [([i32; 3], [i32; 3], [i32; 3]); 6] = [
+/// The faces of [-1, 1]^3 as quads: corner, two edges, outward normal
+/// `u x v` (a closed scene flips them to face inward). The furnace tests
+/// build their emitting box from the same list.
+pub const CUBE_FACES: [([i32; 3], [i32; 3], [i32; 3]); 6] = [
     ([1, -1, -1], [0, 2, 0], [0, 0, 2]),
     ([-1, -1, -1], [0, 0, 2], [0, 2, 0]),
     ([-1, 1, -1], [0, 0, 2], [2, 0, 0]),
