@@ -23,6 +23,7 @@ use lumis_measured::grid::{Grid, Parameterization};
 use lumis_measured::merl::MerlTable;
 use lumis_measured::precompute::{prepare, Plan, PrecomputeReport, Prepared};
 use lumis_measured::reflectance::Reflectance;
+use lumis_measured::tensor::node_grid;
 use lumis_sampling::Pcg32;
 use lumis_tests::{read_scene, render_toml_with, scenes_dir, tabulated};
 
@@ -214,8 +215,18 @@ fn tabulate_refuses_what_the_format_cannot_hold() {
 /// The precomputation of `plan` for `table` (written at `file`), through
 /// its cache.
 fn prepare_cached(table: &MerlTable, file: &Path, plan: Plan) -> (Prepared, PrecomputeReport) {
+    prepare_on(table, file, plan, GRID)
+}
+
+/// [`prepare_cached`] on `grid`.
+fn prepare_on(
+    table: &MerlTable,
+    file: &Path,
+    plan: Plan,
+    grid: Grid,
+) -> (Prepared, PrecomputeReport) {
     let reflectance = Reflectance::Table(Arc::new(table.clone()));
-    prepare(&reflectance, Some(file), plan, GRID, true).unwrap()
+    prepare(&reflectance, Some(file), plan, grid, true).unwrap()
 }
 
 #[test]
@@ -354,6 +365,10 @@ struct Row {
     memory: usize,
 }
 
+/// A row's label, its scene overrides, and what it precomputes on which
+/// grid.
+type Strategy = (String, Vec<String>, Option<(Plan, Grid)>);
+
 const SPP: u32 = 64;
 const SEEDS: u64 = 8;
 const REFERENCE_SPP: u32 = 4096;
@@ -368,6 +383,7 @@ fn measured_results_table() {
     ));
     out.push_str("| material | strategy | relMSE | PSNR dB | render s | precompute s | sampler memory |\n| --- | --- | --- | --- | --- | --- | --- |\n");
     let mut glossy_cosine_over_factored = 0.0;
+    let mut glossy_cosine_over_tensor = 0.0;
     let mut worst_factored_over_analytic = 0.0f64;
     for (name, plugin, set, analytic) in MATERIALS {
         let file = tabulated(&dir, name, plugin, set);
@@ -391,7 +407,7 @@ fn measured_results_table() {
             1000,
         );
         let (analytic_ref, _) = render(&["shape.0.bsdf=analytic".into()], REFERENCE_SPP, 1000);
-        let mut strategies: Vec<(String, Vec<String>, Option<Plan>)> = vec![(
+        let mut strategies: Vec<Strategy> = vec![(
             "cosine".into(),
             vec!["bsdf.sample.sampling=cosine".into()],
             None,
@@ -403,13 +419,37 @@ fn measured_results_table() {
                     "bsdf.sample.sampling=factored".into(),
                     format!("bsdf.sample.terms={terms}"),
                 ],
-                Some(Plan::Factored { terms }),
+                Some((Plan::Factored { terms }, GRID)),
             ));
         }
+        // The lecture's model-quality comparison: the projected deviation
+        // vector's factored model, and sampling from a tensor's factors.
+        strategies.push((
+            "pdv factored L=2".into(),
+            vec![
+                "bsdf.sample.sampling=factored".into(),
+                "bsdf.sample.parameterization=pdv".into(),
+            ],
+            Some((
+                Plan::Factored { terms: 2 },
+                Grid {
+                    parameterization: Parameterization::Pdv,
+                    ..GRID
+                },
+            )),
+        ));
+        strategies.push((
+            "tensor L=2".into(),
+            vec!["bsdf.sample.sampling=tensor".into()],
+            Some((
+                Plan::Tensor { terms: 2 },
+                node_grid(Parameterization::HalfDiff),
+            )),
+        ));
         strategies.push((
             "tabulated".into(),
             vec!["bsdf.sample.sampling=tabulated".into()],
-            Some(Plan::Tabulated),
+            Some((Plan::Tabulated, GRID)),
         ));
         strategies.push((
             "analytic model".into(),
@@ -419,17 +459,17 @@ fn measured_results_table() {
         let mut rows = Vec::new();
         for (label, overrides, plan) in strategies {
             let (seconds, memory) = match plan {
-                Some(plan) => {
+                Some((plan, grid)) => {
                     let start = Instant::now();
                     let payload = lumis_measured::precompute::compute(
-                        &|wo, wi| table.eval(wi, wo),
+                        &Reflectance::Table(Arc::new(table.clone())),
                         plan,
-                        GRID,
+                        grid,
                         &ProgressBar::hidden(),
                     );
                     let seconds = start.elapsed().as_secs_f64();
                     drop(payload);
-                    let (prepared, _) = prepare_cached(&table, &file, plan);
+                    let (prepared, _) = prepare_on(&table, &file, plan, grid);
                     (seconds, prepared.memory_bytes())
                 }
                 None => (0.0, 0),
@@ -493,6 +533,7 @@ fn measured_results_table() {
         let factored = rel("factored L=2");
         if name == "conductor-0.05" {
             glossy_cosine_over_factored = rel("cosine") / factored;
+            glossy_cosine_over_tensor = rel("cosine") / rel("tensor L=2");
         }
         worst_factored_over_analytic =
             worst_factored_over_analytic.max(factored / rel("analytic model"));
@@ -507,6 +548,12 @@ fn measured_results_table() {
     assert!(
         glossy_cosine_over_factored > 4.0,
         "cosine / factored relMSE only {glossy_cosine_over_factored} on conductor-0.05\n{out}"
+    );
+    // Sampling the tensor's own factors beats cosine sampling on the
+    // glossiest table too.
+    assert!(
+        glossy_cosine_over_tensor > 4.0,
+        "cosine / tensor relMSE only {glossy_cosine_over_tensor} on conductor-0.05\n{out}"
     );
     assert!(
         worst_factored_over_analytic < 1.3,

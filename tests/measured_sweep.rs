@@ -10,7 +10,8 @@
 //! conductor-0.2 table in the default tier, every table and term count in
 //! an ignored sweep. And the kit on an analytic source (`bsdf`, the check
 //! kit's stand-in gold conductor) in every parameterization, its samplers
-//! and a tensor fitted to the BSDF itself.
+//! (the tensor sampler's non-negative factors among them) and a tensor
+//! fitted to the BSDF itself.
 
 use lumis_check::bsdf_suite::{variant, Variant};
 use lumis_tests::{assert_measured_variants_pass, tabulated, MEASURED_MATERIALS as MATERIALS};
@@ -48,7 +49,7 @@ fn an_analytic_source_passes_the_check_kit_in_every_parameterization() {
     std::fs::create_dir_all(&dir).unwrap();
     let mut variants: Vec<Variant> = Vec::new();
     for parameterization in ["half-diff", "pdv", "in-out"] {
-        for sampling in ["factored", "tabulated"] {
+        for sampling in ["factored", "tabulated", "tensor"] {
             let toml = format!(
                 "bsdf = \"gold\"\nparameterization = \"{parameterization}\"\nsampling = \"{sampling}\"\n"
             );
@@ -59,6 +60,8 @@ fn an_analytic_source_passes_the_check_kit_in_every_parameterization() {
     let tensor =
         "bsdf = \"gold\"\nparameterization = \"pdv\"\nrepresentation = \"tensor\"\nrank = 2\n";
     variants.push(variant("gold pdv tensor R=2", tensor).unwrap());
+    let sampled = format!("{tensor}sampling = \"tensor\"\nterms = 4\n");
+    variants.push(variant("gold pdv tensor R=2, tensor sampling L=4", &sampled).unwrap());
     assert_measured_variants_pass(&variants, &dir);
 }
 

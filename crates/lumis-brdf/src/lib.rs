@@ -18,7 +18,7 @@ use lumis_measured::merl::{write_atomic, MerlTable, SAMPLES, THETA_H_RES};
 use lumis_measured::precompute::{prepare, Plan};
 use lumis_measured::reflectance::Reflectance;
 use lumis_measured::tabulate::tabulate;
-use lumis_measured::tensor::{compression_error, DIMS};
+use lumis_measured::tensor::{compression_error, node_grid, DIMS};
 
 use lumis_app::parameter_table;
 
@@ -42,13 +42,14 @@ pub struct TabulateArgs {
 pub struct PrecomputeArgs {
     /// The MERL table.
     pub table: PathBuf,
-    /// factored or tabulated.
+    /// factored, tabulated or tensor.
     #[arg(long, default_value = "factored")]
     pub sampling: String,
-    /// Terms of the factorization (factored).
+    /// Terms of the factorization (factored, tensor).
     #[arg(long, default_value_t = 2)]
     pub terms: usize,
-    /// Outgoing elevations, half-angle bins, azimuth bins.
+    /// Outgoing elevations, half-angle bins, azimuth bins (factored,
+    /// tabulated; the tensor has its nodes).
     #[arg(long, value_delimiter = ',', default_value = "32,64,64")]
     pub grid: Vec<usize>,
     /// The coordinates of the grid: half-diff, pdv or in-out.
@@ -122,17 +123,21 @@ pub fn tabulate_bsdf(args: &TabulateArgs, registry: &Registry) -> Result<String>
 /// `lumis brdf precompute`: returns the report line.
 pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
     let plan = match args.sampling.as_str() {
-        "factored" if (1..=16).contains(&args.terms) => Plan::Factored { terms: args.terms },
-        "factored" => return Err(Error::msg(format!("--terms must be in [1, 16], got {}", args.terms))),
+        "factored" | "tensor" if !(1..=16).contains(&args.terms) => {
+            return Err(Error::msg(format!("--terms must be in [1, 16], got {}", args.terms)))
+        }
+        "factored" => Plan::Factored { terms: args.terms },
+        "tensor" => Plan::Tensor { terms: args.terms },
         "tabulated" => Plan::Tabulated,
         other => {
             return Err(Error::msg(format!(
-                "--sampling must be factored or tabulated (cosine needs no precomputation), got \"{other}\""
+                "--sampling must be factored, tabulated or tensor (cosine needs no precomputation), got \"{other}\""
             )))
         }
     };
     let parameterization = parameterization(&args.parameterization)?;
     let grid = match args.grid.as_slice() {
+        _ if matches!(plan, Plan::Tensor { .. }) => node_grid(parameterization),
         &[n_o, n_w, n_phi] if [n_o, n_w, n_phi].iter().all(|n| (2..=1024).contains(n)) => Grid {
             n_o,
             n_w,
@@ -150,19 +155,7 @@ pub fn precompute_table(args: &PrecomputeArgs) -> Result<String> {
     let table_hash = table.hash();
     let reflectance = Reflectance::Table(std::sync::Arc::new(table));
     // Remove the cache first so that the time is the computation's.
-    let cache = lumis_measured::cache::CacheKey {
-        table_hash,
-        strategy: match plan {
-            Plan::Factored { .. } => "factored",
-            Plan::Tabulated => "tabulated",
-        },
-        terms: match plan {
-            Plan::Factored { terms } => terms,
-            Plan::Tabulated => 0,
-        },
-        grid,
-    }
-    .path(&args.table);
+    let cache = plan.cache_key(table_hash, grid).path(&args.table);
     let _ = std::fs::remove_file(&cache);
     let (_, report) = prepare(&reflectance, Some(&args.table), plan, grid, true)?;
     Ok(report.message)

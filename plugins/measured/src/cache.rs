@@ -42,7 +42,8 @@ pub fn slot(
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CacheKey {
     pub table_hash: u64,
-    /// `"factored"`, `"tabulated"` or `"tensor"`.
+    /// `"factored"`, `"tabulated"`, `"tensor"` (the rendered tensor) or
+    /// `"tensor-sampling"`.
     pub strategy: &'static str,
     pub terms: usize,
     pub grid: Grid,
@@ -53,7 +54,8 @@ impl CacheKey {
         match self.strategy {
             "factored" => 1,
             "tabulated" => 2,
-            _ => 3,
+            "tensor" => 3,
+            _ => 4,
         }
     }
 

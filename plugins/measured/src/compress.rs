@@ -12,10 +12,10 @@ use lumis_api::{Error, ParamChoice, Result};
 
 use crate::cache::{self, CacheKey};
 use crate::cp::{AlsReport, AlsSettings};
-use crate::grid::{Grid, Parameterization};
+use crate::grid::Parameterization;
 use crate::precompute::source_name;
 use crate::reflectance::Reflectance;
-use crate::tensor::{fit, TensorBrdf, DIMS};
+use crate::tensor::{fit, node_grid, TensorBrdf};
 
 /// The cache key of the tensor of the table with content hash
 /// `table_hash` (the grid records the tensor's dimensions and
@@ -25,13 +25,7 @@ pub fn cache_key(table_hash: u64, parameterization: Parameterization, rank: usiz
         table_hash,
         strategy: "tensor",
         terms: rank,
-        grid: Grid {
-            n_o: DIMS[0],
-            n_w: DIMS[1],
-            n_phi: DIMS[2],
-            supersamples: 0,
-            parameterization,
-        },
+        grid: node_grid(parameterization),
     }
 }
 

@@ -29,6 +29,22 @@
 //! and Bro 2005, "PARAFAC and missing values", Chemometrics and Intelligent
 //! Laboratory Systems 75): each sweep then minimises the residual over the
 //! known entries, which still decreases monotonically.
+//!
+//! With [`AlsSettings::nonnegative`], each factor is instead updated by
+//! hierarchical ALS (Cichocki and Phan 2009, "Fast local algorithms for
+//! large scale nonnegative matrix and tensor factorizations", IEICE
+//! Transactions on Fundamentals E92-A(3), algorithm 2): one column at a
+//! time, the least-squares update with the others held, projected onto
+//! the non-negative orthant,
+//!
+//! ```text
+//! A[.][r] <- max(eps, A[.][r] + (M[.][r] - A G[.][r]) / G[r][r])
+//! ```
+//!
+//! from the same `M` and `G`. Each column update is the exact minimiser
+//! of a convex problem, so the residual still cannot increase. A model
+//! whose terms are non-negative is a mixture that can be sampled term by
+//! term ([`crate::tensor_sampling`]).
 
 use lumis_sampling::Pcg32;
 use rayon::prelude::*;
@@ -42,6 +58,8 @@ pub struct AlsSettings {
     pub tolerance: f64,
     /// Seed of the initial factors.
     pub seed: u64,
+    /// Keep every factor non-negative (hierarchical ALS).
+    pub nonnegative: bool,
 }
 
 impl Default for AlsSettings {
@@ -50,6 +68,7 @@ impl Default for AlsSettings {
             max_sweeps: 60,
             tolerance: 1e-5,
             seed: 2011,
+            nonnegative: false,
         }
     }
 }
@@ -91,6 +110,21 @@ impl Cp {
         (0..r)
             .map(|t| self.weights[t] * a[i * r + t] * b[j * r + t] * c[k * r + t])
             .sum()
+    }
+
+    /// Factor `mode` as f32, `dims[mode] x rank` row-major, with the
+    /// weights folded into mode 0 (so that the model is the plain sum of
+    /// products of the three).
+    pub fn folded_factor(&self, mode: usize) -> Vec<f32> {
+        let r = self.rank;
+        self.factors[mode]
+            .chunks_exact(r)
+            .flat_map(|row| {
+                row.iter()
+                    .enumerate()
+                    .map(move |(q, &v)| (if mode == 0 { v * self.weights[q] } else { v }) as f32)
+            })
+            .collect()
     }
 
     /// Fits `rank` terms to `data` (`dims[0] x dims[1] x dims[2]`, `k`
@@ -148,7 +182,7 @@ impl Cp {
                     x[n] = model.value(i, j, k);
                 }
             }
-            model.sweep(&x);
+            model.sweep(&x, settings.nonnegative);
             let residual = model.residual(data, &missing);
             report = AlsReport {
                 sweeps: sweep,
@@ -164,7 +198,7 @@ impl Cp {
     }
 
     /// One ALS sweep over the three factors.
-    fn sweep(&mut self, x: &[f64]) {
+    fn sweep(&mut self, x: &[f64], nonnegative: bool) {
         let r = self.rank;
         let [n0, n1, n2] = self.dims;
         // T[i][j][r] = sum_k X[i][j][k] C[k][r]: shared by the A and B
@@ -193,7 +227,7 @@ impl Cp {
                 }
             }
         }
-        self.solve_mode(0, m);
+        self.solve_mode(0, m, nonnegative);
         // B: M[j][r] = sum_i A[i][r] T[i][j][r].
         let a = &self.factors[0];
         let mut m = vec![0.0; n1 * r];
@@ -205,7 +239,7 @@ impl Cp {
                 }
             }
         }
-        self.solve_mode(1, m);
+        self.solve_mode(1, m, nonnegative);
         // C: M[k][r] = sum_{i,j} A[i][r] B[j][r] X[i][j][k].
         let (a, b) = (&self.factors[0], &self.factors[1]);
         let m = x
@@ -235,23 +269,38 @@ impl Cp {
                     s
                 },
             );
-        self.solve_mode(2, m);
+        self.solve_mode(2, m, nonnegative);
     }
 
     /// Factor `mode` from its MTTKRP `m`: each row solves `G x = m_i` with
     /// `G` the elementwise product of the other two factors' Gram matrices
-    /// (their columns are unit-norm, so `G` is well scaled); the column
-    /// norms of the result become the weights.
-    fn solve_mode(&mut self, mode: usize, mut m: Vec<f64>) {
+    /// (their columns are unit-norm, so `G` is well scaled), or, if
+    /// `nonnegative`, takes one hierarchical-ALS step from the current
+    /// factor; the column norms of the result become the weights.
+    fn solve_mode(&mut self, mode: usize, mut m: Vec<f64>, nonnegative: bool) {
         let r = self.rank;
         let mut g = vec![1.0; r * r];
         for other in (0..3).filter(|&o| o != mode) {
             let gram = gram(&self.factors[other], r);
             g.iter_mut().zip(gram).for_each(|(g, h)| *g *= h);
         }
-        let l = cholesky(&g, r);
-        for row in m.chunks_exact_mut(r) {
-            cholesky_solve(&l, r, row);
+        if nonnegative {
+            // Positive, so that a column never dies (Cichocki and Phan's eps).
+            const FLOOR: f64 = 1e-16;
+            let current = &self.factors[mode];
+            for (row, old) in m.chunks_exact_mut(r).zip(current.chunks_exact(r)) {
+                let mut x: Vec<f64> = old.iter().zip(&self.weights).map(|(v, w)| v * w).collect();
+                for q in 0..r {
+                    let gx: f64 = (0..r).map(|p| x[p] * g[p * r + q]).sum();
+                    x[q] = (x[q] + (row[q] - gx) / g[q * r + q].max(f64::MIN_POSITIVE)).max(FLOOR);
+                }
+                row.copy_from_slice(&x);
+            }
+        } else {
+            let l = cholesky(&g, r);
+            for row in m.chunks_exact_mut(r) {
+                cholesky_solve(&l, r, row);
+            }
         }
         self.weights = normalize_columns(&mut m, r);
         self.factors[mode] = m;
@@ -380,9 +429,17 @@ mod tests {
 
     /// An exactly rank-`rank` array from random factors.
     fn synthetic(dims: [usize; 3], rank: usize, seed: u64) -> Vec<f64> {
+        synthetic_from(dims, rank, seed, -0.3)
+    }
+
+    /// Factors uniform in `[offset, offset + 1)`.
+    fn synthetic_from(dims: [usize; 3], rank: usize, seed: u64, offset: f64) -> Vec<f64> {
         let mut rng = Pcg32::new(seed, 5);
-        let mut factor =
-            |n: usize| -> Vec<f64> { (0..n * rank).map(|_| rng.next_f32() as f64 - 0.3).collect() };
+        let mut factor = |n: usize| -> Vec<f64> {
+            (0..n * rank)
+                .map(|_| rng.next_f32() as f64 + offset)
+                .collect()
+        };
         let (a, b, c) = (factor(dims[0]), factor(dims[1]), factor(dims[2]));
         let mut x = vec![0.0; dims.iter().product()];
         for i in 0..dims[0] {
@@ -402,7 +459,45 @@ mod tests {
             max_sweeps: 3000,
             tolerance: 1e-13,
             seed: 7,
+            nonnegative: false,
         }
+    }
+
+    fn all_nonnegative(model: &Cp) -> bool {
+        model.weights.iter().all(|&w| w >= 0.0) && model.factors.iter().flatten().all(|&v| v >= 0.0)
+    }
+
+    #[test]
+    fn nonnegative_fit_recovers_a_nonnegative_rank_3_array() {
+        let dims = [20, 15, 12];
+        let x = synthetic_from(dims, 3, 4, 0.0);
+        let settings = AlsSettings {
+            nonnegative: true,
+            ..exact()
+        };
+        let (model, report) = Cp::fit(&x, None, dims, 3, settings);
+        assert!(report.relative_error() < 1e-4, "{report:?}");
+        assert!(all_nonnegative(&model));
+    }
+
+    #[test]
+    fn nonnegative_fit_stays_nonnegative_where_the_best_fit_is_not() {
+        // Factors of both signs: the unconstrained fit is exact, the
+        // constrained one is not, but every factor stays >= 0 and its error
+        // cannot be below the unconstrained one's.
+        let dims = [12, 10, 9];
+        let x = synthetic(dims, 2, 5);
+        let (free_model, free) = Cp::fit(&x, None, dims, 2, exact());
+        assert!(!all_nonnegative(&free_model));
+        let settings = AlsSettings {
+            nonnegative: true,
+            max_sweeps: 400,
+            ..exact()
+        };
+        let (model, report) = Cp::fit(&x, None, dims, 2, settings);
+        assert!(all_nonnegative(&model));
+        assert!(report.relative_error() >= free.relative_error());
+        assert!(report.relative_error() < 1.0, "{report:?}");
     }
 
     #[test]

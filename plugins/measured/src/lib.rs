@@ -2,8 +2,9 @@
 //! lookup), the `measured` BSDF plugin and its importance sampling
 //! strategies (cosine, the factored representation of Lawrence,
 //! Rusinkiewicz and Ramamoorthi 2004, a tabulated 2D distribution per
-//! outgoing elevation), the cache of their precomputation, the tensor
-//! (CP) approximation of a table the plugin can render from instead, and
+//! outgoing elevation, the tensor's own factors), the cache of their
+//! precomputation, the tensor (CP) approximation of a table the plugin can
+//! render from instead, and
 //! the tabulation of any lumis BSDF as a MERL table.
 
 pub mod cache;
@@ -18,6 +19,7 @@ pub mod reflectance;
 pub mod tabulate;
 pub mod tabulated;
 pub mod tensor;
+pub mod tensor_sampling;
 
 pub use measured::{Measured, MeasuredParams, MeasuredRepresentation, MeasuredSampling, SPEC};
 pub use merl::MerlTable;

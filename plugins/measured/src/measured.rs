@@ -27,12 +27,13 @@ use crate::merl::MerlTable;
 use crate::precompute::{prepare, Plan, PrecomputeReport, Prepared};
 use crate::reflectance::Reflectance;
 use crate::tabulate::check_representable;
+use crate::tensor::node_grid;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Bsdf,
     name: "measured",
     source: lumis_api::source_file!(),
-    doc: "isotropic BRDF tabulated in the MERL format, or an analytic BSDF fitted directly (f itself, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004) or tabulated sampling; one-sided",
+    doc: "isotropic BRDF tabulated in the MERL format, or an analytic BSDF fitted directly (f itself, or a rank-R tensor approximation of it); cosine, factored (Lawrence et al. 2004), tabulated or tensor (from the factors of a non-negative tensor, after Bilgili et al. 2011) sampling; one-sided",
     params: MeasuredParams::SPECS,
 };
 
@@ -50,18 +51,19 @@ pub struct MeasuredParams {
     pub bsdf: Option<NestedBsdf>,
     /// cosine (the baseline), factored (L separable terms in half-vector
     /// coordinates), tabulated (a 2D table per outgoing elevation, the
-    /// memory-hungry reference)
+    /// memory-hungry reference), tensor (L non-negative terms fitted to f at
+    /// the tensor's 90 x 90 x 180 nodes, sampled from their 1D factors)
     #[param(default = Factored)]
     pub sampling: MeasuredSampling,
-    /// L, the terms of the factorization (factored only)
+    /// L, the terms of the factorization (factored, tensor)
     #[param(default = 2, range = (1, 16))]
     pub terms: i64,
     /// [outgoing elevations, half-angle bins, azimuth bins] of the
-    /// precomputation (factored, tabulated)
+    /// precomputation (factored, tabulated; tensor sampling has its nodes)
     #[param(default = [32, 64, 64])]
     pub grid: Vec<i64>,
     /// the coordinates of wi about wo the precomputation tabulates
-    /// (factored, tabulated) and the tensor is fitted over: half-diff (the
+    /// (factored, tabulated) and the tensors are fitted over: half-diff (the
     /// half vector), pdv (the projected deviation vector, the tangent-plane
     /// part of wi + wo) or in-out (wi itself)
     #[param(default = HalfDiff)]
@@ -87,6 +89,7 @@ pub enum MeasuredSampling {
     Cosine,
     Factored,
     Tabulated,
+    Tensor,
 }
 
 /// The `representation` choice of `measured`.
@@ -177,13 +180,23 @@ impl Measured {
                 params.unread(keys.terms);
                 Some(Plan::Tabulated)
             }
+            MeasuredSampling::Tensor => {
+                params.unread(keys.grid);
+                Some(Plan::Tensor {
+                    terms: p.terms as usize,
+                })
+            }
         };
         let setup = match plan {
-            Some(plan) => Some((
-                plan,
-                checked_grid(&p.grid, p.parameterization, params)?,
-                p.cache,
-            )),
+            Some(plan) => {
+                let grid = match plan {
+                    Plan::Tensor { .. } => node_grid(p.parameterization),
+                    Plan::Factored { .. } | Plan::Tabulated => {
+                        checked_grid(&p.grid, p.parameterization, params)?
+                    }
+                };
+                Some((plan, grid, p.cache))
+            }
             None => None,
         };
         let source = match (&p.file, p.bsdf) {
@@ -251,6 +264,7 @@ impl Measured {
             Strategy::Cosine => warp::cosine_hemisphere_pdf(wi.z),
             Strategy::Prepared(Prepared::Factored(f)) => f.pdf(wo, wi),
             Strategy::Prepared(Prepared::Tabulated(t)) => t.pdf(wo, wi),
+            Strategy::Prepared(Prepared::Tensor(t)) => t.pdf(wo, wi),
         }
     }
 }
@@ -273,6 +287,7 @@ impl Bsdf for Measured {
             Strategy::Cosine => warp::square_to_cosine_hemisphere(u2),
             Strategy::Prepared(Prepared::Factored(f)) => f.sample(wo, u1, u2)?,
             Strategy::Prepared(Prepared::Tabulated(t)) => t.sample(wo, u1, u2)?,
+            Strategy::Prepared(Prepared::Tensor(t)) => t.sample(wo, u1, u2)?,
         };
         // The density from the direction, as pdf() computes it, so that the
         // two agree to the last bit even at bin boundaries.

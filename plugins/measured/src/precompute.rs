@@ -1,6 +1,7 @@
 //! Runs (or loads from the cache) the precomputation a sampling strategy
 //! needs, once per table and setting: the grid of `f cos theta_i` in
-//! parallel, then the factorization, behind one progress bar.
+//! parallel, then the factorization, or the non-negative tensor of the
+//! nodes, behind one progress bar.
 
 use std::path::Path;
 use std::time::Instant;
@@ -13,12 +14,19 @@ use crate::factored::{factorize, Factored, Factors, NMF_ITERATIONS, REFINE_ITERA
 use crate::grid::{normalize_rows, Grid};
 use crate::reflectance::Reflectance;
 use crate::tabulated::Tabulated;
+use crate::tensor_sampling::{self, TensorSampler};
 
 /// What the strategy needs precomputed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Plan {
-    Factored { terms: usize },
+    Factored {
+        terms: usize,
+    },
     Tabulated,
+    /// On the tensor's nodes ([`crate::tensor::node_grid`]).
+    Tensor {
+        terms: usize,
+    },
 }
 
 impl Plan {
@@ -26,13 +34,25 @@ impl Plan {
         match self {
             Plan::Factored { .. } => "factored",
             Plan::Tabulated => "tabulated",
+            Plan::Tensor { .. } => "tensor-sampling",
         }
     }
 
     fn terms(self) -> usize {
         match self {
-            Plan::Factored { terms } => terms,
+            Plan::Factored { terms } | Plan::Tensor { terms } => terms,
             Plan::Tabulated => 0,
+        }
+    }
+
+    /// What the cache of this plan on `grid` for a table of content hash
+    /// `table_hash` must match.
+    pub fn cache_key(self, table_hash: u64, grid: Grid) -> CacheKey {
+        CacheKey {
+            table_hash,
+            strategy: self.name(),
+            terms: self.terms(),
+            grid,
         }
     }
 
@@ -41,6 +61,7 @@ impl Plan {
         match self {
             Plan::Factored { terms } => terms * (grid.n_o + grid.n_w + grid.n_phi),
             Plan::Tabulated => grid.n_o * grid.columns(),
+            Plan::Tensor { terms } => tensor_sampling::payload_len(terms),
         }
     }
 }
@@ -50,6 +71,7 @@ impl Plan {
 pub enum Prepared {
     Factored(Factored),
     Tabulated(Tabulated),
+    Tensor(TensorSampler),
 }
 
 impl Prepared {
@@ -57,6 +79,7 @@ impl Prepared {
         match self {
             Prepared::Factored(f) => f.memory_bytes(),
             Prepared::Tabulated(t) => t.memory_bytes(),
+            Prepared::Tensor(t) => t.memory_bytes(),
         }
     }
 }
@@ -94,24 +117,36 @@ fn from_payload(plan: Plan, grid: Grid, data: &[f32]) -> Prepared {
                 .collect();
             Prepared::Tabulated(Tabulated::new(grid, &rows))
         }
+        Plan::Tensor { terms } => {
+            Prepared::Tensor(TensorSampler::new(grid.parameterization, terms, data))
+        }
     }
 }
 
-/// Computes the payload of `plan` for `f(wo, wi)` (no cache).
+/// Computes the payload of `plan` for `reflectance` (no cache).
 pub fn compute(
-    f: &(dyn Fn(Vec3, Vec3) -> Rgb + Sync),
+    reflectance: &Reflectance,
     plan: Plan,
     grid: Grid,
     progress: &ProgressBar,
 ) -> Vec<f32> {
-    let mut rows = grid.rows_of(f, progress);
-    normalize_rows(&mut rows);
+    let rows = || {
+        let f = |wo: Vec3, wi: Vec3| -> Rgb { reflectance.eval(wi, wo) };
+        let mut rows = grid.rows_of(&f, progress);
+        normalize_rows(&mut rows);
+        rows
+    };
     match plan {
         Plan::Factored { terms } => {
-            let factors = factorize(&rows, &grid, terms, progress);
+            let factors = factorize(&rows(), &grid, terms, progress);
             [factors.f, factors.u, factors.v].concat()
         }
-        Plan::Tabulated => rows.concat(),
+        Plan::Tabulated => rows().concat(),
+        Plan::Tensor { terms } => {
+            let payload = tensor_sampling::fit(reflectance, grid.parameterization, terms);
+            progress.inc(1);
+            payload
+        }
     }
 }
 
@@ -129,18 +164,11 @@ pub fn prepare(
     let label = match plan {
         Plan::Factored { terms } => format!("factored L = {terms}"),
         Plan::Tabulated => "tabulated".to_string(),
+        Plan::Tensor { terms } => format!("tensor L = {terms}"),
     };
-    let cache = cache::slot(
-        use_cache,
-        table_path,
-        reflectance.cache_hash(),
-        |table_hash| CacheKey {
-            table_hash,
-            strategy: plan.name(),
-            terms: plan.terms(),
-            grid,
-        },
-    );
+    let cache = cache::slot(use_cache, table_path, reflectance.cache_hash(), |hash| {
+        plan.cache_key(hash, grid)
+    });
     let mut note = String::new();
     if let Some((path, key)) = &cache {
         match cache::load(path, key, plan.count(&grid)) {
@@ -165,17 +193,17 @@ pub fn prepare(
             Err(miss) => note = miss.note(path),
         }
     }
-    let total = grid.n_o as u64
-        + match plan {
-            Plan::Factored { .. } => (NMF_ITERATIONS + REFINE_ITERATIONS) as u64,
-            Plan::Tabulated => 0,
-        };
+    let total = match plan {
+        Plan::Factored { .. } => (grid.n_o + NMF_ITERATIONS + REFINE_ITERATIONS) as u64,
+        Plan::Tabulated => grid.n_o as u64,
+        Plan::Tensor { .. } => 1,
+    };
     let progress = ProgressBar::new(total).with_message(format!("{label} sampling of {name}"));
     if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} {elapsed}") {
         progress.set_style(style.progress_chars("=> "));
     }
     let start = Instant::now();
-    let data = compute(&|wo, wi| reflectance.eval(wi, wo), plan, grid, &progress);
+    let data = compute(reflectance, plan, grid, &progress);
     let seconds = start.elapsed().as_secs_f64();
     progress.finish_and_clear();
     if let Some((path, key)) = &cache {

@@ -67,6 +67,18 @@ fn from_log(y: f32) -> f32 {
     y.exp_m1().max(0.0)
 }
 
+/// The nodes of `parameterization` as a [`Grid`] (`supersamples` unused):
+/// what a cache records of a tensor's layout.
+pub fn node_grid(parameterization: Parameterization) -> Grid {
+    Grid {
+        n_o: DIMS[0],
+        n_w: DIMS[1],
+        n_phi: DIMS[2],
+        supersamples: 0,
+        parameterization,
+    }
+}
+
 /// The position of one coordinate between its two nodes.
 type Axis = (usize, usize, f32);
 
@@ -86,19 +98,8 @@ impl TensorBrdf {
     /// From three fitted channels.
     pub fn new(parameterization: Parameterization, channels: &[Cp; 3]) -> Self {
         let rank = channels[0].rank;
-        let factors = std::array::from_fn(|c| {
-            let cp = &channels[c];
-            std::array::from_fn(|m| {
-                cp.factors[m]
-                    .chunks_exact(rank)
-                    .flat_map(|row| {
-                        row.iter()
-                            .enumerate()
-                            .map(move |(r, &v)| (if m == 0 { v * cp.weights[r] } else { v }) as f32)
-                    })
-                    .collect()
-            })
-        });
+        let factors =
+            std::array::from_fn(|c| std::array::from_fn(|m| channels[c].folded_factor(m)));
         Self {
             parameterization,
             rank,
@@ -279,7 +280,7 @@ fn axes(parameterization: Parameterization, wo: Vec3, wi: Vec3) -> Option<[Axis;
 
 /// The index coordinate of `theta` on an axis of 90 cell-centred nodes.
 #[inline]
-fn elevation_index(w: Vec3) -> f32 {
+pub(crate) fn elevation_index(w: Vec3) -> f32 {
     let theta = (w.x * w.x + w.y * w.y).sqrt().atan2(w.z);
     theta / FRAC_PI_2 * DIMS[0] as f32 - 0.5
 }
@@ -317,17 +318,17 @@ pub fn node_pair(
     (wo.z > 0.0 && wi.z > 0.0).then_some((wo, wi))
 }
 
-/// `ln(1 + f)` of `source` at the nodes of `parameterization`, per
-/// channel, and which nodes are known. A table in half-diff gives its own
-/// MERL nodes (an invalid sample is missing); otherwise each node's pair
-/// is evaluated (a node with no pair is missing): a table through its
-/// interpolation, an analytic BSDF exactly, at the parameterization's own
-/// nodes.
-pub fn log_samples(
+/// `f` of `source` at the nodes of `parameterization`, `(a, b, c)` at
+/// `(a * DIMS[1] + b) * DIMS[2] + c`, per channel; `None` where unknown. A
+/// table in half-diff gives its own MERL nodes (an invalid sample is
+/// unknown); otherwise each node's pair is evaluated (a node with no pair
+/// is unknown): a table through its interpolation, an analytic BSDF
+/// exactly, at the parameterization's own nodes.
+pub fn node_reflectance(
     source: &Reflectance,
     parameterization: Parameterization,
-) -> ([Vec<f64>; 3], [Vec<bool>; 3]) {
-    let nodes: Vec<[Option<f32>; 3]> = (0..SAMPLES)
+) -> Vec<[Option<f32>; 3]> {
+    (0..SAMPLES)
         .into_par_iter()
         .map(|n| {
             let (a, b, c) = (
@@ -346,7 +347,16 @@ pub fn log_samples(
                 },
             }
         })
-        .collect();
+        .collect()
+}
+
+/// `ln(1 + f)` of `source` at the nodes of `parameterization`
+/// ([`node_reflectance`]), per channel, and which nodes are known.
+pub fn log_samples(
+    source: &Reflectance,
+    parameterization: Parameterization,
+) -> ([Vec<f64>; 3], [Vec<bool>; 3]) {
+    let nodes = node_reflectance(source, parameterization);
     let values = std::array::from_fn(|c| nodes.iter().map(|v| v[c].map_or(0.0, to_log)).collect());
     let known = std::array::from_fn(|c| nodes.iter().map(|v| v[c].is_some()).collect());
     (values, known)
