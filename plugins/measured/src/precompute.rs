@@ -215,8 +215,12 @@ pub fn prepare(
     }
     let prepared = from_payload(plan, grid, &data);
     let memory_bytes = prepared.memory_bytes();
+    let (on, cells) = match plan {
+        Plan::Tensor { .. } => ("fitted at the", "nodes"),
+        Plan::Factored { .. } | Plan::Tabulated => ("on a", "grid precomputed"),
+    };
     let message = format!(
-        "{name}: {label} sampling on a {} x {} x {} grid precomputed in {seconds:.2} s, {} KiB{note}",
+        "{name}: {label} sampling {on} {} x {} x {} {cells} in {seconds:.2} s, {} KiB{note}",
         grid.n_o,
         grid.n_w,
         grid.n_phi,
