@@ -38,18 +38,16 @@
 //! with `u_l(w)`, `v_l(phi)` the densities of the 1D distributions. `F`
 //! is interpolated linearly in `theta_o` between rows, which keeps the
 //! mixture exact. A factorization can leave a term near zero where `f` is
-//! not: each 1D distribution is mixed with a uniform one of weight
-//! [`DEFENSIVE`] so that the density is positive wherever `f` may be
-//! (Hesterberg 1995's defensive mixture), at a cost of 1% of the samples.
+//! not: each 1D distribution is defensive ([`crate::mixture`], which also
+//! draws and evaluates the mixture).
 
 use indicatif::ProgressBar;
 use lumis_api::Vec3;
-use lumis_sampling::{Distribution1D, Pcg32};
+use lumis_sampling::Pcg32;
 
 use crate::grid::Grid;
+use crate::mixture::{defensive, SeparableMixture};
 
-/// Weight of the uniform part of every 1D distribution.
-pub const DEFENSIVE: f32 = 0.01;
 /// Multiplicative-update iterations of the rank-L factorization.
 pub const NMF_ITERATIONS: usize = 400;
 /// Power iterations for each rank-1 split and refit iterations of `F`.
@@ -308,24 +306,7 @@ pub struct Factored {
     terms: usize,
     /// Selection probabilities per row, `n_o x L`, rows summing to 1.
     weights: Vec<f32>,
-    u: Vec<Distribution1D>,
-    v: Vec<Distribution1D>,
-}
-
-/// A distribution over `edges` with masses `p` (summing to 1) mixed with
-/// the uniform one (masses proportional to bin width) by `DEFENSIVE`.
-pub(crate) fn defensive(edges: &std::sync::Arc<[f32]>, p: &[f32]) -> Distribution1D {
-    let width = edges[edges.len() - 1] - edges[0];
-    let total: f32 = p.iter().sum();
-    let mass: Vec<f32> = p
-        .iter()
-        .enumerate()
-        .map(|(i, &x)| {
-            let data = if total > 0.0 { x / total } else { 0.0 };
-            (1.0 - DEFENSIVE) * data + DEFENSIVE * (edges[i + 1] - edges[i]) / width
-        })
-        .collect();
-    Distribution1D::new(edges.clone(), &mass)
+    mixture: SeparableMixture,
 }
 
 impl Factored {
@@ -355,66 +336,37 @@ impl Factored {
             grid,
             terms,
             weights,
-            u,
-            v,
+            mixture: SeparableMixture::new(grid, u, v),
         }
     }
 
-    /// Term `l`'s probability for `wo`, interpolated between rows.
+    /// The terms' probabilities for `wo`, interpolated between rows.
     #[inline]
-    fn weight(&self, rows: (usize, usize, f32), l: usize) -> f32 {
-        let (k0, k1, t) = rows;
-        (1.0 - t) * self.weights[k0 * self.terms + l] + t * self.weights[k1 * self.terms + l]
+    fn weights(&self, wo: Vec3) -> impl Iterator<Item = f32> + '_ {
+        let (k0, k1, t) = self.grid.rows(wo);
+        let row = |k: usize| &self.weights[k * self.terms..(k + 1) * self.terms];
+        row(k0)
+            .iter()
+            .zip(row(k1))
+            .map(move |(&w0, &w1)| (1.0 - t) * w0 + t * w1)
     }
 
     /// Draws `wi` (or `None` when the coordinates send it below the
     /// horizon or faces away from `wo`).
     #[inline]
     pub fn sample(&self, wo: Vec3, u1: f32, u2: lumis_api::Vec2) -> Option<Vec3> {
-        let rows = self.grid.rows(wo);
-        let mut l = self.terms - 1;
-        let mut acc = 0.0;
-        for j in 0..self.terms {
-            acc += self.weight(rows, j);
-            if u1 < acc {
-                l = j;
-                break;
-            }
-        }
-        let (w, _, _) = self.u[l].sample(u2.x);
-        let (phi, _, _) = self.v[l].sample(u2.y);
-        let (wi, _) = self.grid.direction(wo, w, phi)?;
-        Some(wi)
+        self.mixture.sample(wo, self.weights(wo), u1, u2)
     }
 
     /// The density of [`Self::sample`] w.r.t. solid angle of `wi`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((w, phi, jacobian)) = self.grid.coordinates(wo, wi) else {
-            return 0.0;
-        };
-        let (Some(a), Some(b)) = (self.u[0].bin(w), self.v[0].bin(phi)) else {
-            return 0.0;
-        };
-        let rows = self.grid.rows(wo);
-        let mut p = 0.0;
-        for l in 0..self.terms {
-            p += self.weight(rows, l) * self.u[l].bin_pdf(a) * self.v[l].bin_pdf(b);
-        }
-        p / jacobian
+        self.mixture.pdf(wo, wi, self.weights(wo))
     }
 
-    /// Bytes held (the bin edges once, they are shared).
+    /// Bytes held.
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of::<Self>()
-            + 4 * self.weights.len()
-            + self
-                .u
-                .iter()
-                .chain(&self.v)
-                .map(|d| d.memory_bytes())
-                .sum::<usize>()
-            + 4 * (self.grid.n_w + self.grid.n_phi + 2)
+        std::mem::size_of::<Self>() + 4 * self.weights.len() + self.mixture.memory_bytes()
     }
 }
 

@@ -14,6 +14,7 @@ pub mod factored;
 pub mod grid;
 mod measured;
 pub mod merl;
+pub mod mixture;
 pub mod precompute;
 pub mod reflectance;
 pub mod tabulate;

@@ -8,7 +8,7 @@
 //!
 //! Between rows the density is the mixture of the two rows' (weights
 //! linear in `theta_o`), sampled by picking a row. Each row is mixed with
-//! the uniform density by [`crate::factored::DEFENSIVE`], as the factored
+//! the uniform density by [`crate::mixture::DEFENSIVE`], as the factored
 //! terms are.
 
 use std::sync::Arc;
@@ -16,8 +16,8 @@ use std::sync::Arc;
 use lumis_api::{Vec2, Vec3};
 use lumis_sampling::Distribution1D;
 
-use crate::factored::DEFENSIVE;
 use crate::grid::Grid;
+use crate::mixture::DEFENSIVE;
 
 #[derive(Debug, Clone)]
 struct Row {

@@ -32,26 +32,19 @@
 //!   Not proportional to `f cos theta_i`, but unbiased: the density below
 //!   is exact.
 //!
-//! The density is the mixture's, evaluated the same way,
-//!
-//! ```text
-//! p(wi) = sum_q P_q(wo) u_q(r) v_q(phi) / J,   J = d omega_i / (dr dphi),
-//! ```
-//!
-//! and each 1D distribution is mixed with a uniform one (`DEFENSIVE`, as
-//! [`crate::factored`]).
+//! The density is the mixture's ([`crate::mixture`], as for the factored
+//! sampler), evaluated the same way, each 1D distribution defensive.
 
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::sync::Arc;
 
 use lumis_api::{Rgb, Vec2, Vec3};
-use lumis_sampling::Distribution1D;
 use rayon::prelude::*;
 
 use crate::cp::{AlsSettings, Cp};
-use crate::factored::defensive;
-use crate::grid::{Grid, Parameterization};
+use crate::grid::Parameterization;
 use crate::merl::clamped_axis;
+use crate::mixture::{defensive, SeparableMixture};
 use crate::reflectance::Reflectance;
 use crate::tensor::{elevation_index, node_grid, node_pair, node_reflectance, DIMS};
 
@@ -69,7 +62,7 @@ pub fn payload_len(terms: usize) -> usize {
 /// Fits `terms` non-negative terms to the density a sampler should follow
 /// at the nodes of `parameterization`: the luminance of `f cos theta_i`
 /// per unit `dr dphi` of the sampled coordinates (`f cos theta_i J`, `J`
-/// of [`Grid::coordinates`]), which integrates to the albedo over a row
+/// of [`crate::grid::Grid::coordinates`]), which integrates to the albedo over a row
 /// and so stays bounded where `f` itself grows without bound at grazing
 /// angles. A node with no pair of directions, or a table's invalid one, is
 /// a known zero, not a missing value as for the rendered tensor: no
@@ -133,8 +126,6 @@ impl Condition {
 /// Draws `wi` from the factors of a non-negative tensor.
 #[derive(Debug, Clone)]
 pub struct TensorSampler {
-    /// Maps `(r, phi)` to `wi`; its resolution is not used.
-    grid: Grid,
     condition: Condition,
     terms: usize,
     /// Per term: the conditioning factor, `DIMS[axis]` values.
@@ -142,8 +133,7 @@ pub struct TensorSampler {
     /// Per term: the masses of its two sampled factors (and, in
     /// half-diff, of `phi_d`).
     mass: Vec<f32>,
-    u: Vec<Distribution1D>,
-    v: Vec<Distribution1D>,
+    mixture: SeparableMixture,
 }
 
 /// Edges of `phi` over `[0, 2 pi)`: the tensor's azimuth nodes `c / (n - 1)
@@ -233,7 +223,6 @@ impl TensorSampler {
             v.push(defensive(&phi_edges, &phi_masses));
         }
         Self {
-            grid,
             condition: Condition {
                 axis: condition_axis,
                 parameterization,
@@ -241,8 +230,7 @@ impl TensorSampler {
             terms,
             conditioning,
             mass,
-            u,
-            v,
+            mixture: SeparableMixture::new(grid, u, v),
         }
     }
 
@@ -269,47 +257,19 @@ impl TensorSampler {
     /// hemisphere (or, in pdv, the disk).
     #[inline]
     pub fn sample(&self, wo: Vec3, u1: f32, u2: Vec2) -> Option<Vec3> {
-        let mut q = self.terms - 1;
-        let mut acc = 0.0;
-        for (j, p) in self.weights(wo).enumerate() {
-            acc += p;
-            if u1 < acc {
-                q = j;
-                break;
-            }
-        }
-        let (r, _, _) = self.u[q].sample(u2.x);
-        let (phi, _, _) = self.v[q].sample(u2.y);
-        let (wi, _) = self.grid.direction(wo, r, phi)?;
-        Some(wi)
+        self.mixture.sample(wo, self.weights(wo), u1, u2)
     }
 
     /// The density of [`Self::sample`] w.r.t. solid angle of `wi`.
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some((r, phi, jacobian)) = self.grid.coordinates(wo, wi) else {
-            return 0.0;
-        };
-        let (Some(a), Some(b)) = (self.u[0].bin(r), self.v[0].bin(phi)) else {
-            return 0.0;
-        };
-        let p: f32 = self
-            .weights(wo)
-            .enumerate()
-            .map(|(q, p)| p * self.u[q].bin_pdf(a) * self.v[q].bin_pdf(b))
-            .sum();
-        p / jacobian
+        self.mixture.pdf(wo, wi, self.weights(wo))
     }
 
     /// Bytes held.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()
             + 4 * (self.conditioning.len() + self.mass.len())
-            + self
-                .u
-                .iter()
-                .chain(&self.v)
-                .map(|d| d.memory_bytes())
-                .sum::<usize>()
+            + self.mixture.memory_bytes()
     }
 }
