@@ -55,7 +55,8 @@ impl CacheKey {
             "factored" => 1,
             "tabulated" => 2,
             "tensor" => 3,
-            _ => 4,
+            "tensor-sampling" => 4,
+            other => unreachable!("no precomputation is named {other:?}"),
         }
     }
 

@@ -51,8 +51,9 @@ pub struct MeasuredParams {
     pub bsdf: Option<NestedBsdf>,
     /// cosine (the baseline), factored (L separable terms in half-vector
     /// coordinates), tabulated (a 2D table per outgoing elevation, the
-    /// memory-hungry reference), tensor (L non-negative terms fitted to f at
-    /// the tensor's 90 x 90 x 180 nodes, sampled from their 1D factors)
+    /// memory-hungry reference), tensor (L non-negative terms fitted to f cos
+    /// theta_i at the tensor's 90 x 90 x 180 nodes, sampled from their 1D
+    /// factors)
     #[param(default = Factored)]
     pub sampling: MeasuredSampling,
     /// L, the terms of the factorization (factored, tensor)
