@@ -186,13 +186,13 @@ impl TensorSampler {
             };
         let (r_edges, phi_edges): (Arc<[f32]>, Arc<[f32]>) = (r_edges.into(), phi_edges.into());
         let (mut conditioning, mut mass, mut u, mut v) = (vec![], vec![], vec![], vec![]);
+        // The sampled radial factor: a (theta_h) in half-diff, b else.
+        let radial = if parameterization == Parameterization::HalfDiff {
+            0
+        } else {
+            1
+        };
         for q in 0..terms {
-            // The sampled radial factor: a (theta_h) in half-diff, b else.
-            let radial = if parameterization == Parameterization::HalfDiff {
-                0
-            } else {
-                1
-            };
             let r_masses: Vec<f32> = r_edges
                 .windows(2)
                 .enumerate()
