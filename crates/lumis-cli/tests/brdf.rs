@@ -18,6 +18,13 @@ fn scratch(name: &str) -> tempfile::TempDir {
         .unwrap()
 }
 
+/// Fails unless `out` contains every one of `wanted`.
+fn assert_mentions(out: &str, wanted: &[&str]) {
+    for want in wanted {
+        assert!(out.contains(want), "missing {want}:\n{out}");
+    }
+}
+
 fn text(o: &Output) -> String {
     format!(
         "{}{}",
@@ -117,16 +124,17 @@ fn tabulate_precompute_and_check_a_measured_table() {
     ]);
     let out = text(&run);
     assert!(run.status.success(), "{out}");
-    for want in [
-        "rank-2 CP tensor over pdv",
-        "table 4374000 floats",
-        "tensor 2160 floats",
-        "2025x smaller",
-        "relative RMSE of f",
-        "PSNR of ln(1 + f)",
-    ] {
-        assert!(out.contains(want), "missing {want}:\n{out}");
-    }
+    assert_mentions(
+        &out,
+        &[
+            "rank-2 CP tensor over pdv",
+            "table 4374000 floats",
+            "tensor 2160 floats",
+            "2025x smaller",
+            "relative RMSE of f",
+            "PSNR of ln(1 + f)",
+        ],
+    );
     // Header, 2160 f32, hash.
     assert_eq!(
         std::fs::metadata(&factors).unwrap().len(),
@@ -148,30 +156,33 @@ fn tabulate_precompute_and_check_a_measured_table() {
     ]);
     let out = text(&run);
     assert!(run.status.success(), "{out}");
-    for want in [
-        "sampling = \"cosine\"",
-        "sampling = \"tabulated\"",
-        "parameterization = \"pdv\"",
-        "parameterization = \"in-out\"",
-        "representation = \"tensor\"",
-        "terms = 16",
-        "passed, 0 failed",
-    ] {
-        assert!(out.contains(want), "missing {want}:\n{out}");
-    }
+    assert_mentions(
+        &out,
+        &[
+            "sampling = \"cosine\"",
+            "sampling = \"tabulated\"",
+            "sampling = \"tensor\"",
+            "parameterization = \"pdv\"",
+            "parameterization = \"in-out\"",
+            "representation = \"tensor\"",
+            "terms = 16",
+            "passed, 0 failed",
+        ],
+    );
     // Without a table the sweep checks the plugin on the kit's analytic
     // stand-ins (`bsdf`), and says why the settings without a source are
     // not tested.
     let run = lumis(&["check-plugin", "--bsdf", "measured", "--samples", "1000"]);
     let out = text(&run);
     assert!(run.status.success(), "{out}");
-    for want in [
-        "bsdf = \"gold\"",
-        "missing: give a MERL table file (or an analytic bsdf)",
-        "passed, 0 failed",
-    ] {
-        assert!(out.contains(want), "missing {want}:\n{out}");
-    }
+    assert_mentions(
+        &out,
+        &[
+            "bsdf = \"gold\"",
+            "missing: give a MERL table file (or an analytic bsdf)",
+            "passed, 0 failed",
+        ],
+    );
     std::fs::remove_dir_all(dir).unwrap();
 }
 
