@@ -145,6 +145,73 @@ fn toml_value(value: &Value) -> Result<toml::Value> {
     })
 }
 
+/// Denoises `color`, guided by `albedo` and `normal` where given.
+pub fn denoise_colour(
+    denoiser: &dyn Denoiser,
+    color: &Image,
+    albedo: Option<&Image>,
+    normal: Option<&Image>,
+) -> Result<Image> {
+    let input = DenoiseInput {
+        width: color.width,
+        height: color.height,
+        color: &color.pixels,
+        albedo: albedo.map(|a| a.pixels.as_slice()),
+        normal: normal.map(|n| n.pixels.as_slice()),
+    };
+    let pixels = denoiser.denoise(&input)?;
+    if pixels.len() != color.pixels.len() {
+        return Err(Error::msg(format!(
+            "the denoiser returned {} pixels, expected {}",
+            pixels.len(),
+            color.pixels.len()
+        )));
+    }
+    Ok(Image {
+        width: color.width,
+        height: color.height,
+        pixels,
+    })
+}
+
+/// Denoises a film's image, guided by its albedo and normal, which a
+/// scene with a denoiser always makes.
+pub fn denoise_film_image(denoiser: &dyn Denoiser, film: &Film) -> Result<Image> {
+    let aovs = film.aov_images();
+    let guide = |wanted: Aov| aovs.iter().find(|(aov, _)| *aov == wanted).map(|(_, i)| i);
+    denoise_colour(
+        denoiser,
+        &film.image(),
+        guide(Aov::Albedo),
+        guide(Aov::Normal),
+    )
+}
+
+/// Writes `denoised` to `outputs` with the header `attributes` and
+/// [`DENOISED_BY`] `denoiser_toml`.
+pub fn write_denoised_image(
+    denoised: &Image,
+    denoiser_toml: &str,
+    outputs: &Outputs,
+    mut attributes: Vec<(String, String)>,
+) -> Result<()> {
+    attributes.retain(|(name, _)| name != DENOISED_BY);
+    attributes.push((DENOISED_BY.into(), denoiser_toml.to_string()));
+    outputs.write_with_channels(denoised, &[], &[], &attributes)
+}
+
+/// The error of a denoise that failed after the raw image at `raw_exr`
+/// was written: it names where the raw render is.
+fn failed_beside(raw_exr: &Path) -> impl Fn(Error) -> Error + '_ {
+    move |e| {
+        Error::msg(format!(
+            "denoising failed; the raw render is in {}: {}",
+            raw_exr.display(),
+            e
+        ))
+    }
+}
+
 /// Denoises `color` (guided by `albedo` and `normal`, where given), writes
 /// the result to `outputs` with the header `attributes` and
 /// [`DENOISED_BY`], and returns it. Called once the raw image is on disk
@@ -155,46 +222,18 @@ pub fn write_denoised(
     albedo: Option<&Image>,
     normal: Option<&Image>,
     outputs: &Outputs,
-    mut attributes: Vec<(String, String)>,
+    attributes: Vec<(String, String)>,
     raw_exr: &Path,
 ) -> Result<Image> {
-    let input = DenoiseInput {
-        width: color.width,
-        height: color.height,
-        color: &color.pixels,
-        albedo: albedo.map(|a| a.pixels.as_slice()),
-        normal: normal.map(|n| n.pixels.as_slice()),
-    };
-    let failed = |e: Error| {
-        Error::msg(format!(
-            "denoising failed; the raw render is in {}: {}",
-            raw_exr.display(),
-            e
-        ))
-    };
-    let pixels = denoiser.denoiser.denoise(&input).map_err(failed)?;
-    if pixels.len() != color.pixels.len() {
-        return Err(failed(Error::msg(format!(
-            "the denoiser returned {} pixels, expected {}",
-            pixels.len(),
-            color.pixels.len()
-        ))));
-    }
-    let denoised = Image {
-        width: color.width,
-        height: color.height,
-        pixels,
-    };
-    attributes.retain(|(name, _)| name != DENOISED_BY);
-    attributes.push((DENOISED_BY.into(), denoiser.toml.clone()));
-    outputs
-        .write_with_channels(&denoised, &[], &[], &attributes)
-        .map_err(failed)?;
+    let failed = failed_beside(raw_exr);
+    let denoised =
+        denoise_colour(denoiser.denoiser.as_ref(), color, albedo, normal).map_err(&failed)?;
+    write_denoised_image(&denoised, &denoiser.toml, outputs, attributes).map_err(&failed)?;
     Ok(denoised)
 }
 
-/// Denoises a finished film (`lumis render`, `lumis merge`), guided by its
-/// albedo and normal, which a scene with a denoiser always makes.
+/// Denoises a finished film (`lumis render`, `lumis merge`), writes the
+/// result beside the raw image at `raw_exr`, and returns it.
 pub fn denoise_film(
     denoiser: &ConfiguredDenoiser,
     film: &Film,
@@ -202,17 +241,11 @@ pub fn denoise_film(
     metadata: &ImageMetadata,
     raw_exr: &Path,
 ) -> Result<Image> {
-    let aovs = film.aov_images();
-    let guide = |wanted: Aov| aovs.iter().find(|(aov, _)| *aov == wanted).map(|(_, i)| i);
-    write_denoised(
-        denoiser,
-        &film.image(),
-        guide(Aov::Albedo),
-        guide(Aov::Normal),
-        outputs,
-        metadata.attributes(),
-        raw_exr,
-    )
+    let failed = failed_beside(raw_exr);
+    let denoised = denoise_film_image(denoiser.denoiser.as_ref(), film).map_err(&failed)?;
+    write_denoised_image(&denoised, &denoiser.toml, outputs, metadata.attributes())
+        .map_err(&failed)?;
+    Ok(denoised)
 }
 
 #[cfg(test)]

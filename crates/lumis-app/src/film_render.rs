@@ -9,11 +9,14 @@ use std::sync::Arc;
 
 use lumis_core::audit::Defects;
 use lumis_core::{Error, RenderStats, Result};
+use lumis_image::Image;
 use lumis_render::{progress_units, Film, PassContext};
 use lumis_scene::{LoadedScene, SceneDocument};
 
 use crate::checkpoint::Checkpoint;
-use crate::denoise::table_toml;
+use crate::denoise::{
+    claim_denoised_outputs, denoise_film_image, table_toml, write_denoised_image,
+};
 use crate::memory::{MemoryBudget, MemoryEstimate};
 use crate::metadata::{lumis_version, ImageMetadata};
 use crate::outputs::Outputs;
@@ -60,6 +63,11 @@ pub struct FilmRender {
     /// The scene's `[denoiser]` as one line of TOML, recorded in the
     /// images written ([`ImageMetadata::denoiser`]).
     pub denoiser: Option<String>,
+    /// The image the scene's `[denoiser]` made of a finished render of all
+    /// the samples, as `lumis render` denoises it; an error where
+    /// denoising failed (the render stands); `None` without a denoiser,
+    /// for a part, or for an interrupted render.
+    pub denoised: Option<Result<Image>>,
 }
 
 /// Renders `loaded` into a film, in passes, until its samples are done or
@@ -135,6 +143,13 @@ pub fn render_film(
     };
     let totals = run_passes(&plan, &mut state, end, |_| Ok(()))?;
     progress.finish();
+    let finished = !totals.interrupted && state.film.samples > state.film.start;
+    let denoised = match &loaded.denoiser {
+        Some(scene) if finished && request.samples.is_none() => {
+            Some(denoise_film_image(scene.denoiser.as_ref(), &state.film))
+        }
+        _ => None,
+    };
     Ok(FilmRender {
         film: state.film,
         seed: loaded.seed,
@@ -149,6 +164,7 @@ pub fn render_film(
             .as_ref()
             .map(|d| table_toml(&d.entity.table))
             .transpose()?,
+        denoised,
     })
 }
 
@@ -173,11 +189,18 @@ impl FilmRender {
         defect_warnings(&self.defects)
     }
 
+    /// The denoised image, where the render has one ([`Self::denoised`]).
+    pub fn denoised_image(&self) -> Option<&Image> {
+        self.denoised.as_ref()?.as_ref().ok()
+    }
+
     /// Writes the render as `lumis render` would have: `PATH.exr` and
     /// `PATH.png` for `output` (a directory gets `NAME.exr`), the EXR's
-    /// header saying what `document` rendered; a slice writes its partial
-    /// EXR for `lumis merge`. An image of this scene with more samples is
-    /// not replaced unless `force`. Returns the files written.
+    /// header saying what `document` rendered, and its denoised image as
+    /// `PATH.denoised.exr` and `.png` where it has one; a slice writes its
+    /// partial EXR for `lumis merge`. An image of this scene with more
+    /// samples is not replaced unless `force`. Returns the raw image's
+    /// files.
     pub fn write(
         &self,
         output: &Path,
@@ -195,6 +218,10 @@ impl FilmRender {
         let (exr, png) = output_paths(output, &document.name);
         let png = self.slice.is_none().then_some(png);
         let outputs = Outputs::claim(&exr, png.as_deref())?;
+        let denoised = match (self.denoised_image(), &self.denoiser) {
+            (Some(image), Some(toml)) => Some((image, toml, claim_denoised_outputs(&exr)?)),
+            _ => None,
+        };
         let scene_hash = document.hash()?;
         if self.slice.is_none() {
             refuse_fewer_samples(&exr, scene_hash, self.spp(), force)?;
@@ -211,6 +238,7 @@ impl FilmRender {
             slice: self.slice,
             denoiser: self.denoiser.clone(),
         };
+        let attributes = metadata.attributes();
         match self.slice {
             Some(_) => Partial {
                 film: self.film.clone(),
@@ -218,6 +246,9 @@ impl FilmRender {
             }
             .write(&outputs)?,
             None => outputs.write(&self.film.image(), &self.film.aov_images(), &metadata)?,
+        }
+        if let Some((image, toml, outputs)) = denoised {
+            write_denoised_image(image, toml, &outputs, attributes)?;
         }
         Ok((exr, png))
     }

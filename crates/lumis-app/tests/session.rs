@@ -10,6 +10,7 @@ use lumis_app::{
     builtin_registry, render, render_film, FilmRequest, ImageMetadata, Progress, RenderArgs,
     SampleSlice, Session,
 };
+use lumis_core::{DenoiseInput, Denoiser, Params, PluginKind, PluginParams, PluginSpec, Registrar};
 use lumis_scene::SceneDocument;
 
 fn scene(name: &str) -> PathBuf {
@@ -185,4 +186,104 @@ fn a_render_in_memory_is_the_render_to_files() {
         refused.message.contains("expected sample indices"),
         "{refused}"
     );
+}
+
+/// A denoiser that halves the colour, or (`fails = true`) fails.
+struct Halving {
+    fails: bool,
+}
+
+impl Denoiser for Halving {
+    fn denoise(&self, input: &DenoiseInput<'_>) -> lumis_core::Result<Vec<[f32; 3]>> {
+        match self.fails {
+            true => Err(lumis_core::Error::msg("no device")),
+            false => Ok(input.color.iter().map(|c| c.map(|v| 0.5 * v)).collect()),
+        }
+    }
+}
+
+#[derive(Debug, PluginParams)]
+struct HalvingParams {
+    /// fail instead
+    #[param(default = false)]
+    fails: bool,
+}
+
+const HALVING: PluginSpec = PluginSpec {
+    kind: PluginKind::Denoiser,
+    name: "halving",
+    source: lumis_api::source_file!(),
+    doc: "halves the colour, or fails",
+    params: HalvingParams::SPECS,
+};
+
+fn halving(params: &Params) -> lumis_core::Result<Box<dyn Denoiser>> {
+    let p = HalvingParams::read(params)?;
+    Ok(Box::new(Halving { fails: p.fails }))
+}
+
+/// A render in memory of a scene with a `[denoiser]` denoises its image
+/// once finished, and writes it beside the raw one; a part is not
+/// denoised; a denoiser that fails leaves the render, with the error.
+#[test]
+fn a_render_in_memory_runs_the_scenes_denoiser() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut registry = builtin_registry().unwrap();
+    registry.add_denoiser(HALVING, halving).unwrap();
+    let stop = AtomicBool::new(false);
+    let session = Session::silent(&registry, &stop);
+    let document = SceneDocument::read(&scene("cornell-box.toml"))
+        .unwrap()
+        .with_overrides(vec!["film.resolution=[16, 16]".into()]);
+    let load = |denoiser: &str| {
+        let set = ["sampler.spp=2".to_string(), denoiser.to_string()];
+        document.load(&set, &registry).unwrap()
+    };
+    let request = FilmRequest {
+        threads: 2,
+        ..Default::default()
+    };
+
+    let loaded = load("denoiser.type=\"halving\"");
+    let rendered = render_film(&loaded, &request, &session).unwrap();
+    let halved: Vec<[f32; 3]> = rendered
+        .film
+        .image()
+        .pixels
+        .iter()
+        .map(|c| c.map(|v| 0.5 * v))
+        .collect();
+    assert_eq!(rendered.denoised_image().unwrap().pixels, halved);
+    let (exr, _) = rendered
+        .write(&dir.path().join("box"), &document, false)
+        .unwrap();
+    let denoised_exr = dir.path().join("box.denoised.exr");
+    assert!(exr.exists() && denoised_exr.exists());
+    assert!(dir.path().join("box.denoised.png").exists());
+    let image = lumis_image::read_exr(&denoised_exr).unwrap();
+    assert_eq!(image.pixels, halved);
+
+    let part = FilmRequest {
+        samples: Some(SampleSlice {
+            start: 0,
+            end: 1,
+            total: 2,
+        }),
+        ..request.clone()
+    };
+    assert!(render_film(&loaded, &part, &session)
+        .unwrap()
+        .denoised
+        .is_none());
+
+    let failing = load("denoiser={ type = \"halving\", fails = true }");
+    let rendered = render_film(&failing, &request, &session).unwrap();
+    let error = rendered.denoised.as_ref().unwrap().as_ref().unwrap_err();
+    assert!(error.to_string().contains("no device"), "{error}");
+    assert_eq!(rendered.spp(), 2);
+    rendered
+        .write(&dir.path().join("failed"), &document, false)
+        .unwrap();
+    assert!(dir.path().join("failed.exr").exists());
+    assert!(!dir.path().join("failed.denoised.exr").exists());
 }

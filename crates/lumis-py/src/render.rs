@@ -114,6 +114,10 @@ pub fn run(
         let line = line.strip_prefix("warning: ").unwrap_or(line);
         warnings.call_method1("warn", (line,))?;
     }
+    if let Some(Err(e)) = &rendered.denoised {
+        let line = format!("denoising failed, the render's `denoised` is None: {e}");
+        warnings.call_method1("warn", (line,))?;
+    }
     Ok((rendered, stopped_by))
 }
 
@@ -125,6 +129,7 @@ pub struct Render {
     document: SceneDocument,
     image: Py<PyAny>,
     aovs: Py<PyDict>,
+    denoised: Option<Py<PyAny>>,
 }
 
 impl Render {
@@ -134,11 +139,16 @@ impl Render {
         for (aov, image) in film.film.aov_images() {
             aovs.set_item(aov.name(), array_of(py, image, aov.channels().len())?)?;
         }
+        let denoised = film
+            .denoised_image()
+            .map(|image| Ok::<_, PyErr>(array_of(py, image.clone(), 3)?.unbind()))
+            .transpose()?;
         Ok(Self {
             film,
             document,
             image,
             aovs: aovs.unbind(),
+            denoised,
         })
     }
 
@@ -178,6 +188,14 @@ impl Render {
     #[getter]
     fn aovs(&self, py: Python<'_>) -> Py<PyDict> {
         self.aovs.clone_ref(py)
+    }
+
+    /// The image the scene's `[denoiser]` made of the finished render,
+    /// as `lumis render` denoises it (shape and type as `image`); `None`
+    /// without a denoiser, for a part of the samples, or when interrupted.
+    #[getter]
+    fn denoised(&self, py: Python<'_>) -> Option<Py<PyAny>> {
+        self.denoised.as_ref().map(|d| d.clone_ref(py))
     }
 
     /// Samples per pixel in the image.
@@ -248,10 +266,11 @@ impl Render {
     }
 
     /// Writes `PATH.exr` and `PATH.png` as `lumis render -o PATH` would,
-    /// with the same metadata in the EXR's header (a render of a slice of
-    /// the samples writes its partial EXR, for `lumis merge`). An image of
-    /// this scene with more samples is kept unless `force`. Returns the
-    /// paths written.
+    /// with the same metadata in the EXR's header, and the denoised image
+    /// as `PATH.denoised.exr` and `.png` where there is one (a render of a
+    /// slice of the samples writes its partial EXR, for `lumis merge`). An
+    /// image of this scene with more samples is kept unless `force`.
+    /// Returns the raw image's paths.
     #[pyo3(signature = (path, force=false))]
     fn write(
         &self,

@@ -78,6 +78,28 @@ def test_write_makes_the_command_lines_files(cornell_box, tmp_path):
     fewer.write(tmp_path / "box", force=True)
 
 
+def test_a_scenes_denoiser_runs_as_the_command_lines(cornell_box, cli, tmp_path):
+    denoiser = {"denoiser.type": "oidn", "denoiser.quality": "fast"}
+    render = small(cornell_box, **denoiser).render(spp=2, seed=4, progress=False)
+    assert render.denoised.dtype == np.float32
+    assert render.denoised.shape == (32, 32, 3)
+    assert not np.array_equal(render.denoised, render.image)
+    cli("render", cornell_box, "--spp", 2, "--seed", 4, "--set", f"film.resolution={RESOLUTION}",
+        "--set", 'denoiser.type="oidn"', "--set", 'denoiser.quality="fast"',
+        "-o", tmp_path / "cli", "--no-checkpoint", "-q")
+    assert np.array_equal(render.image, lumis.read_image(tmp_path / "cli.exr"))
+    assert np.array_equal(render.denoised, lumis.read_image(tmp_path / "cli.denoised.exr"))
+    render.write(tmp_path / "py")
+    assert np.array_equal(lumis.read_image(tmp_path / "py.denoised.exr"), render.denoised)
+    assert (tmp_path / "py.denoised.png").is_file()
+    # A part of the samples is not denoised, nor a scene without a denoiser.
+    part = small(cornell_box, **denoiser).render(spp=2, samples=range(0, 1), progress=False)
+    assert part.denoised is None
+    part.write(tmp_path / "part")
+    assert not (tmp_path / "part.denoised.exr").exists()
+    assert small(cornell_box).render(spp=1, progress=False).denoised is None
+
+
 def test_outputs_statistics_and_notebook_display(cornell_box):
     scene = small(cornell_box, **{"film.aovs": ["albedo", "depth", "variance"]})
     render = scene.render(spp=2, progress=False)
