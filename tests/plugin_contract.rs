@@ -14,7 +14,7 @@ use lumis_core::light::LightSampleLanes;
 use lumis_core::wrap::Wrapped;
 use lumis_core::{
     Bsdf, BsdfContext, BsdfScope, DenoiseInput, Denoiser, Integrator, Light, LightInput,
-    LightSampleContext, LightSampler, LightShape, Location, PluginEntity, PluginInterface,
+    LightSampleContext, LightSampler, LightShape, Location, Pinhole, PluginEntity, PluginInterface,
     PluginKind, Ray, Registry, RenderStats, Rgb, Sampler, Scene, SurfaceInteraction, Texture,
     TextureQuery, UVec2, Vec2, Vec3,
 };
@@ -135,6 +135,11 @@ fn check_light(light: &mut dyn Light, how: &str) {
     light.sample_li_lanes(&[ctx; LANES], &Vec2Lanes::default(), active, &mut lanes);
     assert_eq!(lanes.valid, active, "{how}");
     assert_eq!(lanes.get(7), Some(LIGHT_SAMPLE_LANES), "{how}");
+    assert_eq!(
+        light.sample_le(Vec2::ZERO, Vec2::ZERO),
+        Some(LIGHT_EMISSION),
+        "{how}"
+    );
     assert_eq!(light.pdf_li(&ctx, Vec3::Y), LIGHT_PDF, "{how}");
     assert_eq!(
         light.l(Vec3::ZERO, Vec3::Z, Vec2::ZERO, Vec3::Z),
@@ -190,6 +195,25 @@ fn check_integrator(integrator: &dyn Integrator, lanes_of: &dyn Sampler, how: &s
         LI,
         "{how}"
     );
+    assert!(integrator.splats(), "{how}");
+    let camera = Pinhole {
+        origin: Vec3::ZERO,
+        forward: Vec3::Z,
+        top_left: Vec3::new(-1.0, 1.0, 1.0),
+        per_pixel_x: Vec3::X,
+        per_pixel_y: -Vec3::Y,
+        resolution: UVec2::new(2, 2),
+    };
+    let mut splats = Vec::new();
+    let li = integrator.li_splat(
+        &ray,
+        &Empty,
+        &camera,
+        sampler.as_mut(),
+        &mut |raster, l| splats.push((raster, l)),
+        &mut stats,
+    );
+    assert_eq!((li, splats), (LI_SPLAT, vec![SPLAT]), "{how}");
     assert_eq!(integrator.batch_size(), BATCH_SIZE, "{how}");
     let mut lanes = lanes_of.lanes(2);
     let mut out = [Rgb::BLACK; 2];

@@ -25,7 +25,7 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering::Relaxed};
 use glam::{Vec2, Vec3};
 
 use crate::bsdf::{BsdfEvalLanes, BsdfFlags, BsdfSample, BsdfSampleLanes};
-use crate::light::{LightKind, LightSample, LightSampleLanes};
+use crate::light::{EmissionSample, LightKind, LightSample, LightSampleLanes};
 use crate::light_bounds::LightBounds;
 use crate::light_sampler::SampledLight;
 use crate::sampler::PixelPattern;
@@ -158,6 +158,16 @@ impl Answer for LightSample {
         self.l.audit(tally);
         self.pdf.audit(tally);
         audit_direction(self.wi, tally);
+    }
+}
+
+impl Answer for EmissionSample {
+    #[inline]
+    fn audit(&self, tally: &Tally) {
+        self.l.audit(tally);
+        self.pdf_pos.audit(tally);
+        self.pdf_dir.audit(tally);
+        audit_direction(self.d, tally);
     }
 }
 

@@ -1,10 +1,12 @@
 //! The integrator plugin interface.
 
+use crate::camera::Pinhole;
 use crate::ray::Ray;
 use crate::sampler::{Sampler, SamplerLanes};
 use crate::scene::Scene;
 use crate::spectrum::Rgb;
 use crate::stats::RenderStats;
+use glam::Vec2;
 use lumis_derive::plugin_interface;
 
 /// Estimates the radiance arriving along a camera ray.
@@ -20,6 +22,36 @@ pub trait Integrator: Send + Sync {
         sampler: &mut dyn Sampler,
         stats: &mut RenderStats,
     ) -> Rgb;
+
+    /// Whether the integrator adds light to the film beyond each camera
+    /// ray's own pixel, with [`Integrator::li_splat`] (paths from the
+    /// lights, seen by the camera where they land): the driver then calls
+    /// `li_splat` for every camera ray, and the film keeps the splats.
+    /// False by default.
+    #[on_fault(false)]
+    fn splats(&self) -> bool {
+        false
+    }
+
+    /// [`Integrator::li`] for an integrator that [`Integrator::splats`]:
+    /// the estimate along `ray`, and the light found elsewhere on the film
+    /// through `camera`, each added with `splat(raster, radiance)`. The
+    /// film divides the splats by its samples per pixel, so each call
+    /// stands for one pixel sample of the film (pbrt-v4 `Film::AddSplat`).
+    /// The default is `li`, splatting nothing.
+    #[on_fault(Rgb::BLACK)]
+    fn li_splat(
+        &self,
+        ray: &Ray,
+        scene: &dyn Scene,
+        camera: &Pinhole,
+        sampler: &mut dyn Sampler,
+        splat: &mut dyn FnMut(Vec2, Rgb),
+        stats: &mut RenderStats,
+    ) -> Rgb {
+        let _ = (camera, splat);
+        self.li(ray, scene, sampler, stats)
+    }
 
     /// How many camera rays [`Integrator::li_batch`] wants at once; 1 (the
     /// default): the driver calls [`Integrator::li`] ray by ray.

@@ -19,6 +19,7 @@ extern crate self as lumis_api;
 
 pub mod audit;
 pub mod bsdf;
+pub mod camera;
 pub mod denoiser;
 pub mod doc;
 pub mod error;
@@ -44,6 +45,7 @@ pub mod texture;
 pub mod wrap;
 
 pub use bsdf::{Bsdf, BsdfContext, BsdfFlags, BsdfSample, TransportMode};
+pub use camera::{CameraSample, Pinhole};
 pub use denoiser::{DenoiseInput, Denoiser};
 pub use error::{Error, Location, Result};
 pub use footprint::{PackedFootprint, PixelFootprint};
@@ -51,7 +53,7 @@ pub use image::{DecodedImage, ImageValues};
 pub use integrator::Integrator;
 pub use interaction::{LightIndex, LightSampleContext, SurfaceInteraction};
 pub use lanes::{LaneMask, LANES};
-pub use light::{Light, LightInput, LightKind, LightSample, LightShape};
+pub use light::{EmissionSample, Light, LightInput, LightKind, LightSample, LightShape};
 pub use light_bounds::{Aabb, DirectionCone, LightBounds};
 pub use light_sampler::{LightSampler, SampledLight};
 pub use math::Frame;

@@ -33,6 +33,38 @@ pub struct LightSample {
     pub p: SurfacePoint,
 }
 
+/// A ray of emitted light ([`Light::sample_le`]), where a path traced
+/// from the lights starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmissionSample {
+    /// The ray's origin, with its error bound and the light's normal there
+    /// (zero for a point light; the ray's direction on the disk an
+    /// infinite light shines through).
+    pub p: SurfacePoint,
+    /// Unit direction of the emitted light.
+    pub d: Vec3,
+    /// Radiance along the ray (intensity, W/sr, for a point light).
+    pub l: Rgb,
+    /// Density of the origin w.r.t. area (1 for a point light).
+    pub pdf_pos: f32,
+    /// Density of the direction w.r.t. solid angle.
+    pub pdf_dir: f32,
+}
+
+impl EmissionSample {
+    /// The power the ray carries: `L |cos theta| / (pdf_pos pdf_dir)`, with
+    /// the cosine at the origin's normal (1 for a point light), as the
+    /// weight of a path from the light (pbrt-v4 `LightTracer`).
+    pub fn beta(&self) -> Rgb {
+        let cos = if self.p.n == Vec3::ZERO {
+            1.0
+        } else {
+            self.p.n.dot(self.d).abs()
+        };
+        self.l * (cos / (self.pdf_pos * self.pdf_dir))
+    }
+}
+
 /// The geometry an area light is attached to, handed to its factory.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LightShape {
@@ -173,6 +205,18 @@ pub trait Light: Send + Sync {
         out: &mut LightSampleLanes,
     ) {
         sample_li_each_lane(self, ctx, u, active, out)
+    }
+
+    /// A ray of light leaving the light, for paths traced from the lights
+    /// (pbrt-v4 `Light::SampleLe`): its origin from `u_pos`, its direction
+    /// from `u_dir`. `None` where `u` gives no ray (zero emission there).
+    /// A light that cannot start such paths keeps the default, `None`
+    /// always, and integrators that trace from the lights refuse a scene
+    /// holding it.
+    #[on_fault(None)]
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let _ = (u_pos, u_dir);
+        None
     }
 
     /// Density w.r.t. solid angle with which `sample_li` from `ctx` returns

@@ -14,13 +14,14 @@
 //! "LUMISCKP" version:u32 width:u32 height:u32 samples:u32 spp:u32 aovs:u32
 //! passes:u64 seed:u64 scene_hash:u64 seconds:f64 sums:[f64; 3 * width * height]
 //! squares:[f64; 3 * width * height]? first_hits:[f64; 7 * width * height]?
-//! adaptive? checksum:u64
+//! adaptive? splats:[i64; 3 * width * height]? checksum:u64
 //! ```
 //!
 //! With adaptive sampling (bit 31 of `aovs`), `adaptive` is its settings
 //! and per-pixel state: `min_spp:u32 max_spp:u32 threshold:f32
 //! counts:[u32; width * height] odd_sums:[f64; 3 * width * height]
-//! active:[u8; width * height]`.
+//! active:[u8; width * height]`. With an integrator that splats (bit 30),
+//! `splats` are the film's splat sums.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -37,6 +38,10 @@ const HEADER_BYTES: usize = 8 + 6 * 4 + 4 * 8;
 const FIRST_HIT_VALUES: usize = 7;
 /// The bit of the `aovs` mask saying the film samples adaptively.
 const ADAPTIVE_BIT: u32 = 1 << 31;
+/// The bit of the `aovs` mask saying the film holds splats.
+const SPLATS_BIT: u32 = 1 << 30;
+/// Bytes per pixel of the splat sums.
+const SPLAT_PIXEL_BYTES: usize = 24;
 /// Bytes per pixel of the adaptive state: count, odd sums, active flag.
 const ADAPTIVE_PIXEL_BYTES: usize = 4 + 24 + 1;
 /// A checkpoint: a film's sums, far below this for any film lumis
@@ -80,7 +85,8 @@ impl Checkpoint {
                     ADAPTIVE_BIT
                 } else {
                     0
-                },
+                }
+                | if film.splats.is_some() { SPLATS_BIT } else { 0 },
         ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
@@ -114,6 +120,9 @@ impl Checkpoint {
                 out.extend_from_slice(&value.to_le_bytes());
             }
             out.extend(adaptive.active.iter().map(|&a| a as u8));
+        }
+        for value in film.splats.iter().flatten().flatten() {
+            out.extend_from_slice(&value.to_le_bytes());
         }
         let mut hash = Fnv1a::default();
         hash.write(&out);
@@ -161,7 +170,8 @@ impl Checkpoint {
         }
         let (width, height) = (u32_at(12) as usize, u32_at(16) as usize);
         let adaptive = u32_at(28) & ADAPTIVE_BIT != 0;
-        let mask = u32_at(28) & !ADAPTIVE_BIT;
+        let splats = u32_at(28) & SPLATS_BIT != 0;
+        let mask = u32_at(28) & !(ADAPTIVE_BIT | SPLATS_BIT);
         let aovs: Vec<Aov> = Aov::ALL
             .into_iter()
             .filter(|a| mask & a.bit() != 0)
@@ -183,6 +193,10 @@ impl Checkpoint {
             12 + pixels * ADAPTIVE_PIXEL_BYTES
         } else {
             0
+        } + if splats {
+            pixels * SPLAT_PIXEL_BYTES
+        } else {
+            0
         };
         if rest.len() != expected_rest {
             return Err(format!("its size does not fit a {width}x{height} film"));
@@ -190,6 +204,19 @@ impl Checkpoint {
         let mut film =
             Film::try_with_aovs(lumis_core::UVec2::new(width as u32, height as u32), &aovs)
                 .map_err(|e| e.to_string())?;
+        let (rest, splat_bytes) =
+            rest.split_at(rest.len() - splats as usize * pixels * SPLAT_PIXEL_BYTES);
+        if splats {
+            let sums = film.splat_sums().map_err(|e| e.to_string())?;
+            for (pixel, bytes) in sums
+                .iter_mut()
+                .zip(splat_bytes.chunks_exact(SPLAT_PIXEL_BYTES))
+            {
+                *pixel = std::array::from_fn(|c| {
+                    i64::from_le_bytes(bytes[c * 8..c * 8 + 8].try_into().unwrap())
+                });
+            }
+        }
         if adaptive {
             let u32_of = |i: usize| u32::from_le_bytes(rest[i..i + 4].try_into().unwrap());
             let settings = AdaptiveSampling::new(u32_of(0), u32_of(4), f32::from_bits(u32_of(8)))
@@ -292,6 +319,18 @@ mod tests {
         let back = Checkpoint::from_bytes(&saved.to_bytes()).unwrap();
         assert_eq!(back, saved);
         assert_eq!(back.film.aovs, [Aov::Normal, Aov::Variance, Aov::Spp]);
+    }
+
+    #[test]
+    fn the_splats_round_trip_exactly() {
+        let mut saved = example();
+        saved
+            .film
+            .splat_sums()
+            .unwrap()
+            .copy_from_slice(&[[1, -2, i64::MAX], [0, i64::MIN, 7]]);
+        let back = Checkpoint::from_bytes(&saved.to_bytes()).unwrap();
+        assert_eq!(back, saved);
     }
 
     #[test]

@@ -99,12 +99,7 @@ pub fn render_film(
         }
     }
     let resolution = loaded.camera.resolution();
-    let memory = MemoryEstimate::of(
-        loaded.scene.load_report(),
-        resolution,
-        &loaded.aovs,
-        loaded.adaptive.is_some(),
-    );
+    let memory = MemoryEstimate::of(loaded);
     memory.check(&MemoryBudget::of(request.max_memory))?;
     let mut state = Checkpoint {
         film: empty_film(loaded)?.starting_at(request.samples.map_or(0, |s| s.start)),

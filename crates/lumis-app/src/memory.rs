@@ -4,8 +4,8 @@
 //! signal then takes minutes to act) or being killed.
 
 use lumis_core::{Error, Result, UVec2};
-use lumis_render::{Aov, Film};
-use lumis_scene::LoadReport;
+use lumis_render::Film;
+use lumis_scene::LoadedScene;
 
 /// Bytes per pixel of the images a save writes beside the film's sums:
 /// the float colour and the PNG's bytes.
@@ -25,8 +25,16 @@ pub struct MemoryEstimate {
 }
 
 impl MemoryEstimate {
-    pub fn of(report: &LoadReport, resolution: UVec2, aovs: &[Aov], adaptive: bool) -> Self {
-        let film = Film::memory_bytes(resolution, aovs, adaptive);
+    /// What rendering `loaded` holds.
+    pub fn of(loaded: &LoadedScene) -> Self {
+        let (resolution, aovs) = (loaded.camera.resolution(), &loaded.aovs);
+        let report = loaded.scene.load_report();
+        let film = Film::memory_bytes(
+            resolution,
+            aovs,
+            loaded.adaptive.is_some(),
+            loaded.integrator.splats(),
+        );
         let pixels = u64::from(resolution.x) * u64::from(resolution.y);
         let output_channels: u64 = aovs.iter().map(|a| a.channels().len() as u64).sum();
         let images = pixels.saturating_mul(SAVED_IMAGE_BYTES_PER_PIXEL + 4 * output_channels);

@@ -9,8 +9,9 @@
 //! whole-number channels, `partial.NAME.C.hi` and `partial.NAME.C.lo`,
 //! for `NAME.C` in `sum.{R,G,B}`, `square.{R,G,B}` (with the `variance`
 //! output), `albedo_sum.{R,G,B}`, `normal_sum.{X,Y,Z}` and `depth_sum.Z`
-//! (with `albedo`, `normal` or `depth`), and each pixel's sample count in
-//! `partial.count`. The header holds the [`ImageMetadata`] with its
+//! (with `albedo`, `normal` or `depth`), the bits of the splat sums of an
+//! integrator that splats, `i64`s in `partial.splat.{R,G,B}.hi` and
+//! `.lo`, and each pixel's sample count in `partial.count`. The header holds the [`ImageMetadata`] with its
 //! `lumis.slice` and `lumis.total_spp`, the outputs in `lumis.aovs`, and
 //! `lumis.checksum`, the FNV-1a hash of the whole-number channels, so a
 //! damaged file is refused rather than merged.
@@ -80,6 +81,22 @@ fn component_mut<'a>(film: &'a mut Film, name: &str, i: usize) -> Option<&'a mut
     }
 }
 
+/// The splat sums' channels, by colour.
+const SPLAT_CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// The channels `partial.NAME.hi` and `.lo` of 64-bit values' bits.
+fn push_bits(out: &mut Vec<(String, Vec<u32>)>, name: &str, bits: impl Iterator<Item = u64>) {
+    let bits: Vec<u64> = bits.collect();
+    out.push((
+        format!("partial.{name}.hi"),
+        bits.iter().map(|b| (b >> 32) as u32).collect(),
+    ));
+    out.push((
+        format!("partial.{name}.lo"),
+        bits.iter().map(|&b| b as u32).collect(),
+    ));
+}
+
 /// FNV-1a of the channels, names and values, in name order.
 fn checksum(channels: &[(String, Vec<u32>)]) -> u64 {
     let mut sorted: Vec<&(String, Vec<u32>)> = channels.iter().collect();
@@ -104,15 +121,13 @@ impl Partial {
     fn channels(&self) -> Vec<(String, Vec<u32>)> {
         let mut out = Vec::new();
         for (name, values) in sum_components(&self.film) {
-            let bits: Vec<u64> = values.iter().map(|v| v.to_bits()).collect();
-            out.push((
-                format!("partial.{name}.hi"),
-                bits.iter().map(|b| (b >> 32) as u32).collect(),
-            ));
-            out.push((
-                format!("partial.{name}.lo"),
-                bits.iter().map(|&b| b as u32).collect(),
-            ));
+            push_bits(&mut out, &name, values.iter().map(|v| v.to_bits()));
+        }
+        if let Some(splats) = &self.film.splats {
+            for (c, channel) in SPLAT_CHANNELS.iter().enumerate() {
+                let bits = splats.iter().map(|s| s[c] as u64);
+                push_bits(&mut out, &format!("splat.{channel}"), bits);
+            }
         }
         let counts = (0..self.film.sums.len()).map(|i| self.film.samples_of(i));
         out.push((COUNT_CHANNEL.to_string(), counts.collect()));
@@ -196,13 +211,28 @@ impl Partial {
                 slice.spp()
             )));
         }
-        for (name, _) in sum_components(&film) {
+        let bits = |name: &str| -> Result<Vec<u64>> {
             let hi = channel(&format!("partial.{name}.hi"))?;
             let lo = channel(&format!("partial.{name}.lo"))?;
-            for (i, (&hi, &lo)) in hi.iter().zip(lo).enumerate() {
+            Ok(hi
+                .iter()
+                .zip(lo)
+                .map(|(&hi, &lo)| (hi as u64) << 32 | lo as u64)
+                .collect())
+        };
+        for (name, _) in sum_components(&film) {
+            for (i, bits) in bits(&name)?.into_iter().enumerate() {
                 let value = component_mut(&mut film, &name, i)
                     .ok_or_else(|| not_partial(&format!("no buffer for {name}")))?;
-                *value = f64::from_bits((hi as u64) << 32 | lo as u64);
+                *value = f64::from_bits(bits);
+            }
+        }
+        if channel("partial.splat.R.hi").is_ok() {
+            let by_colour = SPLAT_CHANNELS.map(|c| bits(&format!("splat.{c}")));
+            let [r, g, b] = by_colour;
+            let (r, g, b) = (r?, g?, b?);
+            for (i, sum) in film.splat_sums()?.iter_mut().enumerate() {
+                *sum = [r[i] as i64, g[i] as i64, b[i] as i64];
             }
         }
         Ok(Self { film, metadata })

@@ -204,12 +204,7 @@ pub fn render(args: &RenderArgs, session: &Session) -> Result<RenderReport> {
         return Err(Error::msg("spp must be at least 1"));
     }
     let slice = args.sample_slice(spp)?;
-    let memory = MemoryEstimate::of(
-        loaded.scene.load_report(),
-        loaded.camera.resolution(),
-        &loaded.aovs,
-        loaded.adaptive.is_some(),
-    );
+    let memory = MemoryEstimate::of(&loaded);
     let budget = MemoryBudget::of(args.max_memory);
     if !args.quiet {
         session.note(&memory.line(&budget));

@@ -1,7 +1,7 @@
 //! A pinhole perspective camera.
 
 use lumis_core::glam::Vec3A;
-use lumis_core::{Error, PixelFootprint, Ray, Result, UVec2, Vec2, Vec3};
+use lumis_core::{Error, Pinhole, PixelFootprint, Ray, Result, UVec2, Vec2, Vec3};
 
 /// A pinhole camera at `origin` looking at `target`. `fov` is the full
 /// angle of the image's smaller axis (the vertical one for landscape and
@@ -85,15 +85,32 @@ impl PerspectiveCamera {
         self.resolution
     }
 
-    /// The pixel spacing textures filter over, at `spp` samples per pixel
-    /// ([`PixelFootprint`]).
-    pub fn pixel_footprint(&self, spp: u32) -> PixelFootprint {
+    /// The camera as paths from the lights see it.
+    pub fn pinhole(&self) -> Pinhole {
+        Pinhole {
+            origin: self.origin,
+            forward: self.forward(),
+            top_left: self.top_left.into(),
+            per_pixel_x: self.per_pixel_x.into(),
+            per_pixel_y: self.per_pixel_y.into(),
+            resolution: self.resolution,
+        }
+    }
+
+    /// The unit direction through the centre of the film.
+    fn forward(&self) -> Vec3 {
         let centre = self.top_left
             + 0.5 * self.resolution.x as f32 * self.per_pixel_x
             + 0.5 * self.resolution.y as f32 * self.per_pixel_y;
+        centre.normalize().into()
+    }
+
+    /// The pixel spacing textures filter over, at `spp` samples per pixel
+    /// ([`PixelFootprint`]).
+    pub fn pixel_footprint(&self, spp: u32) -> PixelFootprint {
         PixelFootprint {
             origin: self.origin,
-            forward: centre.normalize().into(),
+            forward: self.forward(),
             per_pixel_x: self.per_pixel_x.into(),
             per_pixel_y: self.per_pixel_y.into(),
             scale: PixelFootprint::spp_scale(spp),

@@ -7,7 +7,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use lumis_core::{
-    Error, Integrator, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene, UVec2, Vec3,
+    Error, Integrator, Pinhole, Ray, RenderStats, Result, Rgb, Sampler, SamplerLanes, Scene, UVec2,
+    Vec3,
 };
 use lumis_image::Image;
 use rayon::prelude::*;
@@ -17,6 +18,7 @@ use crate::film::Film;
 use crate::first_hit::{first_hit, first_hit_rng};
 use crate::profile::{self, Stage};
 use crate::progress::RenderProgress;
+use crate::splat::SplatBuffer;
 
 /// Tile edge in pixels: small enough to balance load, large enough that
 /// per-tile overhead (sampler clone, progress update) does not show.
@@ -87,7 +89,9 @@ struct Batch {
 
 impl Batch {
     /// Traces the filled lanes and adds their radiance (clamped, where the
-    /// scene asks) to their pixels in `film`, in lane order.
+    /// scene asks) to their pixels in `film`, in lane order; an integrator
+    /// that splats adds its splats to `splats`, clamped the same way.
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         &mut self,
         scene: &dyn Scene,
@@ -96,19 +100,30 @@ impl Batch {
         stats: &mut RenderStats,
         film: &mut Film,
         clamp: Option<f32>,
+        splats: Option<&Splats>,
     ) {
         let n = std::mem::take(&mut self.filled);
         if n == 0 {
             return;
         }
-        profile::in_stage(Stage::Integrator, || {
-            integrator.li_batch(
+        let clamped = |l: Rgb| clamp.map_or(l, |max| l.clamp_max_component(max));
+        profile::in_stage(Stage::Integrator, || match splats {
+            None => integrator.li_batch(
                 &self.rays[..n],
                 scene,
                 lanes,
                 stats,
                 &mut self.radiance[..n],
-            )
+            ),
+            Some(splats) => {
+                let mut splat = |raster, l| splats.buffer.add(raster, clamped(l));
+                for (lane, (ray, out)) in self.rays[..n].iter().zip(&mut self.radiance).enumerate()
+                {
+                    *out = lanes.with_lane(lane, |sampler| {
+                        integrator.li_splat(ray, scene, &splats.camera, sampler, &mut splat, stats)
+                    });
+                }
+            }
         });
         let lanes = self.pixel_of_lane[..n].iter().zip(&self.index_of_lane);
         for ((&i, &index), l) in lanes.zip(&self.radiance) {
@@ -118,12 +133,16 @@ impl Batch {
                 stats.nonfinite += 1;
                 continue;
             }
-            match clamp {
-                Some(max) => film.add_sample(i, index, l.clamp_max_component(max)),
-                None => film.add_sample(i, index, *l),
-            }
+            film.add_sample(i, index, clamped(*l));
         }
     }
+}
+
+/// Where the paths of an integrator that splats add their light: the
+/// run's sums, and the camera they are seen through.
+struct Splats {
+    buffer: SplatBuffer,
+    camera: Pinhole,
 }
 
 /// Renders sample indices `samples` of one tile, adding them to `film`
@@ -148,6 +167,7 @@ fn render_tile(
     clamp: Option<f32>,
     samples: Range<u32>,
     mut film: Film,
+    splats: Option<&Splats>,
     stop: &AtomicBool,
 ) -> Option<(Film, RenderStats)> {
     profile::enter_worker();
@@ -197,7 +217,9 @@ fn render_tile(
                     batch.filled += 1;
                 }
             }
-            batch.trace(scene, integrator, lanes, &mut stats, &mut film, clamp);
+            batch.trace(
+                scene, integrator, lanes, &mut stats, &mut film, clamp, splats,
+            );
         }
     }
     Some((film, stats))
@@ -306,6 +328,23 @@ fn render_run(ctx: &PassContext, film: &mut Film, end: u32) -> Result<Option<Pas
     let samples = film.samples..end;
     let resolution = UVec2::new(film.width as u32, film.height as u32);
     let tiles = tiles(resolution);
+    let splats = match ctx.integrator.splats() {
+        true if film.adaptive.is_some() => {
+            return Err(Error::msg(
+                "adaptive sampling cannot be used with an integrator that splats: its paths \
+                 add light to pixels that may have stopped sampling",
+            ))
+        }
+        // The film's sums are made first: memory that is lacking fails
+        // before the render, not after it.
+        true => film.splat_sums().map(|_| {
+            Some(Splats {
+                buffer: SplatBuffer::new(resolution),
+                camera: ctx.camera.pinhole(),
+            })
+        })?,
+        false => None,
+    };
     let start = Instant::now();
     let rendered: Vec<Option<(Film, RenderStats)>> = ctx.pool.pool.install(|| {
         tiles
@@ -323,6 +362,7 @@ fn render_run(ctx: &PassContext, film: &mut Film, end: u32) -> Result<Option<Pas
                         ctx.clamp,
                         samples.clone(),
                         film.crop(tile.min, tile.max),
+                        splats.as_ref(),
                         ctx.stop,
                     );
                     if out.is_some() {
@@ -341,6 +381,10 @@ fn render_run(ctx: &PassContext, film: &mut Film, end: u32) -> Result<Option<Pas
     for (tile, (tile_film, tile_stats)) in tiles.iter().zip(rendered.into_iter().flatten()) {
         stats += tile_stats;
         film.paste(tile.min, tile_film);
+    }
+    if let Some(splats) = &splats {
+        splats.buffer.add_to(film.splat_sums()?)?;
+        stats.nonfinite += splats.buffer.dropped();
     }
     film.samples = end;
     Ok(Some(PassOutput { stats, seconds }))

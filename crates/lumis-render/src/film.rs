@@ -14,6 +14,7 @@ use lumis_image::Image;
 use crate::adaptive::{pixel_error, still_active, AdaptiveSampling};
 use crate::aov::Aov;
 use crate::first_hit::FirstHit;
+use crate::splat::{add_sums, SPLAT_QUANTUM};
 
 /// The sums of what a pixel's camera rays saw first ([`FirstHit`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -55,6 +56,11 @@ pub struct Film {
     pub aovs: Vec<Aov>,
     /// With adaptive sampling, the per-pixel counts and half-buffers.
     pub adaptive: Option<AdaptiveState>,
+    /// With an integrator that splats, the sums of the light it added to
+    /// each pixel from other pixels' samples, in units of
+    /// [`SPLAT_QUANTUM`] (`splat.rs`); the image adds them over the
+    /// samples per pixel.
+    pub splats: Option<Vec<[i64; 3]>>,
     /// The first sample index the sums hold: 0 for a whole render, `A` for
     /// the slice `A..B` of a render split into parts.
     pub start: u32,
@@ -88,12 +94,20 @@ fn sums_bytes_per_pixel(aovs: &[Aov]) -> usize {
 const ADAPTIVE_BYTES_PER_PIXEL: usize =
     std::mem::size_of::<u32>() + std::mem::size_of::<[f64; 3]>() + std::mem::size_of::<bool>();
 
+/// The bytes per pixel of the splats: the film's sums and those of the run
+/// being rendered ([`crate::SplatBuffer`]).
+const SPLAT_BYTES_PER_PIXEL: usize = 2 * std::mem::size_of::<[i64; 3]>();
+
 impl Film {
     /// The bytes a film of `resolution` with `aovs` (and adaptive
-    /// sampling's state, if `adaptive`) holds: what [`Film::try_with_aovs`]
-    /// and [`Film::with_adaptive`] allocate, known before they do.
-    pub fn memory_bytes(resolution: UVec2, aovs: &[Aov], adaptive: bool) -> u64 {
-        let per_pixel = sums_bytes_per_pixel(aovs) + ADAPTIVE_BYTES_PER_PIXEL * adaptive as usize;
+    /// sampling's state, if `adaptive`, and the splats' sums, if
+    /// `splats`) holds: what [`Film::try_with_aovs`],
+    /// [`Film::with_adaptive`] and a render that splats allocate, known
+    /// before they do.
+    pub fn memory_bytes(resolution: UVec2, aovs: &[Aov], adaptive: bool, splats: bool) -> u64 {
+        let per_pixel = sums_bytes_per_pixel(aovs)
+            + ADAPTIVE_BYTES_PER_PIXEL * adaptive as usize
+            + SPLAT_BYTES_PER_PIXEL * splats as usize;
         (u64::from(resolution.x) * u64::from(resolution.y)).saturating_mul(per_pixel as u64)
     }
 
@@ -135,9 +149,20 @@ impl Film {
                 aovs
             },
             adaptive: None,
+            splats: None,
             start: 0,
             samples: 0,
         })
+    }
+
+    /// The splats' sums, made (all zero) on first use: a film keeps them
+    /// once an integrator that splats has rendered to it.
+    pub fn splat_sums(&mut self) -> Result<&mut [[i64; 3]]> {
+        if self.splats.is_none() {
+            let too_large = || Error::msg("film: no memory for the splats' sums");
+            self.splats = Some(try_buffer(self.sums.len(), [0; 3], too_large)?);
+        }
+        Ok(self.splats.as_deref_mut().unwrap_or_default())
     }
 
     /// This film, sampling adaptively as `settings` say.
@@ -195,6 +220,11 @@ impl Film {
                 slice.start, slice.samples, self.samples
             )));
         }
+        if slice.splats.is_none() && self.splats.is_some() {
+            return Err(Error::msg(
+                "the slice has no splats where the film has: its integrator differs",
+            ));
+        }
         if (slice.width, slice.height) != (self.width, self.height) || slice.aovs != self.aovs {
             return Err(Error::msg(format!(
                 "the slice is a {}x{} film with outputs {:?}, not {}x{} with {:?}",
@@ -223,6 +253,13 @@ impl Film {
                     std::slice::from_ref(&from.normal),
                 );
                 to.depth += from.depth;
+            }
+        }
+        if let Some(from) = &slice.splats {
+            for (to, from) in self.splat_sums()?.iter_mut().zip(from) {
+                for c in 0..3 {
+                    to[c] = add_sums(to[c], from[c])?;
+                }
             }
         }
         self.samples = slice.samples;
@@ -326,6 +363,9 @@ impl Film {
                     .flat_map(|row| a.active[row + x0..row + x1].iter().copied())
                     .collect(),
             }),
+            // The splats stay with the whole film: a tile's paths land
+            // anywhere.
+            splats: None,
             start: self.start,
             samples: self.samples,
         }
@@ -371,9 +411,21 @@ impl Film {
         }
     }
 
-    /// The image: each pixel's mean, black before any sample.
+    /// The image: each pixel's mean, black before any sample, plus its
+    /// splats over the samples per pixel.
     pub fn image(&self) -> Image {
-        self.image_of(|i| self.sums[i].map(|s| s * self.inverse_samples(i)))
+        let mean = |i: usize| self.sums[i].map(|s| s * self.inverse_samples(i));
+        let Some(splats) = &self.splats else {
+            return self.image_of(mean);
+        };
+        let splat_scale = match self.samples - self.start {
+            0 => 0.0,
+            n => SPLAT_QUANTUM / n as f64,
+        };
+        self.image_of(|i| {
+            let mean = mean(i);
+            std::array::from_fn(|c| mean[c] + splats[i][c] as f64 * splat_scale)
+        })
     }
 
     /// The image of one output, or `None` for one this film was not made
@@ -467,7 +519,10 @@ mod tests {
                     + film.adaptive.as_ref().map_or(0, |a| {
                         a.counts.len() * 4 + a.odd_sums.len() * 24 + a.active.len()
                     });
-                assert_eq!(Film::memory_bytes(resolution, aovs, adaptive), held as u64);
+                assert_eq!(
+                    Film::memory_bytes(resolution, aovs, adaptive, false),
+                    held as u64
+                );
             }
         }
     }

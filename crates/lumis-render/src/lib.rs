@@ -9,6 +9,7 @@ mod film;
 mod first_hit;
 pub mod profile;
 mod progress;
+mod splat;
 
 pub use adaptive::{pixel_error, AdaptiveSampling};
 pub use aov::Aov;
@@ -20,3 +21,4 @@ pub use driver::{
 pub use film::{AdaptiveState, Film, FirstHitSums};
 pub use first_hit::{first_hit, first_hit_rng, FirstHit, MAX_SPECULAR_BOUNCES};
 pub use progress::{ProgressFn, RenderProgress};
+pub use splat::{SplatBuffer, SPLAT_QUANTUM};

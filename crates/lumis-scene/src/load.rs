@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use lumis_core::doc::Table;
 use lumis_core::{
-    Denoiser, Error, Integrator, LightSampler, Location, PluginEntity, Registry, Result, Sampler,
+    Denoiser, Error, Integrator, Light, LightSampler, Location, PluginEntity, Registry, Result,
+    Sampler, Vec2,
 };
 use lumis_files::{FileKind, MIB};
 use lumis_render::{Aov, PerspectiveCamera};
@@ -75,6 +76,10 @@ pub fn load_str(
 /// plugins are created through the registry (extended with the libraries
 /// the scene loads), and its shapes are assembled into Embree with their
 /// area lights; the light sampler comes last, over every light.
+///
+/// An integrator that traces paths from the lights
+/// ([`lumis_core::Integrator::splats`]) is refused with adaptive sampling,
+/// and with a light that starts no paths.
 pub(crate) fn load_document(
     root: Table,
     origin: &Location,
@@ -124,6 +129,35 @@ pub(crate) fn load_document(
     )?;
     let light_sampler =
         registry.create::<dyn LightSampler>(&description.light_sampler, &assembled.lights)?;
+    if plugins.integrator.splats() {
+        let integrator = &description.integrator;
+        if let Some(adaptive) = &description.adaptive {
+            return Err(Error::at(
+                &adaptive.location,
+                format!(
+                    "[adaptive] cannot be used with integrator type '{}': its paths from the \
+                     lights add light to pixels that may have stopped sampling",
+                    integrator.type_name
+                ),
+            ));
+        }
+        if let Some(index) = assembled
+            .lights
+            .iter()
+            .position(|l| !starts_light_paths(l.as_ref()))
+        {
+            return Err(Error::at(
+                &integrator.type_location,
+                format!(
+                    "integrator type '{}' traces paths from the lights, but light {index} \
+                     (of power {}) starts none: its plugin does not implement \
+                     Light::sample_le",
+                    integrator.type_name,
+                    assembled.lights[index].power()
+                ),
+            ));
+        }
+    }
 
     let textured = assembled.footprint || plugins.textures.values().any(|t| t.uses_footprint());
     let scene = RenderScene {
@@ -181,4 +215,15 @@ pub(crate) fn load_document(
         clamp: description.clamp,
         adaptive,
     })
+}
+
+/// Whether `light` starts paths from the lights: one that keeps
+/// [`Light::sample_le`]'s default answers `None` everywhere, one that emits
+/// answers somewhere on a 4 x 4 grid of its numbers.
+fn starts_light_paths(light: &dyn Light) -> bool {
+    light.power().is_black()
+        || (0..16).any(|i| {
+            let u = Vec2::new((i % 4) as f32 + 0.5, (i / 4) as f32 + 0.5) / 4.0;
+            light.sample_le(u, Vec2::new(u.y, u.x)).is_some()
+        })
 }

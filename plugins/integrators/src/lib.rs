@@ -1,9 +1,11 @@
 //! Standard integrators: `path` (unidirectional path tracing), `direct`
-//! (direct lighting only), and `wavefront` and `packet` (`path`'s estimator
-//! on many paths at once), sharing one direct-lighting estimator.
+//! (direct lighting only), `wavefront` and `packet` (`path`'s estimator
+//! on many paths at once), sharing one direct-lighting estimator, and
+//! `light` (particle tracing, from the lights to the camera).
 
 mod direct;
 mod estimator;
+mod light;
 mod packet;
 mod path;
 mod path_state;
@@ -15,6 +17,7 @@ pub use estimator::{
     Estimator, EstimatorParams, Heuristic, HeuristicName, MisEstimator, SceneView, Strategy,
     VertexPlan,
 };
+pub use light::{LightTracer, LightTracerParams};
 pub use packet::{PacketIntegrator, PacketParams};
 pub use path::{PathIntegrator, PathParams};
 pub use specialize::{Specialized, Trace};
@@ -35,7 +38,8 @@ pub fn register(registry: &mut dyn Registrar) -> Result<()> {
     })?;
     registry.add_integrator(packet::SPEC, |p| {
         Ok(Box::new(PacketIntegrator::from_params(p)?))
-    })
+    })?;
+    registry.add_integrator(light::SPEC, |p| Ok(Box::new(LightTracer::from_params(p)?)))
 }
 
 /// As [`register`], with each integrator's loop also compiled for the scene
@@ -59,5 +63,6 @@ pub fn register_specialized<S: Scene + 'static>(registry: &mut dyn Registrar) ->
     })?;
     registry.add_integrator(packet::SPEC, |p| {
         Ok(Box::new(PacketIntegrator::from_params(p)?))
-    })
+    })?;
+    registry.add_integrator(light::SPEC, |p| Ok(Box::new(LightTracer::from_params(p)?)))
 }

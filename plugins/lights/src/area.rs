@@ -2,8 +2,11 @@
 //! measure from area to solid angle.
 
 use lumis_api::interaction::LightSampleContext;
+use lumis_api::light::EmissionSample;
 use lumis_api::ray::SurfacePoint;
 use std::sync::Arc;
+
+use crate::emission::diffuse_emission;
 
 use lumis_api::params::Textured;
 use lumis_api::{
@@ -317,6 +320,18 @@ impl<S: PlanarShape> Light for AreaLight<S> {
             Sampling::Area => self.sample_area(ctx, u),
             Sampling::SolidAngle => self.sample_solid_angle(ctx, u),
         }
+    }
+
+    /// A point uniform by area, emitting cosine-distributed about its
+    /// normal.
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        diffuse_emission(
+            self.shape.sample_point(u_pos),
+            1.0 / self.shape.area(),
+            self.emission.radiance,
+            self.emission.two_sided,
+            u_dir,
+        )
     }
 
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {

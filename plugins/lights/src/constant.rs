@@ -1,7 +1,9 @@
 //! `constant`: uniform radiance arriving from every direction (the white
 //! furnace's light).
 
+use crate::emission::infinite_emission;
 use lumis_api::interaction::LightSampleContext;
+use lumis_api::light::EmissionSample;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
     Error, Light, LightKind, LightSample, LightShape, Params, PluginKind, PluginParams, PluginSpec,
@@ -73,6 +75,12 @@ impl Light for ConstantLight {
             pdf: warp::UNIFORM_SPHERE_PDF,
             p: SurfacePoint::isolated(far),
         })
+    }
+
+    /// From a point on the disk facing the direction drawn, outside the
+    /// scene's bounding sphere.
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        infinite_emission(self, self.scene_center, self.scene_radius, u_pos, u_dir)
     }
 
     fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vec3) -> f32 {

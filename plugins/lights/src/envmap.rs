@@ -21,8 +21,10 @@ mod equirect;
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
+use crate::emission::infinite_emission;
 use lumis_api::glam::Quat;
 use lumis_api::interaction::LightSampleContext;
+use lumis_api::light::EmissionSample;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
     Error, Light, LightKind, LightSample, LightShape, ParamChoice, Params, PluginKind,
@@ -233,6 +235,12 @@ impl Light for EnvMapLight {
             pdf,
             p: self.far_point(ctx, wi),
         })
+    }
+
+    /// From a point on the disk facing the direction drawn, outside the
+    /// scene's bounding sphere.
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        infinite_emission(self, self.scene_center, self.scene_radius, u_pos, u_dir)
     }
 
     fn pdf_li(&self, _ctx: &LightSampleContext, wi: Vec3) -> f32 {

@@ -4,6 +4,7 @@
 
 mod area;
 mod constant;
+mod emission;
 mod envmap;
 mod point;
 mod quad;

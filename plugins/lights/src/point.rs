@@ -1,11 +1,13 @@
 //! `point`: an isotropic point light (a delta distribution in position).
 
 use lumis_api::interaction::LightSampleContext;
+use lumis_api::light::EmissionSample;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
     Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
     PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
+use lumis_sampling::warp;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -71,6 +73,17 @@ impl Light for PointLight {
             wi: to_light / dist2.sqrt(),
             pdf: 1.0,
             p: SurfacePoint::isolated(self.position),
+        })
+    }
+
+    /// A direction uniform over the sphere.
+    fn sample_le(&self, _u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        Some(EmissionSample {
+            p: SurfacePoint::isolated(self.position),
+            d: warp::square_to_uniform_sphere(u_dir),
+            l: self.intensity,
+            pdf_pos: 1.0,
+            pdf_dir: warp::UNIFORM_SPHERE_PDF,
         })
     }
 

@@ -14,7 +14,11 @@
 use std::f32::consts::PI;
 
 use lumis_api::lanes::{LaneMask, Vec2Lanes, LANES};
-use lumis_api::light::{sample_li_each, sample_li_lanes_by_batch, LightSampleLanes};
+use lumis_api::light::{
+    sample_li_each, sample_li_lanes_by_batch, EmissionSample, LightSampleLanes,
+};
+
+use crate::emission::diffuse_emission;
 use lumis_api::math::gamma;
 use lumis_api::ray::SurfacePoint;
 use lumis_api::{
@@ -328,6 +332,18 @@ impl Light for SphereLight {
                 }
             }
         })
+    }
+
+    /// A point uniform by area, emitting cosine-distributed about its
+    /// normal (inward for an inward sphere).
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        diffuse_emission(
+            self.surface_point(warp::square_to_uniform_sphere(u_pos)),
+            1.0 / self.area(),
+            self.emission.radiance,
+            self.emission.two_sided,
+            u_dir,
+        )
     }
 
     fn pdf_li(&self, ctx: &LightSampleContext, wi: Vec3) -> f32 {

@@ -6,11 +6,14 @@
 //! is never hit by a ray, so its samples take MIS weight 1.
 
 use lumis_api::interaction::LightSampleContext;
+use lumis_api::light::EmissionSample;
 use lumis_api::ray::SurfacePoint;
+use lumis_api::Frame;
 use lumis_api::{
     Aabb, Error, Light, LightBounds, LightKind, LightSample, LightShape, Params, PluginKind,
     PluginParams, PluginSpec, Result, Rgb, Vec2, Vec3,
 };
+use lumis_sampling::warp;
 
 pub const SPEC: PluginSpec = PluginSpec {
     kind: PluginKind::Light,
@@ -130,6 +133,21 @@ impl Light for SpotLight {
             wi,
             pdf: 1.0,
             p: SurfacePoint::isolated(self.position),
+        })
+    }
+
+    /// A direction uniform in the cone of the cutoff angle (pbrt-v4
+    /// `SpotLight::SampleLe`), its intensity the falloff's.
+    fn sample_le(&self, _u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let h_max = 1.0 - self.cos_falloff_end;
+        let local = warp::square_to_uniform_cone(u_dir, h_max);
+        let l = self.intensity * self.falloff(local.z);
+        (!l.is_black()).then(|| EmissionSample {
+            p: SurfacePoint::isolated(self.position),
+            d: Frame::from_z(self.axis).to_world(local),
+            l,
+            pdf_pos: 1.0,
+            pdf_dir: warp::uniform_cone_pdf(h_max),
         })
     }
 

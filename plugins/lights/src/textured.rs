@@ -5,6 +5,7 @@
 
 use std::sync::Arc;
 
+use lumis_api::light::EmissionSample;
 use lumis_api::{
     Light, LightBounds, LightKind, LightSample, LightSampleContext, Rgb, Texture, TextureQuery,
     Vec2, Vec3,
@@ -58,6 +59,12 @@ impl<S: PlanarShape> Light for TexturedAreaLight<S> {
 
     fn sample_li(&self, ctx: &LightSampleContext, u: Vec2) -> Option<LightSample> {
         let mut s = self.light.sample_li(ctx, u)?;
+        s.l = self.at(self.light.shape.uv_at(s.p.p)) * s.l;
+        Some(s)
+    }
+
+    fn sample_le(&self, u_pos: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+        let mut s = self.light.sample_le(u_pos, u_dir)?;
         s.l = self.at(self.light.shape.uv_at(s.p.p)) * s.l;
         Some(s)
     }
