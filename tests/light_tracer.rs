@@ -184,17 +184,19 @@ fn splats_are_the_same_whatever_the_threads_passes_or_parts() {
 
 /// Each built-in light's paths carry its power: the mean of
 /// `L |cos| / (pdf_pos pdf_dir)` over its rays is `power()` (area, sphere,
-/// point and spot lights, a textured one and the environment, whose power
-/// is what enters the scene's bounding sphere).
+/// point and spot lights, a textured one, and a constant and an image
+/// environment, whose power is what enters the scene's bounding sphere).
 #[test]
 fn every_lights_paths_carry_its_power() {
     let textured = EVERY_LIGHT.replace(
         "emission = { radiance = 3.0, two_sided = true }",
         "emission = { radiance = { texture = \"checks\" }, two_sided = true }",
     );
-    let loaded = load(&textured, &[]);
+    let with_map =
+        format!("{textured}\n[[light]]\ntype = \"envmap\"\nfilename = \"bench/sky.exr\"\n");
+    let loaded = load(&with_map, &[]);
     let lights = loaded.scene.lights();
-    assert_eq!(lights.len(), 5);
+    assert_eq!(lights.len(), 6);
     let mut rng = Pcg32::new(7, 11);
     let n = 400_000;
     for (index, light) in lights.iter().enumerate() {
