@@ -10,7 +10,10 @@
 //!   radiance `l()` gives at its point, and `sample_li_batch` and
 //!   `sample_li_lanes` (on every lane and under a mask, the masked-out
 //!   lanes untouched) return what `sample_li` does;
-//! - `power()` is finite and non-negative;
+//! - `power()` is finite and non-negative, and where the light starts
+//!   paths from the lights (`sample_le`), the mean power its rays carry,
+//!   `L |cos| / (pdf_pos pdf_dir)`, is `power()` within five standard
+//!   errors;
 //! - no NaN, infinite or negative radiance or pdf anywhere.
 //!
 //! A delta light (`LightKind::DeltaPosition`) has no density to test: its
@@ -354,6 +357,11 @@ pub fn check_light_variants(
                     .problems
                     .push(format!("power() = {:?}", result.power));
             }
+            result.problems.extend(check_emission(
+                light.as_ref(),
+                variant.samples(cfg.samples),
+                case as u64,
+            ));
             if light.kind() == LightKind::DeltaPosition {
                 result.problems.extend(check_delta(
                     light.as_ref(),
@@ -600,6 +608,52 @@ fn check_lanes(light: &dyn Light, ctx: &LightSampleContext, u: &[Vec2]) -> Vec<S
     Vec::new()
 }
 
+/// The rays `sample_le` starts carry the light's power on average: the
+/// mean of `L |cos| / (pdf_pos pdf_dir)` over `samples` random rays is
+/// `power()` within five standard errors, and every ray is finite with
+/// positive densities. A light that starts none (the trait's default) has
+/// nothing to check.
+fn check_emission(light: &dyn Light, samples: usize, seed: u64) -> Vec<String> {
+    let mut rng = Pcg32::new(seed, 0xe1e5);
+    let (mut sum, mut squares, mut started) = ([0.0f64; 3], [0.0f64; 3], 0);
+    for _ in 0..samples {
+        let mut u = || rng.next_f32();
+        let (u_pos, u_dir) = (Vec2::new(u(), u()), Vec2::new(u(), u()));
+        let Some(ray) = light.sample_le(u_pos, u_dir) else {
+            continue;
+        };
+        let beta = ray.beta();
+        if bad(ray.pdf_pos) || bad(ray.pdf_dir) || bad_rgb(beta) || !ray.d.is_finite() {
+            return vec![format!(
+                "sample_le returned a ray with l = {:?}, pdf_pos = {}, pdf_dir = {}, d = {:?} at u = {u_pos:?}, {u_dir:?}",
+                ray.l, ray.pdf_pos, ray.pdf_dir, ray.d
+            )];
+        }
+        started += 1;
+        for (c, v) in [beta.r, beta.g, beta.b].into_iter().enumerate() {
+            sum[c] += v as f64;
+            squares[c] += v as f64 * v as f64;
+        }
+    }
+    if started == 0 {
+        return Vec::new();
+    }
+    let n = samples as f64;
+    let power = light.power();
+    let mut problems = Vec::new();
+    for (c, expected) in [power.r, power.g, power.b].into_iter().enumerate() {
+        let mean = sum[c] / n;
+        let se = ((squares[c] / n - mean * mean).max(0.0) / n).sqrt();
+        let expected = expected as f64;
+        if (mean - expected).abs() > 5.0 * se + 1e-4 * expected.abs() {
+            problems.push(format!(
+                "the rays sample_le starts carry {mean:.5} on average in channel {c}, not power() = {expected:.5} ({se:.2e} standard error)"
+            ));
+        }
+    }
+    problems
+}
+
 /// A delta light: `sample_li` returns the same sample whatever `u` (bit
 /// for bit), finite and non-negative, and `pdf_li` is zero everywhere.
 fn check_delta(
@@ -700,6 +754,7 @@ pub fn format_light_results(results: &[LightCaseResult]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lumis_core::EmissionSample;
 
     /// An infinite light of radiance 1 above the horizon and 0 below,
     /// sampled uniformly over the sphere; its samples report
@@ -738,6 +793,62 @@ mod tests {
         fn power(&self) -> Rgb {
             Rgb::WHITE
         }
+    }
+
+    /// A point of intensity `(1, 2, 1)` in the upper hemisphere and half
+    /// that below, which starts rays uniform over the sphere and reports
+    /// their density times `pdf_scale`.
+    struct Glow {
+        pdf_scale: f32,
+    }
+
+    impl Light for Glow {
+        fn kind(&self) -> LightKind {
+            LightKind::DeltaPosition
+        }
+
+        fn sample_li(&self, _: &LightSampleContext, _: Vec2) -> Option<LightSample> {
+            None
+        }
+
+        fn sample_le(&self, _: Vec2, u_dir: Vec2) -> Option<EmissionSample> {
+            let d = warp::square_to_uniform_sphere(u_dir);
+            let l = Rgb::new(1.0, 2.0, 1.0) * if d.z > 0.0 { 1.0 } else { 0.5 };
+            Some(EmissionSample {
+                p: SurfacePoint::isolated(Vec3::ZERO),
+                d,
+                l,
+                pdf_pos: 1.0,
+                pdf_dir: warp::UNIFORM_SPHERE_PDF * self.pdf_scale,
+            })
+        }
+
+        fn pdf_li(&self, _: &LightSampleContext, _: Vec3) -> f32 {
+            0.0
+        }
+
+        fn l(&self, _: Vec3, _: Vec3, _: Vec2, _: Vec3) -> Rgb {
+            Rgb::BLACK
+        }
+
+        fn power(&self) -> Rgb {
+            Rgb::new(1.0, 2.0, 1.0) * (3.0 * std::f32::consts::PI)
+        }
+    }
+
+    /// Rays that carry the light's power pass; rays whose density is 2%
+    /// off fail, naming the channel.
+    #[test]
+    fn rays_that_miss_the_power_fail() {
+        let honest = check_emission(&Glow { pdf_scale: 1.0 }, 20_000, 1);
+        assert!(honest.is_empty(), "{honest:?}");
+        let off = check_emission(&Glow { pdf_scale: 1.02 }, 20_000, 1);
+        assert!(
+            off.iter().any(|p| p.contains("sample_le starts carry")),
+            "{off:?}"
+        );
+        let none = check_emission(&HalfSky { sample_scale: 1.0 }, 100, 1);
+        assert!(none.is_empty(), "a light that starts no rays: {none:?}");
     }
 
     /// The spread that forgives a sample at a radiance edge does not
