@@ -30,8 +30,9 @@ fn check_with(
 }
 
 /// `path` passes the full check in [`check_plugin_checks_a_builtin_integrator`];
-/// `direct` (whose exact values are those of depth 2), `wavefront` and
-/// `packet` pass it at half the samples, to keep this test short.
+/// `direct` (whose exact values are those of depth 2), `wavefront`,
+/// `packet` and `light` (the film's splats through the driver) pass it at
+/// half the samples, to keep this test short.
 #[test]
 fn every_builtin_integrator_passes() {
     let registry = builtin_registry().unwrap();
@@ -40,7 +41,7 @@ fn every_builtin_integrator_passes() {
         compare_spp: 32,
         ..IntegratorCheckConfig::default()
     };
-    for name in ["direct", "wavefront", "packet"] {
+    for name in ["direct", "wavefront", "packet", "light"] {
         let results = check_with(&registry, name, &cfg);
         let table = format_integrator_results(&results);
         assert!(results.iter().all(|r| r.passed()), "{table}");
