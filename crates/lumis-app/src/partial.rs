@@ -11,8 +11,9 @@
 //! output), `albedo_sum.{R,G,B}`, `normal_sum.{X,Y,Z}` and `depth_sum.Z`
 //! (with `albedo`, `normal` or `depth`), the bits of the splat sums of an
 //! integrator that splats, `i64`s in `partial.splat.{R,G,B}.hi` and
-//! `.lo`, and each pixel's sample count in `partial.count`. The header holds the [`ImageMetadata`] with its
-//! `lumis.slice` and `lumis.total_spp`, the outputs in `lumis.aovs`, and
+//! `.lo`, and each pixel's sample count in `partial.count`. The header
+//! holds the [`ImageMetadata`] with its `lumis.slice` and
+//! `lumis.total_spp`, the outputs in `lumis.aovs`, and
 //! `lumis.checksum`, the FNV-1a hash of the whole-number channels, so a
 //! damaged file is refused rather than merged.
 
